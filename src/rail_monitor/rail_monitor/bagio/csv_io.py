@@ -1,0 +1,170 @@
+"""CSV export of a wayside detector: documented columns with units in the header.
+
+One row per train pass; lines starting with '#' are comments. A column's name is the quantity
+followed by its unit; the accepted names and their conversion to SI are the table below, so a
+file in km/h or mrad reads correctly and a file in an unknown unit is refused by name.
+
+    quantity              accepted columns (unit)                          required
+    time                  time_utc (ISO 8601), time_unix_s, time_unix_ns   yes
+    train_id              train_id                                         yes
+    vehicle_class         vehicle_class                                    yes
+    vehicle_count         vehicle_count                                    one of the two
+    axle_count            axle_count                                       one of the two
+    speed                 speed_mps, speed_kmh                             yes
+    angle_of_attack       angle_of_attack_rad, angle_of_attack_mrad        yes
+    wheel_load            wheel_load_n, wheel_load_kn                      no (0: class value)
+    friction_state        dry, wet, friction_modifier, contaminated        yes
+    train_length          train_length_m                                   no (0: from the class)
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Callable
+from pathlib import Path
+
+
+from rail_monitor.errors import InputError, RailMonitorError
+from rail_monitor.passes import FRICTION_BY_NAME, FRICTION_NAMES, PassTable
+from rail_monitor.timeutil import NS_PER_S, format_iso_ns, parse_iso_ns
+
+
+def _time_utc(text: str) -> int:
+    return parse_iso_ns(text)
+
+
+def _time_unix_s(text: str) -> int:
+    return int(round(float(text) * NS_PER_S))
+
+
+def _friction(text: str) -> int:
+    try:
+        return FRICTION_BY_NAME[text.strip().lower()]
+    except KeyError:
+        raise ValueError(f"unknown friction state {text!r} (use {', '.join(FRICTION_BY_NAME)})") from None
+
+
+def _count(text: str) -> int:
+    value = int(text)
+    if value < 0 or value > 65535:
+        raise ValueError(f"{value} is outside 0-65535")
+    return value
+
+
+def _scaled(factor: float) -> Callable[[str], float]:
+    return lambda text: float(text) * factor
+
+
+# quantity -> {column name: parser to the PassTable column's SI value}; None marks "optional".
+_QUANTITIES: dict[str, tuple[str, dict[str, Callable[[str], object]], object]] = {
+    "time": ("stamp_ns", {"time_utc": _time_utc, "time_unix_s": _time_unix_s, "time_unix_ns": int}, None),
+    "train_id": ("train_id", {"train_id": str}, None),
+    "vehicle_class": ("vehicle_class", {"vehicle_class": str}, None),
+    "vehicle_count": ("vehicle_count", {"vehicle_count": _count}, 0),
+    "axle_count": ("axle_count", {"axle_count": _count}, 0),
+    "speed": ("speed_mps", {"speed_mps": float, "speed_kmh": _scaled(1.0 / 3.6)}, None),
+    "angle_of_attack": ("angle_of_attack_rad",
+                        {"angle_of_attack_rad": float, "angle_of_attack_mrad": _scaled(1.0e-3)}, None),
+    "wheel_load": ("wheel_load_n", {"wheel_load_n": float, "wheel_load_kn": _scaled(1.0e3)}, 0.0),
+    "friction_state": ("friction_state", {"friction_state": _friction}, None),
+    "train_length": ("train_length_m", {"train_length_m": float}, 0.0),
+}
+
+
+def _quantity_of(column: str) -> str | None:
+    for q in sorted(_QUANTITIES, key=len, reverse=True):
+        if column == q or column.startswith(q + "_"):
+            return q
+    return None
+
+
+def _read_text(path: Path) -> str:
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise InputError(f"{path}: line {line}: not UTF-8 text (byte {raw[exc.start]:#04x}); "
+                         "export the CSV as UTF-8") from None
+
+
+def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
+    """Read a detector CSV. A malformed row is an error naming its line, unless skip_bad_rows
+    (then it is left out and counted in the returned table's ``skipped`` attribute)."""
+    path = Path(path)
+    text = _read_text(path)
+    lines = [(n, line) for n, line in enumerate(text.splitlines(), start=1)
+             if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise InputError(f"{path}: no header line (expected columns such as time_utc,train_id,...)")
+    header_line, header = lines[0][0], next(csv.reader([lines[0][1]]))
+    header = [h.strip() for h in header]
+    parsers: dict[int, tuple[str, Callable[[str], object]]] = {}
+    seen: dict[str, str] = {}
+    for i, col in enumerate(header):
+        q = _quantity_of(col)
+        if q is None:
+            continue  # extra columns of a detector export are allowed and ignored
+        target, accepted, _ = _QUANTITIES[q]
+        if col not in accepted:
+            raise InputError(f"{path}: line {header_line}: column {col!r} has a unit this reader does not "
+                             f"accept; use one of {', '.join(accepted)}")
+        if q in seen:
+            raise InputError(f"{path}: line {header_line}: columns {seen[q]!r} and {col!r} give the same quantity")
+        seen[q] = col
+        parsers[i] = (target, accepted[col])
+    missing = [q for q, (_, acc, default) in _QUANTITIES.items() if default is None and q not in seen]
+    if missing:
+        names = "; ".join(" or ".join(_QUANTITIES[q][1]) for q in missing)
+        raise InputError(f"{path}: missing column(s): {names}")
+    if "vehicle_count" not in seen and "axle_count" not in seen:
+        raise InputError(f"{path}: missing column: vehicle_count or axle_count")
+
+    rows, skipped = [], 0
+    for n, line in lines[1:]:
+        cells = next(csv.reader([line]))
+        try:
+            if len(cells) != len(header):
+                raise ValueError(f"{len(cells)} fields where the header has {len(header)}")
+            row = {target: default for _, (target, _, default) in _QUANTITIES.items()}
+            for i, (target, parse) in parsers.items():
+                try:
+                    row[target] = parse(cells[i].strip())
+                except (ValueError, RailMonitorError) as exc:
+                    raise ValueError(f"column {header[i]!r}: {exc}") from None
+            rows.append(row)
+        except ValueError as exc:
+            if not skip_bad_rows:
+                raise InputError(f"{path}: line {n}: {exc}") from None
+            skipped += 1
+    table = PassTable.from_rows(rows)
+    table.skipped = skipped  # type: ignore[attr-defined]
+    return table
+
+
+CSV_HEADER_COMMENT = """\
+# Train passes at a wayside site (rail_monitor CSV). One row per pass.
+# time_utc: ISO 8601 UTC; speed_mps [m/s]; angle_of_attack_rad [rad]; wheel_load_n [N] (0: class value);
+# train_length_m [m] (0: from the class); friction_state: dry | wet | friction_modifier | contaminated
+"""
+
+
+def write_csv(table: PassTable, path: str | Path) -> None:
+    """Write passes in the documented layout (SI columns, ISO times with ns; lossless)."""
+    buf = io.StringIO()
+    buf.write(CSV_HEADER_COMMENT)
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["time_utc", "train_id", "vehicle_class", "vehicle_count", "axle_count", "speed_mps",
+                "angle_of_attack_rad", "wheel_load_n", "friction_state", "train_length_m"])
+    for i in range(len(table)):
+        r = table.row(i)
+        w.writerow([format_iso_ns(r["stamp_ns"]), r["train_id"], r["vehicle_class"], r["vehicle_count"],
+                    r["axle_count"], repr(r["speed_mps"]), repr(r["angle_of_attack_rad"]), repr(r["wheel_load_n"]),
+                    FRICTION_NAMES.get(r["friction_state"], str(r["friction_state"])), repr(r["train_length_m"])])
+    Path(path).write_text(buf.getvalue(), encoding="utf-8")
+
+

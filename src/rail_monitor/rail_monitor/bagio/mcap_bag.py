@@ -1,0 +1,270 @@
+"""A rosbag2-compatible MCAP bag writer: one folder, metadata.yaml version 9, split files.
+
+Layout and fields follow rosbag2 Jazzy's MCAP storage: header profile ``ros2``; one schema per
+type with encoding ``ros2msg`` (full dependency text); channels with message encoding ``cdr``
+and metadata ``offered_qos_profiles`` (YAML text) and ``topic_type_hash`` (RIHS01); a
+``rosbag2`` metadata record; zstd-compressed chunks. Chunks are
+closed at least every ``flush_period_ns`` of log time or wall time, and every write goes to the
+OS at once, so a killed process leaves every complete chunk readable (see :func:`rail_monitor.bagio.reader.salvage_mcap`).
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+from mcap.writer import CompressionType, Writer
+
+from rail_monitor.bagio.typestore import schema_text, type_hash
+from rail_monitor.errors import RailMonitorError
+
+# rosbag2's "infinite" duration in QoS (deadline, lifespan, lease) as written by Jazzy.
+_INFINITE = {"sec": 9223372036, "nsec": 854775807}
+
+
+def qos_dict(reliable: bool = True, transient_local: bool = False, depth: int = 1000,
+             keep_all: bool = False) -> dict[str, Any]:
+    """One offered QoS profile in the metadata.yaml version 9 layout."""
+    return {
+        "history": "keep_all" if keep_all else "keep_last",
+        "depth": depth,
+        "reliability": "reliable" if reliable else "best_effort",
+        "durability": "transient_local" if transient_local else "volatile",
+        "deadline": dict(_INFINITE),
+        "lifespan": dict(_INFINITE),
+        "liveliness": "automatic",
+        "liveliness_lease_duration": dict(_INFINITE),
+        "avoid_ros_namespace_conventions": False,
+    }
+
+
+class _DirectFile:
+    """A write-only file whose every write reaches the OS at once (no user-space buffer), so a
+    killed writer leaves on disk everything it wrote. Not a RawIOBase, which mcap would wrap in
+    a BufferedWriter."""
+
+    def __init__(self, path: Path) -> None:
+        self._fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+        self._pos = 0
+
+    def write(self, data: bytes | memoryview) -> int:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(self._fd, view):]
+        self._pos += len(data)
+        return len(data)
+
+    def tell(self) -> int:
+        return self._pos
+
+    def flush(self) -> None:
+        pass
+
+    def fileno(self) -> int:
+        return self._fd
+
+    def close(self) -> None:
+        os.close(self._fd)
+
+
+def _dump(obj: Any) -> str:
+    return yaml.safe_dump(obj, sort_keys=False, default_flow_style=False)
+
+
+@dataclass
+class _Topic:
+    name: str
+    typename: str
+    qos: list[dict[str, Any]]
+    count: int = 0
+
+
+@dataclass
+class _File:
+    path: Path
+    writer: Writer
+    stream: Any
+    channel_ids: dict[str, int] = field(default_factory=dict)
+    first_ns: int | None = None
+    last_ns: int = 0
+    count: int = 0
+
+
+class McapBagWriter:
+    """Write CDR-serialised messages into a rosbag2 MCAP bag folder.
+
+    Parameters: folder [path] (must not exist, or be empty); compression 'zstd' or 'none';
+    chunk_size [bytes] of uncompressed messages per chunk; max_file_bytes [bytes] and
+    max_file_duration_ns [ns] of log time to start a new file (0: no split); flush_period_ns
+    [ns] of log time after which an open chunk is closed (0: only when full);
+    flush_wall_period_s [s] of wall time likewise (0: never).
+    """
+
+    def __init__(self, folder: str | Path, *, compression: str = "zstd", chunk_size: int = 1 << 20,
+                 max_file_bytes: int = 0, max_file_duration_ns: int = 0, flush_period_ns: int = 0,
+                 flush_wall_period_s: float = 0.0) -> None:
+        self.folder = Path(folder)
+        if self.folder.exists() and any(self.folder.iterdir()):
+            raise RailMonitorError(f"{self.folder}: output folder exists and is not empty")
+        if compression not in ("zstd", "none"):
+            raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
+        self._chunk_size = chunk_size
+        self._max_bytes = max_file_bytes
+        self._max_duration = max_file_duration_ns
+        self._flush_ns = flush_period_ns
+        self._flush_wall = flush_wall_period_s
+        self._last_flush_ns = 0
+        self._last_flush_wall = time.monotonic()
+        self._topics: dict[str, _Topic] = {}
+        self._files: list[_File] = []
+        self._file: _File | None = None
+        self.closed = False
+
+    # -- topics and files -------------------------------------------------------------------
+    def add_topic(self, topic: str, typename: str, offered_qos: list[dict[str, Any]] | None = None) -> None:
+        """Declare a topic before writing to it (idempotent for the same type)."""
+        known = self._topics.get(topic)
+        if known is not None:
+            if known.typename != typename:
+                raise RailMonitorError(f"topic {topic} already recorded as {known.typename}, not {typename}")
+            return
+        self._topics[topic] = _Topic(topic, typename, offered_qos if offered_qos is not None else [qos_dict()])
+        if self._file is not None:
+            self._register(self._file, self._topics[topic])
+
+    def _register(self, f: _File, t: _Topic) -> None:
+        schema_id = f.writer.register_schema(name=t.typename, encoding="ros2msg",
+                                             data=schema_text(t.typename).encode())
+        f.channel_ids[t.name] = f.writer.register_channel(
+            topic=t.name, message_encoding="cdr", schema_id=schema_id,
+            metadata={"offered_qos_profiles": _dump(t.qos).rstrip("\n"), "topic_type_hash": type_hash(t.typename)},
+        )
+
+    def _open_file(self) -> _File:
+        path = self.folder / f"{self.folder.name}_{len(self._files)}.mcap"
+        stream = _DirectFile(path)
+        writer = Writer(stream, chunk_size=self._chunk_size, compression=self._compression)
+        writer.start(profile="ros2", library="rail_monitor")
+        f = _File(path, writer, stream)
+        for t in self._topics.values():
+            self._register(f, t)
+        self._files.append(f)
+        return f
+
+    def _close_file(self, f: _File) -> None:
+        f.writer.add_metadata("rosbag2", {"serialized_metadata": _dump(self._info()), "ROS_DISTRO": "jazzy"})
+        f.writer.finish()
+        f.stream.close()
+
+    # -- writing ----------------------------------------------------------------------------
+    def write(self, topic: str, data: bytes, log_time_ns: int, publish_time_ns: int | None = None) -> None:
+        """Append one serialised message [CDR bytes] at log_time_ns [ns since the epoch]."""
+        if self.closed:
+            raise RailMonitorError("bag writer is closed")
+        t = self._topics.get(topic)
+        if t is None:
+            raise RailMonitorError(f"topic {topic} was not added to the bag")
+        f = self._file
+        if f is not None and f.first_ns is not None and (
+            (self._max_bytes and f.stream.tell() >= self._max_bytes)
+            or (self._max_duration and log_time_ns - f.first_ns >= self._max_duration)
+        ):
+            self._close_file(f)
+            f = None
+        if f is None:
+            f = self._file = self._open_file()
+        f.writer.add_message(channel_id=f.channel_ids[topic], log_time=log_time_ns, data=data,
+                             publish_time=log_time_ns if publish_time_ns is None else publish_time_ns,
+                             sequence=t.count)
+        if f.first_ns is None:
+            f.first_ns = log_time_ns
+        f.first_ns = min(f.first_ns, log_time_ns)
+        f.last_ns = max(f.last_ns, log_time_ns)
+        f.count += 1
+        t.count += 1
+        self._maybe_flush(log_time_ns)
+
+    def _maybe_flush(self, log_time_ns: int) -> None:
+        now = time.monotonic()
+        by_log = self._flush_ns and log_time_ns - self._last_flush_ns >= self._flush_ns
+        by_wall = self._flush_wall and now - self._last_flush_wall >= self._flush_wall
+        if by_log or by_wall:
+            self.flush()
+            self._last_flush_ns, self._last_flush_wall = log_time_ns, now
+
+    def flush(self) -> None:
+        """Close the open chunk and hand it to the OS (messages so far survive a kill)."""
+        if self._file is not None:
+            self._file.writer.flush()
+
+    def sync(self) -> None:
+        """flush, then fsync the open file (survives a power loss)."""
+        if self._file is not None:
+            self.flush()
+            os.fsync(self._file.stream.fileno())
+
+    # -- metadata ---------------------------------------------------------------------------
+    @property
+    def message_count(self) -> int:
+        return sum(t.count for t in self._topics.values())
+
+    def topic_counts(self) -> dict[str, int]:
+        return {t.name: t.count for t in self._topics.values()}
+
+    def _info(self) -> dict[str, Any]:
+        files = self._files
+        start = min((f.first_ns for f in files if f.first_ns is not None), default=0)
+        end = max((f.last_ns for f in files), default=0)
+        return {
+            "version": 9,
+            "storage_identifier": "mcap",
+            "duration": {"nanoseconds": max(0, end - start)},
+            "starting_time": {"nanoseconds_since_epoch": start},
+            "message_count": self.message_count,
+            "topics_with_message_count": [
+                {
+                    "topic_metadata": {
+                        "name": t.name, "type": t.typename, "serialization_format": "cdr",
+                        "offered_qos_profiles": t.qos, "type_description_hash": type_hash(t.typename),
+                    },
+                    "message_count": t.count,
+                }
+                for t in self._topics.values()
+            ],
+            "compression_format": "",
+            "compression_mode": "",
+            "relative_file_paths": [f.path.name for f in files],
+            "files": [
+                {"path": f.path.name, "starting_time": {"nanoseconds_since_epoch": f.first_ns or 0},
+                 "duration": {"nanoseconds": f.last_ns - (f.first_ns or f.last_ns)}, "message_count": f.count}
+                for f in files
+            ],
+            "custom_data": None,
+            "ros_distro": "jazzy",
+        }
+
+    def close(self) -> Path:
+        """Finish the open file and write metadata.yaml; returns the bag folder."""
+        if self.closed:
+            return self.folder
+        if self._file is None:  # an empty bag still gets one valid file
+            self._file = self._open_file()
+        self._close_file(self._file)
+        self._file = None
+        tmp = self.folder / "metadata.yaml.tmp"
+        tmp.write_text(_dump({"rosbag2_bagfile_information": self._info()}), encoding="utf-8")
+        os.replace(tmp, self.folder / "metadata.yaml")
+        self.closed = True
+        return self.folder
+
+    def __enter__(self) -> McapBagWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,161 @@
+"""Reading pass histories: rosbag2 bags (MCAP or sqlite3, via rosbags), bare MCAP files, CSV.
+
+Every failure becomes an :class:`~rail_monitor.errors.InputError` with one line naming the
+file and the cause; front ends print it without a traceback and exit non-zero.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mcap.reader import NonSeekingReader
+from rosbags.highlevel import AnyReader
+
+from rail_monitor.bagio.typestore import TRAIN_PASS, typestore
+from rail_monitor.errors import InputError, RailMonitorError
+from rail_monitor.passes import PassTable
+from rail_monitor.timeutil import from_sec_nanosec
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0]}" if text else type(exc).__name__
+
+
+def is_csv(path: Path) -> bool:
+    return path.suffix.lower() == ".csv"
+
+
+def _open_bag(path: Path) -> AnyReader:
+    if not path.exists():
+        raise InputError(f"{path}: no such file or folder")
+    if path.is_file() and path.stat().st_size == 0:
+        raise InputError(f"{path}: empty file, not a bag")
+    try:
+        reader = AnyReader([path], default_typestore=typestore())
+        reader.open()
+    except RailMonitorError:
+        raise
+    except Exception as exc:  # rosbags raises many types for corrupt input; all mean "unusable"
+        raise InputError(f"{path}: cannot open bag: {_one_line(exc)}") from None
+    return reader
+
+
+@dataclass(frozen=True)
+class TopicInfo:
+    name: str
+    typename: str
+    count: int
+
+
+@dataclass(frozen=True)
+class BagInfo:
+    path: Path
+    storage: str
+    start_ns: int
+    end_ns: int
+    message_count: int
+    topics: list[TopicInfo]
+
+
+def bag_info(path: str | Path) -> BagInfo:
+    """Storage, time span and per-topic counts of a bag (folder, .mcap or .db3)."""
+    path = Path(path)
+    reader = _open_bag(path)
+    try:
+        topics: dict[str, TopicInfo] = {}
+        for c in reader.connections:
+            prev = topics.get(c.topic)
+            topics[c.topic] = TopicInfo(c.topic, c.msgtype, c.msgcount + (prev.count if prev else 0))
+        files = [p for p in ([path] if path.is_file() else path.iterdir())]
+        storage = "sqlite3" if any(p.suffix == ".db3" for p in files) else "mcap"
+        return BagInfo(path, storage, reader.start_time, reader.end_time, reader.message_count,
+                       sorted(topics.values(), key=lambda t: t.name))
+    except Exception as exc:
+        raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
+    finally:
+        reader.close()
+
+
+def _row_from_msg(msg: Any) -> dict[str, Any]:
+    """A deserialised TrainPass (rosbags object) as a PassTable row."""
+    return {
+        "stamp_ns": from_sec_nanosec(msg.header.stamp.sec, msg.header.stamp.nanosec),
+        "train_id": msg.train_id,
+        "vehicle_class": msg.vehicle_class,
+        "vehicle_count": msg.vehicle_count,
+        "axle_count": msg.axle_count,
+        "speed_mps": msg.speed_mps,
+        "angle_of_attack_rad": msg.angle_of_attack_rad,
+        "wheel_load_n": msg.wheel_load_n,
+        "friction_state": msg.friction_state,
+        "train_length_m": msg.train_length_m,
+    }
+
+
+def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
+    """Every TrainPass in a bag, in log-time order. topic: the topic to read (default: the one
+    TrainPass topic; more than one is an error that lists them)."""
+    path = Path(path)
+    reader = _open_bag(path)
+    try:
+        conns = [c for c in reader.connections if (c.topic == topic if topic else c.msgtype == TRAIN_PASS)]
+        if not conns:
+            have = sorted({f"{c.topic} [{c.msgtype}]" for c in reader.connections}) or ["no topics"]
+            want = f"topic {topic}" if topic else f"a {TRAIN_PASS} topic"
+            raise InputError(f"{path}: no {want} in the bag; it has {', '.join(have)}")
+        bad = [c for c in conns if c.msgtype != TRAIN_PASS]
+        if bad:
+            raise InputError(f"{path}: topic {bad[0].topic} is {bad[0].msgtype}, not {TRAIN_PASS}")
+        names = sorted({c.topic for c in conns})
+        if len(names) > 1:
+            raise InputError(f"{path}: several TrainPass topics ({', '.join(names)}); choose one with --topic")
+        rows = [_row_from_msg(reader.deserialize(raw, c.msgtype)) for c, _, raw in reader.messages(connections=conns)]
+    except RailMonitorError:
+        raise
+    except Exception as exc:
+        raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
+    finally:
+        reader.close()
+    return PassTable.from_rows(rows)
+
+
+def read_passes(path: str | Path, topic: str | None = None) -> PassTable:
+    """Train passes from a CSV export or a bag, whichever path names."""
+    path = Path(path)
+    if is_csv(path):
+        from rail_monitor.bagio.csv_io import read_csv
+
+        return read_csv(path)
+    return read_bag_passes(path, topic)
+
+
+@dataclass(frozen=True)
+class SalvagedMessage:
+    topic: str
+    typename: str
+    log_time_ns: int
+    data: bytes
+
+
+def salvage_mcap(path: str | Path) -> Iterator[SalvagedMessage]:
+    """Every message of every complete chunk of an MCAP file, even one cut off mid-write.
+
+    Reads records in order without the summary section, and stops quietly at the first
+    incomplete record (the end of a killed writer's output).
+    """
+    path = Path(path)
+    with open(path, "rb") as stream:
+        reader = NonSeekingReader(stream, validate_crcs=True)
+        it = reader.iter_messages()
+        while True:
+            try:
+                schema, channel, message = next(it)
+            except StopIteration:
+                return
+            except Exception:  # truncated or corrupt tail: everything before it was yielded
+                return
+            yield SalvagedMessage(channel.topic, schema.name if schema else "", message.log_time, message.data)

@@ -1,0 +1,131 @@
+"""Shared node glue: parameters from specs, the site from parameters, diagnostics, main()."""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.exceptions import ParameterException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+
+from rail_monitor.errors import ConfigError, RailMonitorError
+from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
+from rail_monitor.params import ParamSpec
+from rail_monitor.site import SITE_SPECS, VEHICLE_SPECS, Site, site_from_values
+
+
+def _descriptor(spec: ParamSpec, prefix: str) -> ParameterDescriptor:
+    d = ParameterDescriptor(name=prefix + spec.name, description=spec.description, read_only=True)
+    if spec.choices:
+        d.additional_constraints = spec.range_text()
+    if spec.kind is float and (spec.low is not None or spec.high is not None):
+        d.floating_point_range = [FloatingPointRange(
+            from_value=-sys.float_info.max if spec.low is None else float(spec.low),
+            to_value=sys.float_info.max if spec.high is None else float(spec.high), step=0.0)]
+    elif spec.kind is int and (spec.low is not None or spec.high is not None):
+        d.integer_range = [IntegerRange(from_value=int(spec.low if spec.low is not None else -(2**63)),
+                                        to_value=int(spec.high if spec.high is not None else 2**63 - 1), step=0)]
+    return d
+
+
+def declare(node: Node, specs: Sequence[ParamSpec], prefix: str = "") -> dict[str, Any]:
+    """Declare each spec (with its descriptor) and return the checked values by spec name.
+
+    A wrongly typed or out-of-range value raises ConfigError naming the parameter and its range.
+    """
+    values: dict[str, Any] = {}
+    for spec in specs:
+        name = prefix + spec.name
+        if node.has_parameter(name):  # shared specs (e.g. site_id) are declared once
+            values[spec.name] = node.get_parameter(name).value
+            continue
+        try:
+            p = node.declare_parameter(name, spec.default, _descriptor(spec, prefix))
+        except (ParameterException, TypeError, ValueError) as exc:
+            raise ConfigError(f"parameter '{name}': {str(exc).splitlines()[0]} (allowed: {spec.range_text()}, "
+                              f"type {spec.kind.__name__})") from None
+        value = p.value
+        if isinstance(spec.default, list):
+            value = list(value)
+        values[spec.name] = spec.check(value, prefix)
+    return values
+
+
+def declare_site(node: Node) -> Site:
+    """Declare the site parameters and the rolling-stock table, and build the Site."""
+    flat = declare(node, SITE_SPECS)
+    for name in flat["vehicle_classes"]:
+        for key, value in declare(node, VEHICLE_SPECS, prefix=f"vehicle.{name}.").items():
+            flat[f"vehicle.{name}.{key}"] = value
+    return site_from_values(flat)
+
+
+class Diagnostics:
+    """Publishes one DiagnosticStatus for a node on /diagnostics every period [s]."""
+
+    def __init__(self, node: Node, values: Callable[[], dict[str, Any]], period_s: float = 1.0,
+                 level: Callable[[], tuple[int, str]] | None = None) -> None:
+        self._node = node
+        self._values = values
+        self._level = level or (lambda: (DiagnosticStatus.OK, "ok"))
+        self._pub = node.create_publisher(DiagnosticArray, "/diagnostics", DIAGNOSTICS_QOS)
+        self._timer = node.create_timer(period_s, self.publish)
+
+    def publish(self) -> None:
+        level, message = self._level()
+        status = DiagnosticStatus(level=level, name=f"{self._node.get_namespace().rstrip('/')}/{self._node.get_name()}",
+                                  message=message, hardware_id=self._node.get_name())
+        status.values = [KeyValue(key=k, value=str(v)) for k, v in self._values().items()]
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = self._node.get_clock().now().to_msg()
+        self._pub.publish(msg)
+
+
+class RateMeter:
+    """Counts events and reports their rate over the last report interval [1/s]."""
+
+    def __init__(self) -> None:
+        self.count = 0
+        self._last_count = 0
+        self._last_t = time.monotonic()
+
+    def tick(self, n: int = 1) -> None:
+        self.count += n
+
+    def rate(self) -> float:
+        now = time.monotonic()
+        dt = max(now - self._last_t, 1e-9)
+        r = (self.count - self._last_count) / dt
+        self._last_count, self._last_t = self.count, now
+        return r
+
+
+def run_node(make: Callable[[], Node], args: list[str] | None = None) -> int:
+    """The Jazzy main() pattern for a single node; returns the process exit code.
+
+    Configuration errors are one line on stderr and exit code 2, not a traceback.
+    """
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = make()
+        rclpy.spin(node)
+    except RailMonitorError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            close = getattr(node, "close", None)
+            if close is not None:
+                close()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0

@@ -1,0 +1,128 @@
+"""mcap_recorder: record the graph's topics into a rosbag2-compatible MCAP bag folder.
+
+Records every topic whose type is in a rail_msgs package, /diagnostics and /rosout-free
+others named in ``topics``. Messages are taken serialised (no decode) and written with the
+node's clock as log time (pass time under use_sim_time). The bag is finalised on SIGINT and
+SIGTERM; chunks are closed every ``flush_period_s`` so a SIGKILL loses at most that much.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+from datetime import datetime, timezone
+from pathlib import Path
+
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.node import Node
+from rclpy.qos import QoSProfile
+
+from rail_monitor.bagio.mcap_bag import McapBagWriter
+from rail_monitor.errors import RailMonitorError
+from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, run_node
+from rail_monitor.nodes.qos import qos_to_dict, subscription_qos
+from rail_monitor.params import ParamSpec
+
+DEFAULT_TYPES_PREFIX = "rail_msgs/"
+DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
+
+RECORDER_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("output", "", "Bag folder to create; empty: rail_monitor_<UTC time> in the working folder."),
+    ParamSpec("topics", [""], "Topics to record (absolute or relative to the namespace); empty: every "
+              "rail_msgs topic and /diagnostics."),
+    ParamSpec("compression", "zstd", "Chunk compression.", choices=("zstd", "none")),
+    ParamSpec("chunk_size", 1 << 20, "Uncompressed bytes of messages per chunk [bytes].", 1024, 1 << 30),
+    ParamSpec("max_bag_size", 0, "Start a new file past this size; 0: never [bytes].", 0, 1 << 50),
+    ParamSpec("max_bag_duration_s", 0.0, "Start a new file past this span of log time; 0: never [s].", 0.0, 1.0e9),
+    ParamSpec("flush_period_s", 5.0, "Close the open chunk at least this often (bounds loss on a kill) [s].",
+              0.0, 3600.0),
+    ParamSpec("discovery_period_s", 0.2, "How often to look for new topics [s].", 0.01, 60.0),
+)
+
+
+class McapRecorder(Node):
+    def __init__(self, **kwargs) -> None:
+        super().__init__("mcap_recorder", **kwargs)
+        self.cfg = declare(self, RECORDER_SPECS)
+        out = self.cfg["output"] or f"rail_monitor_{datetime.now(timezone.utc):%Y_%m_%d-%H_%M_%S}"
+        self.writer = McapBagWriter(
+            Path(out), compression=self.cfg["compression"], chunk_size=self.cfg["chunk_size"],
+            max_file_bytes=self.cfg["max_bag_size"], max_file_duration_ns=int(self.cfg["max_bag_duration_s"] * 1e9),
+            flush_wall_period_s=self.cfg["flush_period_s"])
+        wanted = [t for t in self.cfg["topics"] if t]
+        self._wanted = {self.resolve_topic_name(t) for t in wanted} if wanted else None
+        self._lock = threading.Lock()
+        self._group = MutuallyExclusiveCallbackGroup()
+        self._subs: dict[str, object] = {}
+        self.counts: dict[str, int] = {}
+        self.meter = RateMeter()
+        self.create_timer(self.cfg["discovery_period_s"], self.discover, callback_group=self._group)
+        self.flush_timer = self.create_timer(max(self.cfg["flush_period_s"], 0.05), self._flush,
+                                             callback_group=self._group)
+        Diagnostics(self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
+                                   "topics": len(self._subs), "bag": str(self.writer.folder)})
+        self.discover()
+
+    def _want(self, topic: str, types: list[str]) -> bool:
+        if self._wanted is not None:
+            return topic in self._wanted
+        return any(t.startswith(DEFAULT_TYPES_PREFIX) or t == DIAGNOSTICS_TYPE for t in types)
+
+    def discover(self) -> None:
+        """Subscribe to every wanted topic that has appeared, with a QoS its publishers accept."""
+        for topic, types in self.get_topic_names_and_types():
+            if topic in self._subs or not self._want(topic, types):
+                continue
+            if len(types) != 1:
+                self.get_logger().warning(f"{topic} has several types {types}; not recorded")
+                self._subs[topic] = None
+                continue
+            offered: list[QoSProfile] = [i.qos_profile for i in self.get_publishers_info_by_topic(topic)]
+            if not offered:
+                continue  # only subscribers so far: wait for a publisher to learn its QoS
+            typename = types[0]
+            msg_type = _import_type(typename)
+            with self._lock:
+                self.writer.add_topic(topic, typename, [qos_to_dict(q) for q in offered])
+                self.counts[topic] = 0
+            self._subs[topic] = self.create_subscription(
+                msg_type, topic, lambda data, t=topic: self._on_message(t, data), subscription_qos(offered),
+                raw=True, callback_group=self._group)
+            self.get_logger().info(f"recording {topic} [{typename}]")
+
+    def _on_message(self, topic: str, data: bytes) -> None:
+        with self._lock:
+            if self.writer.closed:
+                return
+            self.writer.write(topic, data, self.get_clock().now().nanoseconds)
+            self.counts[topic] += 1
+        self.meter.tick()
+
+    def _flush(self) -> None:
+        with self._lock:
+            if not self.writer.closed:
+                self.writer.flush()
+
+    def close(self) -> Path:
+        """Finalise the bag (metadata.yaml, summary); safe to call twice."""
+        with self._lock:
+            folder = self.writer.close()
+        self.get_logger().info(f"bag {folder}: {self.meter.count} messages")
+        return folder
+
+
+def _import_type(typename: str) -> type:
+    pkg, kind, name = typename.split("/")
+    try:
+        module = __import__(f"{pkg}.{kind}", fromlist=[name])
+        return getattr(module, name)
+    except (ImportError, AttributeError):
+        raise RailMonitorError(f"message type {typename} is not installed") from None
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_node(McapRecorder, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

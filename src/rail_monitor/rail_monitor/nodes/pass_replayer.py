@@ -1,0 +1,56 @@
+"""pass_replayer: replay TrainPass history from a rosbag2 bag (MCAP or sqlite3) or a CSV file.
+
+Publishes ``train_pass`` (rail_msgs/TrainPass) and ``/clock``; exits 0 when done. See
+PUBLISH_SPECS for timing, offsets and flow control.
+"""
+
+from __future__ import annotations
+
+import sys
+
+from rail_monitor.bagio.csv_io import read_csv
+from rail_monitor.bagio.reader import is_csv, read_bag_passes
+from rail_monitor.errors import RailMonitorError
+from rail_monitor.nodes.base import declare
+from rail_monitor.nodes.pass_source import PassSourceNode, run_source
+from rail_monitor.params import ParamSpec
+from rail_monitor.passes import PassTable
+
+REPLAYER_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("source", "", "History to replay: a bag folder, an .mcap or .db3 file, or a .csv export."),
+    ParamSpec("source_topic", "", "TrainPass topic in the bag; empty: its only TrainPass topic."),
+    ParamSpec("skip_bad_rows", False, "CSV: leave malformed rows out (counted) instead of failing."),
+)
+
+
+class PassReplayer(PassSourceNode):
+    def __init__(self, **kwargs) -> None:
+        super().__init__("pass_replayer", **kwargs)
+        self.src = declare(self, REPLAYER_SPECS)
+        if not self.src["source"]:
+            raise RailMonitorError("parameter 'source' is empty: give a bag or CSV path (-p source:=PATH)")
+        self.skipped = 0
+        self._table = self._load()  # read up front: a bad file fails before anything is published
+
+    def _load(self) -> PassTable:
+        from pathlib import Path
+
+        path = Path(self.src["source"])
+        if is_csv(path):
+            table = read_csv(path, skip_bad_rows=self.src["skip_bad_rows"])
+            self.skipped = getattr(table, "skipped", 0)
+            if self.skipped:
+                self.get_logger().warning(f"{path}: {self.skipped} malformed row(s) left out")
+            return table
+        return read_bag_passes(path, self.src["source_topic"] or None)
+
+    def passes(self) -> PassTable:
+        return self._table
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_source(PassReplayer, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,90 @@
+"""Parameter specifications: the one place where names, defaults, units and ranges live.
+
+Nodes turn a :class:`ParamSpec` into a ROS 2 parameter with a descriptor; the pure loaders
+(:func:`resolve`) apply the same specs to a site YAML file read without ROS, so the live graph,
+the command line and batch mode agree on every default and every range.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from rail_monitor.errors import ConfigError
+
+Value = bool | int | float | str | list[float] | list[int] | list[str]
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """One parameter: name (dotted, relative), default, description with unit, allowed range."""
+
+    name: str
+    default: Value
+    description: str
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[str, ...] = ()
+
+    @property
+    def kind(self) -> type:
+        """The Python type of the value (list element type for arrays)."""
+        d = self.default
+        if isinstance(d, list):
+            return type(d[0]) if d else float
+        return type(d)
+
+    def range_text(self) -> str:
+        """The allowed values, for error messages and descriptors."""
+        if self.choices:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        lo = "-inf" if self.low is None else f"{self.low:g}"
+        hi = "inf" if self.high is None else f"{self.high:g}"
+        return f"[{lo}, {hi}]"
+
+    def check(self, value: Any, where: str = "") -> Value:
+        """Return value coerced to the spec's type, or raise ConfigError naming the parameter."""
+        label = f"{where}{self.name}"
+        want = self.kind
+        is_list = isinstance(self.default, list)
+        items = value if is_list else [value]
+        if is_list and not isinstance(value, (list, tuple)):
+            raise ConfigError(f"parameter '{label}' must be a list of {want.__name__}, got {value!r}")
+        out = []
+        for item in items:
+            if want is float and isinstance(item, int) and not isinstance(item, bool):
+                item = float(item)  # the pure loader is lenient where YAML is ambiguous
+            if want is bool and not isinstance(item, bool) or (
+                want is not bool and (isinstance(item, bool) or not isinstance(item, want))
+            ):
+                raise ConfigError(
+                    f"parameter '{label}' must be {want.__name__}, got {type(item).__name__} {item!r}"
+                )
+            if want in (int, float):
+                if isinstance(item, float) and not math.isfinite(item):
+                    raise ConfigError(f"parameter '{label}' must be finite, got {item!r}")
+                if (self.low is not None and item < self.low) or (self.high is not None and item > self.high):
+                    raise ConfigError(f"parameter '{label}' = {item!r} is outside its range {self.range_text()}")
+            if self.choices and item not in self.choices:
+                raise ConfigError(f"parameter '{label}' = {item!r} is not {self.range_text()}")
+            out.append(item)
+        return out if is_list else out[0]
+
+
+def resolve(specs: Sequence[ParamSpec], values: Mapping[str, Any], where: str = "") -> dict[str, Value]:
+    """Apply specs to a flat mapping of dotted names: defaults filled in, every value checked."""
+    return {s.name: s.check(values[s.name], where) if s.name in values else s.default for s in specs}
+
+
+def flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """Flatten a nested YAML mapping into dotted names, as ROS 2 parameter files do."""
+    flat: dict[str, Any] = {}
+    for key, value in tree.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            flat.update(flatten(value, name + "."))
+        else:
+            flat[name] = value
+    return flat

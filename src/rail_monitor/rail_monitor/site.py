@@ -1,0 +1,116 @@
+"""The site: its identity, curve and rolling-stock table, from a ROS 2 parameter file.
+
+One YAML file per site, in the ROS 2 parameter-file layout (``/**: ros__parameters: ...``), is
+read by every node (``--ros-args --params-file``) and, through :func:`load_parameter_file`, by
+the command line and batch mode without ROS. The specs below are the single source of names,
+defaults, units and ranges.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from rail_monitor.errors import ConfigError
+from rail_monitor.params import ParamSpec, flatten, resolve
+
+BRAKE_TYPES = ("cast_iron", "composite", "disc")
+
+SITE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("site_id", "site", "Site identifier, written to header.frame_id of every message."),
+    ParamSpec("curve_radius_m", 250.0, "Radius of the curve at the site [m].", 10.0, 1.0e5),
+    ParamSpec("vehicle_classes", ["emu"], "Names of the vehicle classes of the rolling-stock table."),
+)
+
+# Per vehicle class, under vehicle.<name>.: rolling stock, then the traffic it runs in.
+VEHICLE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("axles_per_vehicle", 4, "Axles per vehicle [-].", 1, 12),
+    ParamSpec("wheel_diameter_m", 0.84, "Nominal wheel diameter [m].", 0.3, 1.5),
+    ParamSpec("brake_type", "disc", "Brake type (sets wheel roughness).", choices=BRAKE_TYPES),
+    ParamSpec("wheel_load_n", 60000.0, "Nominal static wheel load [N].", 1.0e3, 2.5e5),
+    ParamSpec("vehicle_length_m", 20.0, "Vehicle length over couplers [m].", 3.0, 40.0),
+    ParamSpec("bogie_semi_wheelbase_m", 1.25, "Half the bogie wheelbase (axle to bogie centre) [m].", 0.3, 5.0),
+    ParamSpec("traffic_share", 1.0, "Share of the site's trains of this class [-].", 0.0, 1.0),
+    ParamSpec("vehicles_min", 3, "Fewest vehicles in a consist [-].", 1, 100),
+    ParamSpec("vehicles_max", 6, "Most vehicles in a consist [-].", 1, 100),
+    ParamSpec("speed_mean_mps", 19.0, "Mean pass speed of the class at the site [m/s].", 0.5, 100.0),
+    ParamSpec("speed_sd_mps", 1.5, "Standard deviation of the pass speed [m/s].", 0.0, 30.0),
+    ParamSpec("speed_min_mps", 8.0, "Lowest pass speed (the distribution is truncated) [m/s].", 0.5, 100.0),
+    ParamSpec("speed_max_mps", 22.0, "Highest pass speed (line speed at the curve) [m/s].", 0.5, 100.0),
+)
+
+
+@dataclass(frozen=True)
+class VehicleClass:
+    """One entry of the rolling-stock table (units as in VEHICLE_SPECS)."""
+
+    name: str
+    axles_per_vehicle: int
+    wheel_diameter_m: float
+    brake_type: str
+    wheel_load_n: float
+    vehicle_length_m: float
+    bogie_semi_wheelbase_m: float
+    traffic_share: float
+    vehicles_min: int
+    vehicles_max: int
+    speed_mean_mps: float
+    speed_sd_mps: float
+    speed_min_mps: float
+    speed_max_mps: float
+
+
+@dataclass(frozen=True)
+class Site:
+    """A wayside site: identity, curve and rolling-stock table."""
+
+    site_id: str
+    curve_radius_m: float
+    vehicles: Mapping[str, VehicleClass]
+
+    def vehicle(self, name: str) -> VehicleClass:
+        """The vehicle class called name, or a ConfigError listing the known ones."""
+        try:
+            return self.vehicles[name]
+        except KeyError:
+            raise ConfigError(f"unknown vehicle class {name!r}; the site knows {sorted(self.vehicles)}") from None
+
+
+def site_from_values(values: Mapping[str, Any]) -> Site:
+    """Build a Site from flat dotted parameter values (a parameter file or a node's parameters)."""
+    top = resolve(SITE_SPECS, values)
+    vehicles = {}
+    for name in top["vehicle_classes"]:
+        prefix = f"vehicle.{name}."
+        sub = {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
+        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, sub, where=prefix))
+        if v.vehicles_min > v.vehicles_max or v.speed_min_mps > v.speed_max_mps:
+            raise ConfigError(f"vehicle class {name!r}: a minimum exceeds its maximum (vehicles or speed)")
+        vehicles[name] = v
+    if not vehicles:
+        raise ConfigError("parameter 'vehicle_classes' names no vehicle class")
+    return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles)
+
+
+def load_parameter_file(path: str | Path) -> dict[str, Any]:
+    """Read a ROS 2 parameter file into flat dotted names (the ``/**`` section, else the first)."""
+    path = Path(path)
+    try:
+        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{path}: cannot read parameter file: {str(exc).splitlines()[0]}") from None
+    if not isinstance(doc, Mapping) or not doc:
+        raise ConfigError(f"{path}: not a ROS 2 parameter file (expected '/**: ros__parameters: ...')")
+    section = doc.get("/**", next(iter(doc.values())))
+    if not isinstance(section, Mapping) or not isinstance(section.get("ros__parameters"), Mapping):
+        raise ConfigError(f"{path}: no 'ros__parameters' mapping")
+    return flatten(section["ros__parameters"])
+
+
+def load_site(path: str | Path) -> Site:
+    """The Site described by a site parameter file."""
+    return site_from_values(load_parameter_file(path))

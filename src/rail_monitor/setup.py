@@ -1,0 +1,32 @@
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = "rail_monitor"
+
+setup(
+    name=package_name,
+    version="0.1.0",
+    packages=find_packages(exclude=["test", "tests"]),
+    data_files=[
+        ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
+        (f"share/{package_name}", ["package.xml"]),
+        (f"share/{package_name}/config", glob("config/*.yaml")),
+        (f"share/{package_name}/launch", glob("launch/*.py")),
+    ],
+    install_requires=["setuptools"],
+    zip_safe=True,
+    maintainer="rail_monitor developers",
+    maintainer_email="rail-monitor@example.com",
+    description="Wayside rail corrugation, rolling noise and squeal monitor for ROS 2 Jazzy.",
+    license="Apache-2.0",
+    entry_points={
+        "console_scripts": [
+            "pass_replayer = rail_monitor.nodes.pass_replayer:main",
+            "pass_simulator = rail_monitor.nodes.pass_simulator:main",
+            "mcap_recorder = rail_monitor.nodes.mcap_recorder:main",
+            "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
+            "rail-monitor = rail_monitor.cli:main",
+        ],
+    },
+)
