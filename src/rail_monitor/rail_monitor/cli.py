@@ -51,7 +51,7 @@ def _ros_args(ns: argparse.Namespace, site: Path | None, extra: dict[str, object
     """argv for rclpy.init: the site file, the namespace, and -p for every option given."""
     values = {k[2:]: v for k, v in vars(ns).items() if k.startswith("p:") and v is not None}
     values.update({k: v for k, v in extra.items() if v is not None})
-    args = ["rail-monitor", "--ros-args"]
+    args = ["rail-monitor", *getattr(ns, "ros_extra", []), "--ros-args"]
     if site is not None:
         args += ["--params-file", str(site)]
     if getattr(ns, "namespace", None):
@@ -169,6 +169,7 @@ def build_parser() -> argparse.ArgumentParser:
     from rail_monitor.nodes.mcap_recorder import RECORDER_SPECS
     from rail_monitor.nodes.pass_replayer import REPLAYER_SPECS
     from rail_monitor.nodes.pass_source import PUBLISH_SPECS
+    from rail_monitor.nodes.wayside_monitor import MONITOR_SPECS
 
     p = argparse.ArgumentParser(prog="rail-monitor", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
@@ -214,13 +215,17 @@ def build_parser() -> argparse.ArgumentParser:
         s.add_argument("--namespace", help="site namespace (default: the site_id)")
         s.add_argument("--overwrite", action="store_true", default=name == "demo",
                        help="replace an existing output folder")
-        _add_specs(s, PUBLISH_SPECS, skip=("site_id", "wait_for_subscribers", "wait_timeout_s"))
+        _add_specs(s, MONITOR_SPECS + PUBLISH_SPECS, skip=("site_id", "wait_for_subscribers", "wait_timeout_s"))
         s.set_defaults(func=cmd_demo if name == "demo" else cmd_monitor)
     return p
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    ns = build_parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # Anything from --ros-args on goes to the nodes untouched (e.g. -p executor:=events).
+    cut = argv.index("--ros-args") if "--ros-args" in argv else len(argv)
+    ns = build_parser().parse_args(argv[:cut])
+    ns.ros_extra = argv[cut:]
     try:
         return ns.func(ns)
     except RailMonitorError as exc:

@@ -12,6 +12,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 
 from rail_monitor.errors import ConfigError, RailMonitorError
@@ -66,6 +67,11 @@ def declare_site(node: Node) -> Site:
     return site_from_values(flat)
 
 
+def wall_timer(node: Node, period_s: float, callback: Callable[[], None], **kwargs: Any):
+    """A timer on the steady clock: housekeeping must run whether or not /clock (sim time) ticks."""
+    return node.create_timer(period_s, callback, clock=Clock(clock_type=ClockType.STEADY_TIME), **kwargs)
+
+
 class Diagnostics:
     """Publishes one DiagnosticStatus for a node on /diagnostics every period [s]."""
 
@@ -75,7 +81,7 @@ class Diagnostics:
         self._values = values
         self._level = level or (lambda: (DiagnosticStatus.OK, "ok"))
         self._pub = node.create_publisher(DiagnosticArray, "/diagnostics", DIAGNOSTICS_QOS)
-        self._timer = node.create_timer(period_s, self.publish)
+        self._timer = wall_timer(node, period_s, self.publish)
 
     def publish(self) -> None:
         level, message = self._level()

@@ -19,7 +19,7 @@ from rclpy.qos import QoSProfile
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.errors import RailMonitorError
-from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, run_node
+from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, run_node, wall_timer
 from rail_monitor.nodes.qos import qos_to_dict, subscription_qos
 from rail_monitor.params import ParamSpec
 
@@ -56,9 +56,8 @@ class McapRecorder(Node):
         self._subs: dict[str, object] = {}
         self.counts: dict[str, int] = {}
         self.meter = RateMeter()
-        self.create_timer(self.cfg["discovery_period_s"], self.discover, callback_group=self._group)
-        self.flush_timer = self.create_timer(max(self.cfg["flush_period_s"], 0.05), self._flush,
-                                             callback_group=self._group)
+        wall_timer(self, self.cfg["discovery_period_s"], self.discover, callback_group=self._group)
+        wall_timer(self, max(self.cfg["flush_period_s"], 0.05), self._flush, callback_group=self._group)
         Diagnostics(self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
                                    "topics": len(self._subs), "bag": str(self.writer.folder)})
         self.discover()

@@ -38,9 +38,12 @@ PUBLISH_SPECS: tuple[ParamSpec, ...] = (
               0.001, 60.0),
     ParamSpec("wait_for_subscribers", 0, "Wait for this many train_pass subscribers before starting [-].", 0, 1000),
     ParamSpec("wait_timeout_s", 30.0, "Give up waiting for subscribers after this [s].", 0.0, 3600.0),
-    ParamSpec("ack_batch", 200, "Passes published between waits for every subscriber's acknowledgement "
-              "(flow control; below the QoS depth of 1000) [-].", 1, 999),
-    ParamSpec("ack_timeout_s", 60.0, "Longest wait for acknowledgement before the replay fails [s].", 0.1, 3600.0),
+    ParamSpec("ack_batch", 100, "Passes published between flow-control checks (below the publisher's "
+              "QoS depth of 1000) [-].", 1, 999),
+    ParamSpec("ack_timeout_s", 60.0, "Longest wait for subscribers to catch up before the replay fails [s].",
+              0.1, 3600.0),
+    ParamSpec("max_backlog", 2000, "In one process: most passes published but not yet taken by the slowest "
+              "hosted subscriber (below their queue of 10000) [-].", 1, 9000),
     ParamSpec("progress", True, "Show a progress bar on stderr."),
 )
 
@@ -57,6 +60,8 @@ class PassSourceNode(Node):
         self.total = 0
         self.last_stamp_ns = 0
         self.done = threading.Event()
+        # Passes taken by the slowest subscriber hosted in this process (set by wayside_monitor).
+        self.consumed: Callable[[], int] | None = None
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
                                    "rate_per_s": f"{self.meter.rate():.1f}",
                                    "pass_time_ns": self.last_stamp_ns, "done": self.done.is_set()})
@@ -75,7 +80,7 @@ class PassSourceNode(Node):
             keep &= table.stamp_ns <= t0 + int(self.cfg["end_offset_s"] * NS_PER_S)
         return table.take(keep)
 
-    def _clock(self, ns: int) -> None:
+    def _publish_clock(self, ns: int) -> None:
         if self.clock_pub is not None:
             self.clock_pub.publish(Clock(clock=time_msg(ns)))
 
@@ -88,10 +93,27 @@ class PassSourceNode(Node):
                                        f"on {self.pub.topic_name} after {self.cfg['wait_timeout_s']:g} s")
             time.sleep(0.02)
 
-    def _acked(self) -> None:
-        if not self.pub.wait_for_all_acked(Duration(seconds=self.cfg["ack_timeout_s"])):
-            raise RailMonitorError(f"subscribers of {self.pub.topic_name} did not acknowledge within "
-                                   f"{self.cfg['ack_timeout_s']:g} s")
+    def _throttle(self, published: int) -> None:
+        """Flow control: where the consumers share this process, wait until the slowest has taken
+        all but max_backlog; otherwise until every subscriber holds what was sent (DDS
+        acknowledgement; their queues of 10000 absorb the rest).
+
+        Acknowledgement is polled with a zero timeout: a blocking wait_for_all_acked holds the GIL
+        and would starve subscribers in this process of the callbacks that empty their queues.
+        """
+        deadline = time.monotonic() + self.cfg["ack_timeout_s"]
+        zero = Duration(seconds=0)
+        backlog = self.cfg["max_backlog"]
+        def behind() -> bool:
+            if self.consumed is not None:  # exact, and cheaper than a DDS acknowledgement round
+                return published - self.consumed() > backlog
+            return not self.pub.wait_for_all_acked(zero)
+
+        while behind():
+            if time.monotonic() > deadline:
+                raise RailMonitorError(f"subscribers of {self.pub.topic_name} did not keep up within "
+                                       f"{self.cfg['ack_timeout_s']:g} s")
+            time.sleep(0.0005)
 
     def run(self, ok: Callable[[], bool] | None = None) -> int:
         """Publish every pass (blocking); returns how many were published."""
@@ -115,15 +137,15 @@ class PassSourceNode(Node):
                     due = wall0 + (stamp - t0) / NS_PER_S / rate
                     while ok() and (left := due - time.monotonic()) > 0:
                         time.sleep(min(left, period))
-                        self._clock(t0 + int((time.monotonic() - wall0) * rate * NS_PER_S))
-                self._clock(stamp)
+                        self._publish_clock(t0 + int((time.monotonic() - wall0) * rate * NS_PER_S))
+                self._publish_clock(stamp)
                 self.pub.publish(train_pass_msg(table.row(i), frame))
                 self.meter.tick()
                 self.last_stamp_ns = stamp
                 bar.update()
                 if (i + 1) % batch == 0:
-                    self._acked()
-            self._acked()
+                    self._throttle(i + 1)
+            self._throttle(self.meter.count)
         finally:
             bar.close()
         self.done.set()

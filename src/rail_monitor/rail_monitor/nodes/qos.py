@@ -8,10 +8,14 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 
 from rail_monitor.bagio.mcap_bag import qos_dict
 
-# Pass events and model outputs: reliable, deep enough that a burst is queued, not dropped;
-# publishers also wait for acknowledgement in batches (PassPublisher) for end-to-end flow control.
+# Pass events and model outputs: reliable. Publishers keep 1000; subscribers queue 10000 so a
+# burst waits rather than drops. The pass source adds flow control on top (see pass_source):
+# KEEP_ALL readers would give DDS-level backpressure, but Fast DDS's stalled at about 5,100
+# samples here, so we do not use them.
 STREAM_QOS = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.VOLATILE)
+STREAM_SUB_QOS = QoSProfile(depth=10000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
+                            durability=DurabilityPolicy.VOLATILE)
 # Standing alerts: a late subscriber sees them.
 LATCHED_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -34,7 +38,7 @@ def subscription_qos(offered: list[QoSProfile]) -> QoSProfile:
     reliable = bool(offered) and all(q.reliability == ReliabilityPolicy.RELIABLE for q in offered)
     latched = bool(offered) and all(q.durability == DurabilityPolicy.TRANSIENT_LOCAL for q in offered)
     return QoSProfile(
-        depth=1000, history=HistoryPolicy.KEEP_LAST,
+        depth=STREAM_SUB_QOS.depth, history=HistoryPolicy.KEEP_LAST,
         reliability=ReliabilityPolicy.RELIABLE if reliable else ReliabilityPolicy.BEST_EFFORT,
         durability=DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE,
     )
