@@ -11,7 +11,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from mcap.reader import NonSeekingReader
+from mcap.records import Channel, Message, Schema
+from mcap.stream_reader import StreamReader
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.typestore import TRAIN_PASS, typestore
@@ -144,18 +145,27 @@ class SalvagedMessage:
 def salvage_mcap(path: str | Path) -> Iterator[SalvagedMessage]:
     """Every message of every complete chunk of an MCAP file, even one cut off mid-write.
 
-    Reads records in order without the summary section, and stops quietly at the first
-    incomplete record (the end of a killed writer's output).
+    Reads records in file order with mcap's StreamReader (no summary section needed; chunk
+    CRCs checked) and stops quietly at the first incomplete or corrupt record (the end of a
+    killed writer's output). mcap's NonSeekingReader gives up on such a file altogether.
     """
     path = Path(path)
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, Channel] = {}
     with open(path, "rb") as stream:
-        reader = NonSeekingReader(stream, validate_crcs=True)
-        it = reader.iter_messages()
+        records = iter(StreamReader(stream, validate_crcs=True).records)
         while True:
             try:
-                schema, channel, message = next(it)
+                rec = next(records)
             except StopIteration:
                 return
             except Exception:  # truncated or corrupt tail: everything before it was yielded
                 return
-            yield SalvagedMessage(channel.topic, schema.name if schema else "", message.log_time, message.data)
+            if isinstance(rec, Schema):
+                schemas[rec.id] = rec
+            elif isinstance(rec, Channel):
+                channels[rec.id] = rec
+            elif isinstance(rec, Message) and rec.channel_id in channels:
+                ch = channels[rec.channel_id]
+                schema = schemas.get(ch.schema_id)
+                yield SalvagedMessage(ch.topic, schema.name if schema else "", rec.log_time, rec.data)

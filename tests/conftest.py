@@ -1,0 +1,67 @@
+"""Shared fixtures. Tests run inside the workspace environment (ros2_ws/run test)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+TOP = Path(__file__).resolve().parents[1]
+SAMPLE = TOP / "bags" / "sample"
+EXAMPLE_CSV = TOP / "bags" / "example_passes.csv"
+SITE_FILE = TOP / "src" / "rail_monitor" / "config" / "curve_250.yaml"
+
+
+@pytest.fixture(autouse=True)
+def _isolated_dds(monkeypatch: pytest.MonkeyPatch) -> None:
+    # A domain of its own per test run, so a stray process of another run never joins the graph.
+    monkeypatch.setenv("ROS_DOMAIN_ID", os.environ.get("RAIL_TEST_DOMAIN", "42"))
+
+
+@pytest.fixture()
+def site():
+    from rail_monitor.site import load_site
+
+    return load_site(SITE_FILE)
+
+
+@pytest.fixture()
+def site_values() -> dict:
+    from rail_monitor.site import load_parameter_file
+
+    return load_parameter_file(SITE_FILE)
+
+
+@pytest.fixture(scope="session")
+def sample_passes():
+    from rail_monitor.bagio.reader import read_bag_passes
+
+    return read_bag_passes(SAMPLE)
+
+
+@pytest.fixture()
+def ros_context() -> Iterator[object]:
+    """A fresh rclpy Context per test, shut down afterwards."""
+    import rclpy
+    from rclpy.context import Context
+
+    ctx = Context()
+    rclpy.init(context=ctx, domain_id=int(os.environ.get("RAIL_TEST_DOMAIN", "42")))
+    try:
+        yield ctx
+    finally:
+        rclpy.try_shutdown(context=ctx)
+
+
+def run_cmd(*args: str, timeout: float = 120.0, **kw) -> subprocess.CompletedProcess:
+    """Run a workspace executable (PATH set by ros2_ws/run) and capture its output."""
+    env = {**os.environ, "ROS_DOMAIN_ID": os.environ.get("RAIL_TEST_DOMAIN", "42"), **kw.pop("env", {})}
+    return subprocess.run(list(args), capture_output=True, text=True, timeout=timeout, env=env, cwd=TOP, **kw)
+
+
+def python_exe() -> str:
+    return sys.executable
