@@ -27,10 +27,13 @@ _INFINITE = {"sec": 9223372036, "nsec": 854775807}
 
 
 def qos_dict(reliable: bool = True, transient_local: bool = False, depth: int = 1000,
-             keep_all: bool = False) -> dict[str, Any]:
-    """One offered QoS profile in the metadata.yaml version 9 layout."""
+             history: str = "keep_last") -> dict[str, Any]:
+    """One offered QoS profile in the metadata.yaml version 9 layout.
+
+    history: keep_last, keep_all, or unknown (what discovery reports for a remote publisher).
+    """
     return {
-        "history": "keep_all" if keep_all else "keep_last",
+        "history": history,
         "depth": depth,
         "reliability": "reliable" if reliable else "best_effort",
         "durability": "transient_local" if transient_local else "volatile",

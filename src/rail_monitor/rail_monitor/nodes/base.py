@@ -112,6 +112,20 @@ class RateMeter:
         return r
 
 
+def use_flow_control_profile() -> None:
+    """Load the package's Fast DDS profile (short writer heartbeat) unless one is set already.
+
+    Call before rclpy.init: Fast DDS reads the variable when the participant is created.
+    """
+    import os
+
+    from ament_index_python.packages import get_package_share_directory
+
+    if "FASTRTPS_DEFAULT_PROFILES_FILE" not in os.environ:
+        os.environ["FASTRTPS_DEFAULT_PROFILES_FILE"] = os.path.join(
+            get_package_share_directory("rail_monitor"), "config", "fastdds_flow_control.xml")
+
+
 def run_node(make: Callable[[], Node], args: list[str] | None = None) -> int:
     """The Jazzy main() pattern for a single node; returns the process exit code.
 

@@ -19,7 +19,7 @@ from rosgraph_msgs.msg import Clock
 from tqdm import tqdm
 
 from rail_monitor.errors import RailMonitorError
-from rail_monitor.nodes.base import Diagnostics, RateMeter, declare
+from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, use_flow_control_profile
 from rail_monitor.nodes.convert import time_msg, train_pass_msg
 from rail_monitor.nodes.qos import CLOCK_QOS, STREAM_QOS
 from rail_monitor.params import ParamSpec
@@ -98,16 +98,19 @@ class PassSourceNode(Node):
         all but max_backlog; otherwise until every subscriber holds what was sent (DDS
         acknowledgement; their queues of 10000 absorb the rest).
 
-        Acknowledgement is polled with a zero timeout: a blocking wait_for_all_acked holds the GIL
-        and would starve subscribers in this process of the callbacks that empty their queues.
+        In one process we never call wait_for_all_acked: it holds the GIL while it blocks and would
+        starve the hosted subscribers of the callbacks that empty their queues. Across processes
+        we use short blocking waits: zero-timeout polls do not prompt Fast DDS's heartbeat, and
+        the acknowledgement then takes seconds (measured: about 3.6 s per batch of 100).
         """
         deadline = time.monotonic() + self.cfg["ack_timeout_s"]
-        zero = Duration(seconds=0)
+        slice_ = Duration(seconds=0.05)
         backlog = self.cfg["max_backlog"]
+
         def behind() -> bool:
             if self.consumed is not None:  # exact, and cheaper than a DDS acknowledgement round
                 return published - self.consumed() > backlog
-            return not self.pub.wait_for_all_acked(zero)
+            return not self.pub.wait_for_all_acked(slice_)
 
         while behind():
             if time.monotonic() > deadline:
@@ -137,7 +140,8 @@ class PassSourceNode(Node):
                     due = wall0 + (stamp - t0) / NS_PER_S / rate
                     while ok() and (left := due - time.monotonic()) > 0:
                         time.sleep(min(left, period))
-                        self._publish_clock(t0 + int((time.monotonic() - wall0) * rate * NS_PER_S))
+                        # never past the pass itself: /clock must not step backwards
+                        self._publish_clock(min(stamp, t0 + int((time.monotonic() - wall0) * rate * NS_PER_S)))
                 self._publish_clock(stamp)
                 self.pub.publish(train_pass_msg(table.row(i), frame))
                 self.meter.tick()
@@ -155,13 +159,15 @@ class PassSourceNode(Node):
 
 def run_source(make: Callable[[], PassSourceNode], args: list[str] | None = None) -> int:
     """main() of a pass source: spin in the background, publish in the foreground, exit when done."""
+    use_flow_control_profile()
     rclpy.init(args=args)
     node = None
     executor = SingleThreadedExecutor()
+    spinner = threading.Thread(target=executor.spin, daemon=True)
     try:
         node = make()
         executor.add_node(node)
-        threading.Thread(target=executor.spin, daemon=True).start()
+        spinner.start()
         node.run()
     except RailMonitorError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -170,6 +176,8 @@ def run_source(make: Callable[[], PassSourceNode], args: list[str] | None = None
         return 130
     finally:
         executor.shutdown(timeout_sec=1.0)
+        if spinner.is_alive():  # leave no thread inside rcl when the interpreter exits
+            spinner.join(timeout=5.0)
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()

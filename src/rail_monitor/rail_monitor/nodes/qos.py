@@ -24,12 +24,13 @@ CLOCK_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 
 
 def qos_to_dict(qos: QoSProfile) -> dict[str, Any]:
-    """An rclpy QoS profile in rosbag2's metadata layout."""
+    """An rclpy QoS profile in rosbag2's metadata layout (discovered profiles have history
+    'unknown' and depth 0, recorded as they are, as rosbag2 does)."""
     return qos_dict(
         reliable=qos.reliability == ReliabilityPolicy.RELIABLE,
         transient_local=qos.durability == DurabilityPolicy.TRANSIENT_LOCAL,
         depth=qos.depth,
-        keep_all=qos.history == HistoryPolicy.KEEP_ALL,
+        history=qos.history.name.lower(),
     )
 
 

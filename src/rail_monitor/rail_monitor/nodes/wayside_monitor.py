@@ -16,7 +16,7 @@ from rclpy.executors import Executor, ExternalShutdownException, MultiThreadedEx
 from rclpy.node import Node
 
 from rail_monitor.errors import RailMonitorError
-from rail_monitor.nodes.base import declare
+from rail_monitor.nodes.base import declare, use_flow_control_profile
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_replayer import REPLAYER_SPECS, PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
@@ -51,9 +51,11 @@ class _Settings(Node):
 
 def run_graph(args: list[str] | None = None) -> MonitorResult:
     """Build the graph in this process, replay, drain, shut down; return what happened."""
+    use_flow_control_profile()  # for subscribers in other processes (in-process ones are paced exactly)
     rclpy.init(args=args)
     nodes: list[Node] = []
     executor = None
+    spinner = None
     t0 = time.monotonic()
     try:
         settings = _Settings()
@@ -84,6 +86,8 @@ def run_graph(args: list[str] | None = None) -> MonitorResult:
     finally:
         if executor is not None:
             executor.shutdown(timeout_sec=2.0)
+            if spinner is not None and spinner.is_alive():
+                spinner.join(timeout=5.0)
         for n in reversed(nodes):
             close = getattr(n, "close", None)
             if close is not None:

@@ -1,0 +1,117 @@
+"""Executables as separate processes: ros2-run resolution, DDS between processes, signals."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import yaml
+from ament_index_python.packages import get_package_prefix, get_resource
+from rosbags.highlevel import AnyReader
+
+from rail_monitor.bagio.reader import read_bag_passes, salvage_mcap
+
+from conftest import SAMPLE, TOP, run_cmd
+
+FIVE_DAYS = str(5 * 86400.0)
+
+
+def _exe(name: str) -> str:
+    """Resolve an executable the way `ros2 run rail_monitor <name>` does: ament index -> prefix/lib/pkg."""
+    get_resource("packages", "rail_monitor")  # raises LookupError if the package is not registered
+    path = Path(get_package_prefix("rail_monitor")) / "lib" / "rail_monitor" / name
+    assert path.is_file() and os.access(path, os.X_OK), path
+    return str(path)
+
+
+def _expected_slice() -> int:
+    t = read_bag_passes(SAMPLE)
+    return int((t.stamp_ns <= t.stamp_ns[0] + int(float(FIVE_DAYS) * 1e9)).sum())
+
+
+def _start_recorder(out: Path, *extra: str) -> subprocess.Popen:
+    p = subprocess.Popen([_exe("mcap_recorder"), "--ros-args", "-p", f"output:={out}", "-r", "__ns:=/site",
+                          "-p", "flush_period_s:=0.2", *extra],
+                         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=TOP)
+    return p
+
+
+def _replay(*extra: str) -> subprocess.CompletedProcess:
+    return run_cmd(_exe("pass_replayer"), "--ros-args", "-r", "__ns:=/site", "-p", f"source:={SAMPLE}",
+                   "-p", f"end_offset_s:={FIVE_DAYS}", "-p", "wait_for_subscribers:=1", "-p", "progress:=false",
+                   *extra, timeout=120)
+
+
+def test_ament_index_resolves_every_executable():
+    for name in ("pass_replayer", "pass_simulator", "mcap_recorder", "wayside_monitor", "rail-monitor"):
+        _exe(name)
+    r = run_cmd(_exe("rail-monitor"), "replay", "--help")
+    assert r.returncode == 0 and "[m/s]" not in r.stdout or "default: 0.0 [rate]" in r.stdout
+
+
+def test_two_processes_over_dds_lose_nothing_and_sigint_finalises(tmp_path: Path):
+    rec = _start_recorder(tmp_path / "two")
+    try:
+        r = _replay()
+        assert r.returncode == 0, r.stderr
+        n = _expected_slice()
+        time.sleep(1.0)  # let the last acknowledged samples be taken
+    finally:
+        rec.send_signal(signal.SIGINT)
+        out, _ = rec.communicate(timeout=30)
+    assert rec.returncode == 0, out
+    with AnyReader([tmp_path / "two"]) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+    assert counts["/site/train_pass"] == n
+    assert read_bag_passes(tmp_path / "two").equals(read_bag_passes(SAMPLE).take(slice(0, n)))
+
+
+def test_sigterm_finalises_an_indexed_bag(tmp_path: Path):
+    rec = _start_recorder(tmp_path / "term")
+    try:
+        assert _replay().returncode == 0
+        time.sleep(1.0)
+    finally:
+        rec.send_signal(signal.SIGTERM)
+        out, _ = rec.communicate(timeout=30)
+    assert rec.returncode == 0, out
+    meta = yaml.safe_load((tmp_path / "term" / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    topics = {t["topic_metadata"]["name"]: t["message_count"] for t in meta["topics_with_message_count"]}
+    assert topics["/site/train_pass"] == _expected_slice()
+
+
+def test_sigkill_leaves_every_flushed_chunk_readable(tmp_path: Path):
+    rec = _start_recorder(tmp_path / "kill", "-p", "chunk_size:=4096")
+    try:
+        assert _replay().returncode == 0
+        time.sleep(1.5)  # > flush_period_s: every chunk is closed and written
+    finally:
+        rec.send_signal(signal.SIGKILL)
+        rec.communicate(timeout=30)
+    assert not (tmp_path / "kill" / "metadata.yaml").exists()  # killed: never finalised
+    files = sorted((tmp_path / "kill").glob("*.mcap"))
+    salvaged = [m for f in files for m in salvage_mcap(f) if m.topic == "/site/train_pass"]
+    assert len(salvaged) == _expected_slice()
+
+
+def test_wayside_monitor_runs_the_graph_on_a_slice(tmp_path: Path):
+    r = run_cmd("rail-monitor", "monitor", str(SAMPLE), "--output", str(tmp_path / "wm"),
+                "--end-offset-s", FIVE_DAYS, "--no-progress", timeout=180)
+    assert r.returncode == 0, r.stderr
+    n = _expected_slice()
+    assert f"{n} passes through the graph" in r.stdout
+    with AnyReader([tmp_path / "wm"]) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+    assert counts["/curve_250/train_pass"] == n
+
+
+def test_replayer_with_unusable_csv_exits_nonzero_naming_the_line(tmp_path: Path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("time_utc,train_id,vehicle_class,vehicle_count,speed_mps,angle_of_attack_rad,friction_state\n"
+                   "2026-09-01T05:00:00Z,T1,emu,3,nineteen,0.005,dry\n", encoding="utf-8")
+    r = run_cmd(_exe("pass_replayer"), "--ros-args", "-p", f"source:={bad}", timeout=60)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert "line 2: column 'speed_mps'" in r.stderr
