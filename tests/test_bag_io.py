@@ -26,7 +26,6 @@ from conftest import SAMPLE, TOP, run_cmd
 
 
 def _rosidl_hash(typename: str) -> str:
-    pkg, _, name = typename.split("/")
     doc = json.loads(msg_file(typename).with_suffix(".json").read_text())
     return next(h["hash_string"] for h in doc["type_hashes"] if h["type_name"] == typename)
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import threading
 import time
+from itertools import pairwise
 from pathlib import Path
 
 import pytest
@@ -108,12 +109,13 @@ def test_timed_replay_publishes_clock_on_pass_time(tmp_path: Path, ros_context):
     assert n > 150
     assert 0.7 < wall < 3.0  # recorded timing scaled by the rate (first pass to last < 2 days)
     assert len(ticks) > n  # ticks between passes, not only at them
-    assert all(b >= a for a, b in zip(ticks, ticks[1:]))  # pass time never runs backwards
+    assert all(b >= a for a, b in pairwise(ticks))  # pass time never runs backwards
 
 
 def test_simulator_node_writes_bag(tmp_path: Path, ros_context):
-    from conftest import SITE_FILE
     from rail_monitor.site import load_parameter_file
+
+    from conftest import SITE_FILE
 
     flat = load_parameter_file(SITE_FILE)
     flat["simulator.days"] = 3.0
@@ -140,8 +142,9 @@ def test_bad_parameters_name_the_parameter_and_range(ros_context, name, value, m
 
 
 def test_unknown_brake_type_is_refused(ros_context):
-    from conftest import SITE_FILE
     from rail_monitor.site import load_parameter_file
+
+    from conftest import SITE_FILE
 
     flat = load_parameter_file(SITE_FILE)
     flat["vehicle.emu.brake_type"] = "magnetic"

@@ -122,9 +122,10 @@ def cmd_info(ns: argparse.Namespace) -> int:
         print(f"AoA:       mean {1e3 * table.angle_of_attack_rad.mean():.2f} mrad, "
               f"95th percentile {1e3 * np.percentile(table.angle_of_attack_rad, 95):.2f} mrad")
         states, counts = np.unique(table.friction_state, return_counts=True)
-        print("friction:  " + ", ".join(f"{FRICTION_NAMES.get(int(s), s)} {c}" for s, c in zip(states, counts)))
+        mix = zip(states, counts, strict=True)
+        print("friction:  " + ", ".join(f"{FRICTION_NAMES.get(int(s), s)} {c}" for s, c in mix))
         classes, counts = np.unique(table.vehicle_class.astype(str), return_counts=True)
-        print("classes:   " + ", ".join(f"{c} {n}" for c, n in zip(classes, counts)))
+        print("classes:   " + ", ".join(f"{c} {n}" for c, n in zip(classes, counts, strict=True)))
     return 0
 
 

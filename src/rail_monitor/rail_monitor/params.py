@@ -56,7 +56,7 @@ class ParamSpec:
         for item in items:
             if want is float and isinstance(item, int) and not isinstance(item, bool):
                 item = float(item)  # the pure loader is lenient where YAML is ambiguous
-            if want is bool and not isinstance(item, bool) or (
+            if (want is bool and not isinstance(item, bool)) or (
                 want is not bool and (isinstance(item, bool) or not isinstance(item, want))
             ):
                 raise ConfigError(

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -50,7 +50,7 @@ class PassTable:
     friction_state: np.ndarray        # int64, FRICTION_*
     train_length_m: np.ndarray        # float64 [m]
 
-    DTYPES = {
+    DTYPES: ClassVar[dict[str, type]] = {
         "stamp_ns": np.int64, "train_id": object, "vehicle_class": object, "vehicle_count": np.int64,
         "axle_count": np.int64, "speed_mps": np.float64, "angle_of_attack_rad": np.float64,
         "wheel_load_n": np.float64, "friction_state": np.int64, "train_length_m": np.float64,

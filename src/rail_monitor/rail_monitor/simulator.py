@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
@@ -157,7 +157,7 @@ def simulate(site: Site, cfg: SimulatorConfig) -> PassTable:
     # Friction: contaminated (leaf season) before wet before friction modifier before dry.
     hour = (t - cfg.start_ns) // (3600 * NS_PER_S)
     wet = _wet_hours(rng, cfg, int(hour.max(initial=0)) + 1)[hour]
-    day_of_year = np.array([datetime.fromtimestamp(s // NS_PER_S, timezone.utc).timetuple().tm_yday for s in t],
+    day_of_year = np.array([datetime.fromtimestamp(s // NS_PER_S, UTC).timetuple().tm_yday for s in t],
                            dtype=np.int64)
     s0, s1 = cfg.leaf_season_start_doy, cfg.leaf_season_end_doy
     in_season = (day_of_year >= s0) & (day_of_year <= s1) if s0 <= s1 else (day_of_year >= s0) | (day_of_year <= s1)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import re
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 from rail_monitor.errors import RailMonitorError
 
@@ -27,7 +27,7 @@ def parse_iso_ns(text: str) -> int:
 def format_iso_ns(ns: int) -> str:
     """ns since the epoch -> 'YYYY-MM-DDTHH:MM:SS.fffffffffZ' (UTC, lossless)."""
     sec, frac = divmod(int(ns), NS_PER_S)
-    return datetime.fromtimestamp(sec, timezone.utc).strftime("%Y-%m-%dT%H:%M:%S") + f".{frac:09d}Z"
+    return datetime.fromtimestamp(sec, UTC).strftime("%Y-%m-%dT%H:%M:%S") + f".{frac:09d}Z"
 
 
 def to_sec_nanosec(ns: int) -> tuple[int, int]:

@@ -24,7 +24,6 @@ import io
 from collections.abc import Callable
 from pathlib import Path
 
-
 from rail_monitor.errors import InputError, RailMonitorError
 from rail_monitor.passes import FRICTION_BY_NAME, FRICTION_NAMES, PassTable
 from rail_monitor.timeutil import NS_PER_S, format_iso_ns, parse_iso_ns
@@ -35,7 +34,7 @@ def _time_utc(text: str) -> int:
 
 
 def _time_unix_s(text: str) -> int:
-    return int(round(float(text) * NS_PER_S))
+    return round(float(text) * NS_PER_S)
 
 
 def _friction(text: str) -> int:

@@ -5,10 +5,10 @@ from __future__ import annotations
 from typing import Any
 
 from builtin_interfaces.msg import Time
-from rail_msgs.msg import TrainPass
 
 from rail_monitor.passes import PassTable
 from rail_monitor.timeutil import from_sec_nanosec, to_sec_nanosec
+from rail_msgs.msg import TrainPass
 
 
 def time_msg(ns: int) -> Time:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sys
 import threading
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
@@ -44,7 +44,7 @@ class McapRecorder(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__("mcap_recorder", **kwargs)
         self.cfg = declare(self, RECORDER_SPECS)
-        out = self.cfg["output"] or f"rail_monitor_{datetime.now(timezone.utc):%Y_%m_%d-%H_%M_%S}"
+        out = self.cfg["output"] or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
         self.writer = McapBagWriter(
             Path(out), compression=self.cfg["compression"], chunk_size=self.cfg["chunk_size"],
             max_file_bytes=self.cfg["max_bag_size"], max_file_duration_ns=int(self.cfg["max_bag_duration_s"] * 1e9),
@@ -105,6 +105,8 @@ class McapRecorder(Node):
     def close(self) -> Path:
         """Finalise the bag (metadata.yaml, summary); safe to call twice."""
         with self._lock:
+            if self.writer.closed:
+                return self.writer.folder
             folder = self.writer.close()
         self.get_logger().info(f"bag {folder}: {self.meter.count} messages")
         return folder

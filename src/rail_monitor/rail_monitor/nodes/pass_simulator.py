@@ -34,7 +34,7 @@ class PassSimulator(PassSourceNode):
     def passes(self) -> PassTable:
         return self._table
 
-    def run(self, ok=None) -> int:  # noqa: ANN001 - same signature as the base
+    def run(self, ok=None) -> int:
         if self.mode["mode"] == "publish":
             return super().run(ok)
         if not self.mode["output"]:

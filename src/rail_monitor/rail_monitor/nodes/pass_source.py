@@ -11,7 +11,6 @@ import time
 from collections.abc import Callable
 
 import rclpy
-from rail_msgs.msg import TrainPass
 from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
@@ -26,6 +25,7 @@ from rail_monitor.params import ParamSpec
 from rail_monitor.passes import PassTable
 from rail_monitor.site import SITE_SPECS
 from rail_monitor.timeutil import NS_PER_S
+from rail_msgs.msg import TrainPass
 
 PUBLISH_SPECS: tuple[ParamSpec, ...] = (
     SITE_SPECS[0],  # site_id: header.frame_id of every pass
