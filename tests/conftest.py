@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import os
 import subprocess
 import sys
@@ -16,10 +17,15 @@ EXAMPLE_CSV = TOP / "bags" / "example_passes.csv"
 SITE_FILE = TOP / "src" / "rail_monitor" / "config" / "curve_250.yaml"
 
 
+_DOMAINS = itertools.count()
+
+
 @pytest.fixture(autouse=True)
 def _isolated_dds(monkeypatch: pytest.MonkeyPatch) -> None:
-    # A domain of its own per test run, so a stray process of another run never joins the graph.
-    monkeypatch.setenv("ROS_DOMAIN_ID", os.environ.get("RAIL_TEST_DOMAIN", "42"))
+    # A DDS domain of its own per test: endpoints of an earlier test (which discovery may still
+    # list for a moment) and other test runs on the machine never join this test's graph.
+    base = os.getpid() % 11 * 20
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(1 + (base + next(_DOMAINS) % 20) % 220))
 
 
 @pytest.fixture()
@@ -50,7 +56,7 @@ def ros_context() -> Iterator[object]:
     from rclpy.context import Context
 
     ctx = Context()
-    rclpy.init(context=ctx, domain_id=int(os.environ.get("RAIL_TEST_DOMAIN", "42")))
+    rclpy.init(context=ctx, domain_id=int(os.environ["ROS_DOMAIN_ID"]))
     try:
         yield ctx
     finally:
@@ -59,7 +65,7 @@ def ros_context() -> Iterator[object]:
 
 def run_cmd(*args: str, timeout: float = 120.0, **kw) -> subprocess.CompletedProcess:
     """Run a workspace executable (PATH set by ros2_ws/run) and capture its output."""
-    env = {**os.environ, "ROS_DOMAIN_ID": os.environ.get("RAIL_TEST_DOMAIN", "42"), **kw.pop("env", {})}
+    env = {**os.environ, **kw.pop("env", {})}
     return subprocess.run(list(args), capture_output=True, text=True, timeout=timeout, env=env, cwd=TOP, **kw)
 
 

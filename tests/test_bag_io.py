@@ -192,3 +192,12 @@ def test_killed_writer_process_leaves_readable_chunks(tmp_path: Path):
     got = list(salvage_mcap(tmp_path / "k" / "k_0.mcap"))
     assert len(got) >= 1900  # all but the open chunk (about 2048 bytes of messages)
     assert all(m.data == blob.read_bytes() for m in got)
+
+
+def test_header_stamp_read_from_cdr(sample_passes):
+    from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
+
+    assert starts_with_header(TRAIN_PASS) and starts_with_header("diagnostic_msgs/msg/DiagnosticArray")
+    assert not starts_with_header("rosgraph_msgs/msg/Clock")
+    data = pass_cdr(sample_passes.take(slice(0, 20)), "s")
+    assert [header_stamp_ns(d) for d in data] == list(sample_passes.stamp_ns[:20])

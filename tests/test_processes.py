@@ -117,3 +117,14 @@ def test_replayer_with_unusable_csv_exits_nonzero_naming_the_line(tmp_path: Path
     r = run_cmd(_exe("pass_replayer"), "--ros-args", "-p", f"source:={bad}", timeout=60)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert "line 2: column 'speed_mps'" in r.stderr
+
+
+def test_recorded_log_time_is_pass_time(tmp_path: Path):
+    # header log time: the recorded history sits on the pass times, however /clock lagged
+    r = run_cmd("rail-monitor", "monitor", str(SAMPLE), "--output", str(tmp_path / "lt"),
+                "--end-offset-s", FIVE_DAYS, "--no-progress", timeout=180)
+    assert r.returncode == 0, r.stderr
+    with AnyReader([tmp_path / "lt"]) as reader:
+        conns = [c for c in reader.connections if c.msgtype == "rail_msgs/msg/TrainPass"]
+        times = [t for _, t, _ in reader.messages(connections=conns)]
+    assert times == list(read_bag_passes(SAMPLE).stamp_ns[: len(times)])

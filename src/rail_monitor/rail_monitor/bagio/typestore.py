@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import re
+import struct
 from pathlib import Path
 
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
@@ -69,3 +70,22 @@ def schema_text(typename: str) -> str:
 def type_hash(typename: str) -> str:
     """RIHS01 type hash of a message type (as rosidl generates it)."""
     return typestore().hash_rihs01(typename)
+
+
+def starts_with_header(typename: str) -> bool:
+    """True when the message's first field is a std_msgs/Header (its stamp leads the CDR data)."""
+    fields = typestore().fielddefs[typename][1]
+    return bool(fields) and fields[0][1][1] == "std_msgs/msg/Header"
+
+
+def header_stamp_ns(cdr: bytes) -> int | None:
+    """header.stamp [ns] of a CDR message whose first field is a std_msgs/Header, or None.
+
+    CDR: a 4-byte encapsulation header (byte 1: 1 little-endian, 0 big-endian), then
+    stamp.sec (int32) and stamp.nanosec (uint32).
+    """
+    if len(cdr) < 12:
+        return None
+    order = "<" if cdr[1] == 1 else ">"
+    sec, nanosec = struct.unpack_from(order + "iI", cdr, 4)
+    return sec * 1_000_000_000 + nanosec

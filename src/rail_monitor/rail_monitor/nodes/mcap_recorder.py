@@ -1,9 +1,10 @@
 """mcap_recorder: record the graph's topics into a rosbag2-compatible MCAP bag folder.
 
-Records every topic whose type is in a rail_msgs package, /diagnostics and /rosout-free
-others named in ``topics``. Messages are taken serialised (no decode) and written with the
-node's clock as log time (pass time under use_sim_time). The bag is finalised on SIGINT and
-SIGTERM; chunks are closed every ``flush_period_s`` so a SIGKILL loses at most that much.
+Records every topic whose type is in rail_msgs, and /diagnostics, or the topics named in
+``topics``. Messages are taken serialised (no decode). Log time is the message's header stamp
+(pass time; ``log_time:=receive`` uses the node clock at receipt, as rosbag2 does). The bag is
+finalised on SIGINT and SIGTERM; chunks are closed every ``flush_period_s``, so a SIGKILL loses
+at most that much.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
+from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
 from rail_monitor.errors import RailMonitorError
 from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, run_node, wall_timer
 from rail_monitor.nodes.qos import qos_to_dict, subscription_qos
@@ -36,6 +38,9 @@ RECORDER_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("max_bag_duration_s", 0.0, "Start a new file past this span of log time; 0: never [s].", 0.0, 1.0e9),
     ParamSpec("flush_period_s", 5.0, "Close the open chunk at least this often (bounds loss on a kill) [s].",
               0.0, 3600.0),
+    ParamSpec("log_time", "header", "Log time of a message: header = its header.stamp (pass time; messages "
+              "without a header take the node clock), receive = the node clock at receipt, as rosbag2 does.",
+              choices=("header", "receive")),
     ParamSpec("discovery_period_s", 0.2, "How often to look for new topics [s].", 0.01, 60.0),
 )
 
@@ -54,6 +59,7 @@ class McapRecorder(Node):
         self._lock = threading.Lock()
         self._group = MutuallyExclusiveCallbackGroup()
         self._subs: dict[str, object] = {}
+        self._stamped: dict[str, bool] = {}
         self.counts: dict[str, int] = {}
         self.meter = RateMeter()
         wall_timer(self, self.cfg["discovery_period_s"], self.discover, callback_group=self._group)
@@ -84,6 +90,7 @@ class McapRecorder(Node):
             with self._lock:
                 self.writer.add_topic(topic, typename, [qos_to_dict(q) for q in offered])
                 self.counts[topic] = 0
+                self._stamped[topic] = self.cfg["log_time"] == "header" and starts_with_header(typename)
             self._subs[topic] = self.create_subscription(
                 msg_type, topic, lambda data, t=topic: self._on_message(t, data), subscription_qos(offered),
                 raw=True, callback_group=self._group)
@@ -93,7 +100,8 @@ class McapRecorder(Node):
         with self._lock:
             if self.writer.closed:
                 return
-            self.writer.write(topic, data, self.get_clock().now().nanoseconds)
+            stamp = header_stamp_ns(data) if self._stamped[topic] else None
+            self.writer.write(topic, data, stamp if stamp else self.get_clock().now().nanoseconds)
             self.counts[topic] += 1
         self.meter.tick()
 
