@@ -21,12 +21,20 @@ from rail_monitor.errors import ConfigError
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_replayer import PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
+from rail_monitor.site import load_parameter_file
 
-from conftest import EXAMPLE_CSV, SAMPLE
+from conftest import EXAMPLE_CSV, SAMPLE, SITE_FILE
 
 
 def _params(**kw) -> list[Parameter]:
     return [Parameter(k, value=v) for k, v in kw.items()]
+
+
+def _site_params(**simulator) -> list[Parameter]:
+    """The shipped site file as parameter overrides, with simulator.* values replaced."""
+    flat = load_parameter_file(SITE_FILE)
+    flat.update({f"simulator.{k}": v for k, v in simulator.items()})
+    return [Parameter(k, value=v) for k, v in flat.items()]
 
 
 def _replay_and_record(ctx, out: Path, source: str, **replay_params):
@@ -150,3 +158,22 @@ def test_unknown_brake_type_is_refused(ros_context):
     flat["vehicle.emu.brake_type"] = "magnetic"
     with pytest.raises(ConfigError, match=r"vehicle.emu.brake_type.*'magnetic' is not one of"):
         PassSimulator(context=ros_context, parameter_overrides=[Parameter(k, value=v) for k, v in flat.items()])
+
+
+def test_simulator_publishes_live_into_the_recorder(tmp_path: Path, ros_context):
+    over = _site_params(days=2.0) + _params(progress=False, wait_for_subscribers=1)
+    rec = McapRecorder(context=ros_context, parameter_overrides=_params(output=str(tmp_path / "live")))
+    sim = PassSimulator(context=ros_context, parameter_overrides=over)
+    sim.consumed = lambda: rec.counts.get("/train_pass", 0)
+    ex = SingleThreadedExecutor(context=ros_context)
+    ex.add_node(rec)
+    ex.add_node(sim)
+    threading.Thread(target=ex.spin, daemon=True).start()
+    n = sim.run()
+    deadline = time.monotonic() + 30
+    while rec.counts.get("/train_pass", 0) < n and time.monotonic() < deadline:
+        time.sleep(0.01)
+    rec.close()
+    ex.shutdown(timeout_sec=2)
+    assert n > 150
+    assert read_bag_passes(tmp_path / "live").equals(sim.passes())

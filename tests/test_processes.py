@@ -128,3 +128,13 @@ def test_recorded_log_time_is_pass_time(tmp_path: Path):
         conns = [c for c in reader.connections if c.msgtype == "rail_msgs/msg/TrainPass"]
         times = [t for _, t, _ in reader.messages(connections=conns)]
     assert times == list(read_bag_passes(SAMPLE).stamp_ns[: len(times)])
+
+
+def test_launch_file_and_site_config_are_installed():
+    import ast
+
+    share = Path(get_package_prefix("rail_monitor")) / "share" / "rail_monitor"
+    tree = ast.parse((share / "launch" / "wayside.launch.py").read_text())
+    assert any(isinstance(n, ast.FunctionDef) and n.name == "generate_launch_description" for n in tree.body)
+    assert (share / "config" / "curve_250.yaml").is_file()
+    assert (share / "config" / "fastdds_flow_control.xml").is_file()
