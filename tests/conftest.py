@@ -5,7 +5,6 @@ from __future__ import annotations
 import itertools
 import os
 import subprocess
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -68,6 +67,3 @@ def run_cmd(*args: str, timeout: float = 120.0, **kw) -> subprocess.CompletedPro
     env = {**os.environ, **kw.pop("env", {})}
     return subprocess.run(list(args), capture_output=True, text=True, timeout=timeout, env=env, cwd=TOP, **kw)
 
-
-def python_exe() -> str:
-    return sys.executable
