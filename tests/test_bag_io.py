@@ -96,6 +96,18 @@ def test_split_by_size_keeps_every_message(tmp_path: Path, sample_passes):
     assert len(read_bag_passes(tmp_path / "split")) == 2000
 
 
+def test_split_by_duration(tmp_path: Path, sample_passes):
+    part = sample_passes.take(slice(0, 1000))  # about 10 days
+    with McapBagWriter(tmp_path / "d", max_file_duration_ns=2 * 86400 * 10**9) as w:
+        w.add_topic("/train_pass", TRAIN_PASS)
+        for stamp, d in zip(part.stamp_ns, pass_cdr(part, "s"), strict=True):
+            w.write("/train_pass", d, int(stamp))
+    meta = yaml.safe_load((tmp_path / "d" / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    spans = [f["duration"]["nanoseconds"] for f in meta["files"]]
+    assert len(spans) >= 5 and max(spans) < 2 * 86400 * 10**9
+    assert read_bag_passes(tmp_path / "d").equals(part)
+
+
 def test_sample_bag_regenerates_bit_for_bit(tmp_path: Path):
     out = tmp_path / "sample"
     r = run_cmd("rail-monitor", "simulate", "--out", str(out))

@@ -7,6 +7,7 @@ parameters). mode 'bag': writes the passes straight into a rosbag2 MCAP bag at `
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.errors import RailMonitorError
@@ -34,7 +35,7 @@ class PassSimulator(PassSourceNode):
     def passes(self) -> PassTable:
         return self._table
 
-    def run(self, ok=None) -> int:
+    def run(self, ok: Callable[[], bool] | None = None) -> int:
         if self.mode["mode"] == "publish":
             return super().run(ok)
         if not self.mode["output"]:
