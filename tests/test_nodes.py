@@ -177,3 +177,12 @@ def test_simulator_publishes_live_into_the_recorder(tmp_path: Path, ros_context)
     ex.shutdown(timeout_sec=2)
     assert n > 150
     assert read_bag_passes(tmp_path / "live").equals(sim.passes())
+
+
+def test_train_pass_message_conversion_round_trips(sample_passes):
+    from rail_monitor.nodes.convert import train_pass_msg, train_pass_row
+
+    for i in range(0, len(sample_passes), 997):
+        row = sample_passes.row(i)
+        msg = train_pass_msg(row, "curve_250")
+        assert msg.header.frame_id == "curve_250" and train_pass_row(msg) == row

@@ -96,12 +96,6 @@ class PassTable:
         """The rows in time order (stable, so equal stamps keep their order)."""
         return self.take(np.argsort(self.stamp_ns, kind="stable"))
 
-    @staticmethod
-    def concat(tables: Sequence[PassTable]) -> PassTable:
-        if not tables:
-            return PassTable.empty()
-        return PassTable(**{n: np.concatenate([getattr(t, n) for t in tables]) for n in PassTable.columns()})
-
     def equals(self, other: PassTable) -> bool:
         """True when every column is equal element by element (NaN equal to NaN)."""
         return len(self) == len(other) and all(

@@ -6,7 +6,6 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 
-from rail_monitor.passes import PassTable
 from rail_monitor.timeutil import from_sec_nanosec, to_sec_nanosec
 from rail_msgs.msg import TrainPass
 
@@ -46,6 +45,3 @@ def train_pass_row(msg: TrainPass) -> dict[str, Any]:
         "friction_state": msg.friction_state, "train_length_m": msg.train_length_m,
     }
 
-
-def pass_table(msgs: list[TrainPass]) -> PassTable:
-    return PassTable.from_rows(train_pass_row(m) for m in msgs)

@@ -16,9 +16,6 @@ STREAM_QOS = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability
                         durability=DurabilityPolicy.VOLATILE)
 STREAM_SUB_QOS = QoSProfile(depth=10000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
                             durability=DurabilityPolicy.VOLATILE)
-# Standing alerts: a late subscriber sees them.
-LATCHED_QOS = QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
-                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
 DIAGNOSTICS_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 CLOCK_QOS = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
 
