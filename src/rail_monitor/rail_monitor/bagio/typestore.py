@@ -16,6 +16,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 from rail_monitor.errors import RailMonitorError
+from rail_monitor.timeutil import from_sec_nanosec
 
 SEPARATOR = "=" * 80
 TRAIN_PASS = "rail_msgs/msg/TrainPass"
@@ -88,4 +89,4 @@ def header_stamp_ns(cdr: bytes) -> int | None:
         return None
     order = "<" if cdr[1] == 1 else ">"
     sec, nanosec = struct.unpack_from(order + "iI", cdr, 4)
-    return sec * 1_000_000_000 + nanosec
+    return from_sec_nanosec(sec, nanosec)
