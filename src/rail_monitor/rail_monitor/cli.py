@@ -99,12 +99,12 @@ def cmd_simulate(ns: argparse.Namespace) -> int:
 def cmd_info(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.reader import bag_info, is_csv, read_passes
     from rail_monitor.passes import FRICTION_NAMES
-    from rail_monitor.timeutil import format_iso_ns
+    from rail_monitor.timeutil import NS_PER_S, format_iso_ns
 
     path = Path(ns.bag)
     if not is_csv(path):
         info = bag_info(path)
-        span = (info.end_ns - info.start_ns) / 1e9
+        span = (info.end_ns - info.start_ns) / NS_PER_S
         print(f"bag:       {info.path} ({info.storage})")
         print(f"start:     {format_iso_ns(info.start_ns)}")
         print(f"duration:  {span:.1f} s ({span / 86400:.2f} days)")

@@ -34,7 +34,7 @@ from rail_monitor.passes import (
     PassTable,
 )
 from rail_monitor.site import Site
-from rail_monitor.timeutil import NS_PER_S, parse_iso_ns
+from rail_monitor.timeutil import NS_PER_DAY, NS_PER_HOUR, parse_iso_ns
 
 _HOURS_PER_DAY = 24
 
@@ -107,12 +107,12 @@ def simulator_config(values: Mapping[str, Any]) -> SimulatorConfig:
 def _arrivals(rng: np.random.Generator, cfg: SimulatorConfig) -> np.ndarray:
     """Pass times [ns], sorted: Poisson counts per hour from the profile, uniform within the hour."""
     n_hours = int(np.ceil(cfg.days * _HOURS_PER_DAY))
-    hour_of_day = (np.arange(n_hours) + (cfg.start_ns // (3600 * NS_PER_S))) % _HOURS_PER_DAY
+    hour_of_day = (np.arange(n_hours) + (cfg.start_ns // NS_PER_HOUR)) % _HOURS_PER_DAY
     counts = rng.poisson(cfg.trains_per_hour[hour_of_day])
-    hour_start = cfg.start_ns + np.repeat(np.arange(n_hours, dtype=np.int64), counts) * 3600 * NS_PER_S
-    offsets = (rng.random(counts.sum()) * 3600 * NS_PER_S).astype(np.int64)
+    hour_start = cfg.start_ns + np.repeat(np.arange(n_hours, dtype=np.int64), counts) * NS_PER_HOUR
+    offsets = (rng.random(counts.sum()) * NS_PER_HOUR).astype(np.int64)
     t = np.sort(hour_start + offsets)
-    return t[t < cfg.start_ns + int(cfg.days * 86400 * NS_PER_S)]
+    return t[t < cfg.start_ns + int(cfg.days * NS_PER_DAY)]
 
 
 def _wet_hours(rng: np.random.Generator, cfg: SimulatorConfig, n_hours: int) -> np.ndarray:
@@ -155,14 +155,14 @@ def simulate(site: Site, cfg: SimulatorConfig) -> PassTable:
     load = per_class("wheel_load_n") * (1.0 + cfg.wheel_load_sd_fraction * rng.standard_normal(n))
 
     # Friction: contaminated (leaf season) before wet before friction modifier before dry.
-    hour = (t - cfg.start_ns) // (3600 * NS_PER_S)
+    hour = (t - cfg.start_ns) // NS_PER_HOUR
     wet = _wet_hours(rng, cfg, int(hour.max(initial=0)) + 1)[hour]
     day_of_year = np.array([datetime.fromtimestamp(s // NS_PER_S, UTC).timetuple().tm_yday for s in t],
                            dtype=np.int64)
     s0, s1 = cfg.leaf_season_start_doy, cfg.leaf_season_end_doy
     in_season = (day_of_year >= s0) & (day_of_year <= s1) if s0 <= s1 else (day_of_year >= s0) | (day_of_year <= s1)
     contaminated = in_season & (rng.random(n) < cfg.contaminated_probability)
-    day = (t - cfg.start_ns) / (86400 * NS_PER_S)
+    day = (t - cfg.start_ns) / NS_PER_DAY
     fm_on = (cfg.friction_modifier_start_day >= 0.0) & (day >= cfg.friction_modifier_start_day) & (
         day < cfg.friction_modifier_end_day)
     fm = fm_on & (rng.random(n) < cfg.friction_modifier_coverage)

@@ -8,6 +8,8 @@ from datetime import UTC, datetime
 from rail_monitor.errors import RailMonitorError
 
 NS_PER_S = 1_000_000_000
+NS_PER_HOUR = 3600 * NS_PER_S
+NS_PER_DAY = 86400 * NS_PER_S
 _ISO = re.compile(r"^(\d{4}-\d\d-\d\d[T ]\d\d:\d\d:\d\d)(?:\.(\d{1,9}))?(Z|[+-]\d\d:?\d\d)?$")
 
 

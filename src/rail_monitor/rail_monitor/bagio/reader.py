@@ -124,13 +124,14 @@ def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
     return PassTable.from_rows(rows)
 
 
-def read_passes(path: str | Path, topic: str | None = None) -> PassTable:
-    """Train passes from a CSV export or a bag, whichever path names."""
+def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False) -> PassTable:
+    """Train passes from a CSV export or a bag, whichever path names (skip_bad_rows: CSV only,
+    see read_csv; the table's ``skipped`` attribute counts what was left out)."""
     path = Path(path)
     if is_csv(path):
         from rail_monitor.bagio.csv_io import read_csv
 
-        return read_csv(path)
+        return read_csv(path, skip_bad_rows=skip_bad_rows)
     return read_bag_passes(path, topic)
 
 

@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import sys
 
-from rail_monitor.bagio.csv_io import read_csv
-from rail_monitor.bagio.reader import is_csv, read_bag_passes
+from rail_monitor.bagio.reader import read_passes
 from rail_monitor.errors import RailMonitorError
 from rail_monitor.nodes.base import declare
 from rail_monitor.nodes.pass_source import PassSourceNode, run_source
@@ -33,16 +32,11 @@ class PassReplayer(PassSourceNode):
         self._table = self._load()  # read up front: a bad file fails before anything is published
 
     def _load(self) -> PassTable:
-        from pathlib import Path
-
-        path = Path(self.src["source"])
-        if is_csv(path):
-            table = read_csv(path, skip_bad_rows=self.src["skip_bad_rows"])
-            self.skipped = getattr(table, "skipped", 0)
-            if self.skipped:
-                self.get_logger().warning(f"{path}: {self.skipped} malformed row(s) left out")
-            return table
-        return read_bag_passes(path, self.src["source_topic"] or None)
+        table = read_passes(self.src["source"], self.src["source_topic"] or None, self.src["skip_bad_rows"])
+        self.skipped = getattr(table, "skipped", 0)
+        if self.skipped:
+            self.get_logger().warning(f"{self.src['source']}: {self.skipped} malformed row(s) left out")
+        return table
 
     def passes(self) -> PassTable:
         return self._table
