@@ -34,7 +34,7 @@ from rail_monitor.passes import (
     PassTable,
 )
 from rail_monitor.site import Site
-from rail_monitor.timeutil import NS_PER_DAY, NS_PER_HOUR, parse_iso_ns
+from rail_monitor.timeutil import NS_PER_DAY, NS_PER_HOUR, NS_PER_S, parse_iso_ns
 
 _HOURS_PER_DAY = 24
 

@@ -53,7 +53,8 @@ class McapRecorder(Node):
         out = self.cfg["output"] or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
         self.writer = McapBagWriter(
             Path(out), compression=self.cfg["compression"], chunk_size=self.cfg["chunk_size"],
-            max_file_bytes=self.cfg["max_bag_size"], max_file_duration_ns=int(self.cfg["max_bag_duration_s"] * NS_PER_S),
+            max_file_bytes=self.cfg["max_bag_size"],
+            max_file_duration_ns=int(self.cfg["max_bag_duration_s"] * NS_PER_S),
             flush_wall_period_s=self.cfg["flush_period_s"])
         wanted = [t for t in self.cfg["topics"] if t]
         self._wanted = {self.resolve_topic_name(t) for t in wanted} if wanted else None
