@@ -7,7 +7,7 @@ from typing import Any
 from builtin_interfaces.msg import Time
 
 from rail_monitor.timeutil import from_sec_nanosec, to_sec_nanosec
-from rail_msgs.msg import TrainPass
+from rail_msgs.msg import SquealPrediction, TrainPass
 
 
 def time_msg(ns: int) -> Time:
@@ -45,3 +45,24 @@ def train_pass_row(msg: TrainPass) -> dict[str, Any]:
         "friction_state": msg.friction_state, "train_length_m": msg.train_length_m,
     }
 
+
+
+_CASTS = {"boolean": bool, "float": float, "double": float, "string": str}
+
+
+def fill_fields(msg: Any, values: dict[str, Any], i: int) -> Any:
+    """Set msg's fields from row i of a dict of model output arrays (keys = field names).
+
+    Scalars are cast to the field's Python type (numpy scalars are refused by rclpy's setters).
+    """
+    types = msg.get_fields_and_field_types()
+    for name, column in values.items():
+        cast = _CASTS.get(types[name], int)
+        setattr(msg, name, cast(column[i]))
+    return msg
+
+
+def squeal_prediction_msg(values: dict[str, Any], i: int, source: TrainPass) -> SquealPrediction:
+    """Row i of rail_monitor.squeal_risk.predict as a SquealPrediction for the pass source."""
+    msg = SquealPrediction(header=source.header, train_id=source.train_id)
+    return fill_fields(msg, values, i)

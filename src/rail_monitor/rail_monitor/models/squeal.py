@@ -1,0 +1,321 @@
+"""Wheel squeal: one lateral wheel mode driven by a falling lateral creep curve.
+
+Model (seed, section 2.3, eqs. 3-5; ../shared/MODELS.md section 1)::
+
+    m y'' + c y' + k y = -mu(xi') W,      xi' = (Vc + y') k3 / (V0 W),      Vc = V0 sin(theta)
+    mu = k1 xi'                 for xi' <= 1    (adhesion branch,  slope s1 = k1 k3 / V0 [N s/m])
+    mu = k1 + k2 (xi' - 1)      for xi' > 1     (falling branch,   slope s2 = k2 k3 / V0 [N s/m])
+
+The critical creepage is zeta_c = W / k3 and the critical slip velocity u_s = zeta_c V0. Small
+oscillations about the sliding state see the damping c + s2 (seed eq. 5): squeal needs
+c + s2 < 0 and Vc > u_s.
+
+Limit cycle (our derivation; it corrects the sign of the k2 k3 term of the seed's eq. 7).
+Take y' = A w cos(wt) and require that the friction force does no net work against the
+damper over one cycle. With D = Vc - u_s, the contact adheres (xi' <= 1) on the arc where
+A w cos(wt) < -D, of half-angle phi with cos(phi) = D / (A w). The work of the adhesion
+branch over that arc is (s1 - s2) (A w)^2 (2 phi - sin 2 phi) / 2 per cycle (in wt), that of
+the damper and of the falling branch pi (c + s2) (A w)^2; their sum vanishes when::
+
+    sin(2 phi) - 2 phi = 2 pi (V0 c + k2 k3) / (k3 (k1 - k2)),      A w = (Vc - zeta_c V0) / cos(phi)
+
+A root 0 < phi <= pi/2 exists while c + s2 < 0 and s1 + s2 + 2 c >= 0. The closed form assumes
+no reverse slip (the velocity never drives the creepage below -zeta_c), i.e. A w <= Vc + u_s;
+past that limit (or when no root exists) the amplitude is bounded by stick-slip, A w ~ Vc,
+and the regime is flagged rather than reporting the closed form.
+
+k3 conventions (the lateral creep stiffness of the normalised curve) are in
+:data:`K3_CONVENTIONS`; see :func:`lateral_creep_stiffness` for which one reproduces the seed.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.integrate import solve_ivp
+
+from rail_monitor.models.iec61672 import a_weighting_db
+
+FloatArray = NDArray[np.float64]
+
+# SquealPrediction.REGIME_* values.
+REGIME_STABLE, REGIME_LIMIT_CYCLE, REGIME_STICK_SLIP_BOUND = 0, 1, 2
+REGIME_NAMES = {REGIME_STABLE: "stable", REGIME_LIMIT_CYCLE: "limit cycle", REGIME_STICK_SLIP_BOUND: "stick-slip bound"}
+
+K3_CONVENTIONS = ("kalker_unit", "kalker_peak", "saturation_3x")
+
+# Air at 20 degC, 101.325 kPa: rho0 c0 [kg/(m2 s)] (ISO 9613-1 reference atmosphere).
+RHO0_C0 = 1.204 * 343.2
+REFERENCE_POWER_W = 1e-12
+REFERENCE_PRESSURE_PA = 20e-6
+REFERENCE_VELOCITY_MPS = 1.0  # 20 lg(A w / 1 m/s) when no other reference is chosen
+
+
+def shear_modulus(young_pa: ArrayLike, poisson: ArrayLike) -> FloatArray:
+    """G = E / (2 (1 + nu)) [Pa]."""
+    return np.asarray(young_pa, float) / (2.0 * (1.0 + np.asarray(poisson, float)))
+
+
+def lateral_creep_stiffness(
+    shear_pa: ArrayLike, a: ArrayLike, b: ArrayLike, c22: ArrayLike, mu0: ArrayLike, convention: str = "kalker_unit"
+) -> FloatArray:
+    """k3 [N]: the lateral creep stiffness that normalises the creepage, xi' = zeta k3 / W.
+
+    Kalker's linear lateral creep force is G a b C22 zeta (G [Pa], semi-axes a, b [m],
+    C22 [-] from :func:`rail_monitor.models.kalker.creep_coefficients`). Conventions:
+
+    ``kalker_peak``
+        The seed's eq. (4) read literally, xi' = zeta G a b C22 / (mu0 W): k3 = G a b C22 / mu0.
+        The adhesion branch then has Kalker's slope. For the seed's rig this gives
+        k3 = 5.5e5 N (zeta_c = 0.0018) and does not reproduce the seed's Figures 6-7.
+    ``kalker_unit`` (default)
+        k3 = G a b C22, i.e. the creepage normalised by W rather than mu0 W: the adhesion
+        slope is k1 times Kalker's. This is equivalent to a creep-force reduction factor
+        equal to the friction peak, in the range of the reductions needed to match measured
+        creep curves (Kalker's linear theory overestimates measured slopes, e.g. O. Polach,
+        Wear 258 (2005) 992-1000). For the rig: k3 = 1.48e5 N, zeta_c = 0.0068, and the seed's
+        A w = 0.33 m/s at Vc = 0.39 m/s, halving at -34 % Vc, are reproduced (tests). For
+        full-size wheels it puts the squeal onset at 5-10 mrad angle of attack, as observed.
+    ``saturation_3x``
+        Saturation at three times the linear intercept (the cubic Vermeulen-Johnson curve
+        saturates there): k3 = G a b C22 / (3 mu0).
+    """
+    g_ab_c22 = np.asarray(shear_pa, float) * np.asarray(a, float) * np.asarray(b, float) * np.asarray(c22, float)
+    if convention == "kalker_unit":
+        return g_ab_c22
+    if convention == "kalker_peak":
+        return g_ab_c22 / np.asarray(mu0, float)
+    if convention == "saturation_3x":
+        return g_ab_c22 / (3.0 * np.asarray(mu0, float))
+    raise ValueError(f"unknown k3 convention {convention!r}; use one of {K3_CONVENTIONS}")
+
+
+def critical_slip_velocity(speed: ArrayLike, load: ArrayLike, k3: ArrayLike) -> FloatArray:
+    """u_s = zeta_c V0 = W V0 / k3 [m/s] for rolling speed V0 [m/s], load W [N], k3 [N]."""
+    return np.asarray(load, float) * np.asarray(speed, float) / np.asarray(k3, float)
+
+
+def effective_damping(damping: ArrayLike, k2: ArrayLike, k3: ArrayLike, speed: ArrayLike) -> FloatArray:
+    """c + k2 k3 / V0 [N s/m] (seed eq. 5) on the falling branch; negative means unstable."""
+    return np.asarray(damping, float) + np.asarray(k2, float) * np.asarray(k3, float) / np.asarray(speed, float)
+
+
+def creep_force(slip_velocity: ArrayLike, speed: ArrayLike, load: ArrayLike,
+                k1: ArrayLike, k2: ArrayLike, k3: ArrayLike) -> FloatArray:
+    """Lateral friction force mu(xi') W [N] at slip velocity Vc + y' [m/s].
+
+    The seed's piecewise-linear curve, extended as an odd function of the creepage (reverse
+    slip saturates at -k1 and falls with the same slope) and floored at mu = 0 (a falling
+    branch never turns friction into propulsion), so that it stays physical where the closed
+    form's assumptions fail.
+    """
+    u, v0, w = (np.asarray(x, float) for x in (slip_velocity, speed, load))
+    xi = u * np.asarray(k3, float) / (v0 * w)
+    ax = np.abs(xi)
+    mu = np.where(ax <= 1.0, k1 * ax, np.maximum(k1 + k2 * (ax - 1.0), 0.0))
+    return np.sign(xi) * mu * w
+
+
+class LimitCycle(NamedTuple):
+    """Squeal state per case (arrays broadcast over the inputs).
+
+    amplitude: lateral velocity amplitude A w [m/s] (0 when stable; the stick-slip bound Vc
+    where the closed form does not hold); closed_form: the energy-balance A w [m/s] wherever
+    a root exists (NaN elsewhere); phi: half the adhesion angle [rad] (NaN without a root);
+    regime: REGIME_*; unstable: squeal conditions met; effective_damping: c + s2 [N s/m];
+    critical_slip: u_s [m/s]; friction_positive: the falling branch stays above mu = 0 up to
+    the largest creepage of the cycle (where it does not, the seed's curve is being
+    extrapolated past zero friction and the amplitude is outside the model's domain).
+    """
+
+    amplitude: FloatArray
+    closed_form: FloatArray
+    phi: FloatArray
+    regime: NDArray[np.int8]
+    unstable: NDArray[np.bool_]
+    effective_damping: FloatArray
+    critical_slip: FloatArray
+    friction_positive: NDArray[np.bool_]
+
+
+def _solve_x_minus_sin(q: FloatArray) -> FloatArray:
+    """x in [0, pi] with x - sin x = q for 0 <= q <= pi (vectorised bisection, then Newton)."""
+    lo, hi = np.zeros_like(q), np.full_like(q, np.pi)
+    for _ in range(60):  # 2^-60 pi: far below any physical tolerance
+        mid = 0.5 * (lo + hi)
+        low_side = mid - np.sin(mid) < q
+        lo, hi = np.where(low_side, mid, lo), np.where(low_side, hi, mid)
+    x = 0.5 * (lo + hi)
+    slope = 1.0 - np.cos(x)
+    return np.where(slope > 1e-12, x - (x - np.sin(x) - q) / np.where(slope > 1e-12, slope, 1.0), x)
+
+
+def limit_cycle_amplitude(
+    speed: ArrayLike,
+    crabbing: ArrayLike,
+    load: ArrayLike,
+    damping: ArrayLike,
+    k1: ArrayLike,
+    k2: ArrayLike,
+    k3: ArrayLike,
+) -> LimitCycle:
+    """Closed-form squeal velocity amplitude by energy balance (module docstring; seed eq. 7 corrected).
+
+    Parameters
+    ----------
+    speed : rolling speed V0 [m/s]; crabbing : crabbing velocity Vc [m/s] (sign ignored: the
+        creep curve is odd); load : normal load W [N]; damping : modal damping c [N s/m];
+    k1 : friction peak, slope of mu against xi' on the adhesion branch [-];
+    k2 : slope of mu against xi' on the sliding branch [-] (< 0 falling);
+    k3 : lateral creep stiffness [N] (:func:`lateral_creep_stiffness`).
+    """
+    v0, vc, w, c, k1, k2, k3 = np.broadcast_arrays(
+        *(np.asarray(x, float) for x in (speed, crabbing, load, damping, k1, k2, k3))
+    )
+    vc = np.abs(vc)
+    u_s = critical_slip_velocity(v0, w, k3)
+    c_eff = effective_damping(c, k2, k3, v0)
+    s1, s2 = k1 * k3 / v0, k2 * k3 / v0
+    # The floored curve (creep_force) is flat where the falling branch would cross mu = 0.
+    unstable = (c_eff < 0.0) & (vc > u_s) & (k1 + k2 * (vc / u_s - 1.0) > 0.0)
+    # sin 2phi - 2phi = 2 pi (c + s2) / (s1 - s2)  <=>  x - sin x = q with x = 2 phi.
+    q = -2.0 * np.pi * c_eff / np.where(s1 > s2, s1 - s2, np.inf)
+    has_root = unstable & (q <= np.pi)
+    x = _solve_x_minus_sin(np.where(has_root, q, 0.0))
+    phi = np.where(has_root, 0.5 * x, np.nan)
+    cos_phi = np.cos(np.where(has_root, phi, 0.0))
+    closed = np.where(has_root & (cos_phi > 0.0), (vc - u_s) / np.where(cos_phi > 0.0, cos_phi, 1.0), np.nan)
+    closed = np.where(has_root & (cos_phi <= 0.0), np.inf, closed)
+    valid = has_root & (closed <= vc + u_s)
+    regime = np.where(~unstable, REGIME_STABLE, np.where(valid, REGIME_LIMIT_CYCLE, REGIME_STICK_SLIP_BOUND))
+    amplitude = np.where(regime == REGIME_LIMIT_CYCLE, closed, np.where(regime == REGIME_STICK_SLIP_BOUND, vc, 0.0))
+    with np.errstate(invalid="ignore"):
+        xi_max = (vc + np.where(unstable, amplitude, 0.0)) / u_s
+        friction_positive = k1 + k2 * np.maximum(xi_max - 1.0, 0.0) > 0.0
+    return LimitCycle(amplitude, closed, phi, regime.astype(np.int8), unstable, c_eff, u_s, friction_positive)
+
+
+class TimeDomainResult(NamedTuple):
+    """Steady amplitude from direct integration: amplitude [m/s] (half the peak-to-peak wheel
+    velocity over the last cycles), t [s] and velocity [m/s] samples of the last cycles,
+    cycles integrated, and whether the envelope had settled."""
+
+    amplitude: float
+    t: FloatArray
+    velocity: FloatArray
+    cycles: int
+    settled: bool
+
+
+def simulate_limit_cycle(
+    speed: float,
+    crabbing: float,
+    load: float,
+    mass: float,
+    damping: float,
+    stiffness: float,
+    k1: float,
+    k2: float,
+    k3: float,
+    *,
+    initial_velocity: float | None = None,
+    max_cycles: int = 20000,
+    chunk_cycles: int = 200,
+    settle_tol: float = 1e-5,
+    rtol: float = 1e-8,
+) -> TimeDomainResult:
+    """Integrate the full nonlinear ODE (module docstring) with scipy's DOP853, no events.
+
+    Starts at the static equilibrium with a small velocity disturbance (default 1 % of Vc),
+    integrates in chunks of ``chunk_cycles`` natural periods and stops when the velocity
+    amplitude of successive chunks changes by less than ``settle_tol`` (relative), or after
+    ``max_cycles``. Independent of the closed form: used by the tests to check it, and
+    available to users. Units as in :func:`limit_cycle_amplitude`; mass [kg], stiffness [N/m].
+    """
+    omega = np.sqrt(stiffness / mass)
+    period = 2.0 * np.pi / omega
+
+    scale = k3 / (speed * load)  # xi' per unit slip velocity [s/m]
+
+    def rhs(_t: float, s: FloatArray) -> list[float]:
+        # Scalar arithmetic: the solver calls this ~1e5 times; same curve as creep_force.
+        y, v = s
+        xi = (crabbing + v) * scale
+        ax = abs(xi)
+        mu = k1 * ax if ax <= 1.0 else max(k1 + k2 * (ax - 1.0), 0.0)
+        f = math.copysign(mu * load, xi)
+        return [v, (-damping * v - stiffness * y - f) / mass]
+
+    y_static = -float(creep_force(crabbing, speed, load, k1, k2, k3)) / stiffness
+    state = np.array([y_static, 0.01 * abs(crabbing) if initial_velocity is None else initial_velocity])
+    t0, previous, cycles = 0.0, np.nan, 0
+    samples = 64
+    while True:
+        t1 = t0 + chunk_cycles * period
+        t_eval = np.linspace(t1 - 20 * period, t1, 20 * samples * 8 + 1)
+        sol = solve_ivp(rhs, (t0, t1), state, method="DOP853", rtol=rtol, atol=rtol * 1e-3 * max(abs(crabbing), 1e-6),
+                        t_eval=t_eval, max_step=period / 4)
+        v = sol.y[1]
+        amp = 0.5 * float(v.max() - v.min())
+        cycles += chunk_cycles
+        state, t0 = sol.y[:, -1], t1
+        settled = np.isfinite(previous) and abs(amp - previous) <= settle_tol * max(amp, 1e-12)
+        if settled or cycles >= max_cycles:
+            return TimeDomainResult(amp, sol.t, v, cycles, bool(settled))
+        previous = amp
+
+
+def squeal_frequency(mass: ArrayLike, stiffness: ArrayLike) -> FloatArray:
+    """Natural frequency sqrt(k/m) / (2 pi) [Hz] of the squealing mode (mass [kg], stiffness [N/m])."""
+    return np.sqrt(np.asarray(stiffness, float) / np.asarray(mass, float)) / (2.0 * np.pi)
+
+
+class RadiatedLevel(NamedTuple):
+    """Sound power level Lw [dB re 1 pW], level at the receiver Lp [dB re 20 uPa], Lp A-weighted [dB(A)]."""
+
+    power_db: FloatArray
+    level_db: FloatArray
+    level_dba: FloatArray
+
+
+def radiated_level(
+    amplitude: ArrayLike,
+    frequency: ArrayLike,
+    *,
+    radiating_area: ArrayLike = 0.9,
+    radiation_efficiency: ArrayLike = 1.0,
+    spatial_average: ArrayLike = 0.5,
+    distance: ArrayLike = 7.5,
+    solid_angle: float = 2.0 * np.pi,
+) -> RadiatedLevel:
+    """Level at a receiver from a wheel vibrating at velocity amplitude A w [m/s] at frequency [Hz].
+
+    Sound power W = rho0 c0 sigma S <v^2> with <v^2> = spatial_average (A w)^2 / 2 the
+    surface- and time-averaged squared velocity (Thompson, *Railway Noise and Vibration*,
+    Elsevier 2009, sections 5.2 and 13: radiation efficiency sigma ~ 1 for wheel axial modes
+    above about 1 kHz; a mode with nodal diameters averages cos^2 to 1/2 around the
+    circumference, hence spatial_average 0.5 relative to the contact point). S: radiating
+    area [m2] (both sides of a 0.84 m wheel's web and tread, about 0.9 m2). The wheel is a
+    compact source at distance r [m] radiating into solid_angle [sr] (2 pi: hemisphere above
+    a reflecting ground): p^2 = rho0 c0 W / (solid_angle r^2), so
+    Lp = Lw - 10 lg(solid_angle r^2 / 1 m2) + 10 lg(rho0 c0 / 400), the last term 0.14 dB. The squeal is a tone at the
+    mode's frequency; the A-weighted level adds A(f) (IEC 61672-1). Level changes follow
+    20 lg(A w / A w_ref), as in the seed's Figure 7a.
+    """
+    amp = np.asarray(amplitude, float)
+    mean_square = np.asarray(spatial_average, float) * amp**2 / 2.0
+    power = RHO0_C0 * np.asarray(radiation_efficiency, float) * np.asarray(radiating_area, float) * mean_square
+    pressure_sq = RHO0_C0 * power / (solid_angle * np.asarray(distance, float) ** 2)  # far field, I = p^2 / (rho0 c0)
+    with np.errstate(divide="ignore"):
+        lw = 10.0 * np.log10(power / REFERENCE_POWER_W)
+        lp = 10.0 * np.log10(pressure_sq / REFERENCE_PRESSURE_PA**2)
+    return RadiatedLevel(lw, lp, lp + a_weighting_db(frequency))
+
+
+def relative_level(amplitude: ArrayLike, reference: ArrayLike = REFERENCE_VELOCITY_MPS) -> FloatArray:
+    """Level change 20 lg(A w / A w_ref) [dB] (sound power ~ velocity squared; seed section 3.3)."""
+    with np.errstate(divide="ignore"):
+        return 20.0 * np.log10(np.asarray(amplitude, float) / np.asarray(reference, float))

@@ -1,0 +1,67 @@
+"""Shared base of the model nodes: take train_pass, validate, count rejections, diagnose.
+
+A malformed pass is rejected with its reason (rail_monitor.passes.rejection_reasons), counted
+per reason on /diagnostics, logged (throttled) and never reaches the model, so it leaves any
+state untouched.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from typing import Any
+
+from diagnostic_msgs.msg import DiagnosticStatus
+from rclpy.node import Node
+
+from rail_monitor.nodes.base import Diagnostics, RateMeter, declare_site
+from rail_monitor.nodes.convert import time_ns, train_pass_row
+from rail_monitor.nodes.qos import STREAM_SUB_QOS
+from rail_monitor.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.timeutil import format_iso_ns
+from rail_msgs.msg import TrainPass
+
+
+class PassModelNode(Node):
+    """Subscribes ``train_pass``; subclasses implement :meth:`on_pass` for accepted passes."""
+
+    def __init__(self, name: str, **kwargs: Any) -> None:
+        super().__init__(name, **kwargs)
+        self.site = declare_site(self)
+        self.taken = 0  # train_pass messages taken (the pass source's flow control reads it)
+        self.accepted = RateMeter()
+        self.rejected: Counter[str] = Counter()
+        self.last_pass_ns = 0
+        self.create_subscription(TrainPass, "train_pass", self._on_train_pass, STREAM_SUB_QOS)
+        Diagnostics(self, self.diagnostic_values, level=self._level)
+
+    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
+        """Handle one accepted pass: a one-row table with class defaults filled, and its message."""
+        raise NotImplementedError
+
+    def _on_train_pass(self, msg: TrainPass) -> None:
+        self.taken += 1
+        table = PassTable.from_rows([train_pass_row(msg)])
+        reason = rejection_reasons(table, self.site)[0]
+        if reason:
+            self.rejected[reason] += 1
+            self.get_logger().warning(f"pass {msg.train_id!r} rejected: {reason}", throttle_duration_sec=5.0)
+            return
+        self.accepted.tick()
+        self.last_pass_ns = time_ns(msg.header.stamp)
+        self.on_pass(with_class_defaults(table, self.site), msg)
+
+    def diagnostic_values(self) -> dict[str, Any]:
+        values: dict[str, Any] = {
+            "accepted": self.accepted.count,
+            "rejected": sum(self.rejected.values()),
+            "rate_per_s": f"{self.accepted.rate():.1f}",
+            "last_pass": format_iso_ns(self.last_pass_ns) if self.last_pass_ns else "",
+        }
+        values.update({f"rejected: {reason}": n for reason, n in sorted(self.rejected.items())})
+        return values
+
+    def _level(self) -> tuple[int, str]:
+        n = sum(self.rejected.values())
+        if n:
+            return DiagnosticStatus.WARN, f"{n} pass(es) rejected"
+        return DiagnosticStatus.OK, "ok"

@@ -1,0 +1,43 @@
+"""squeal_risk_model: predicted wheel squeal for every accepted train pass.
+
+Subscribes ``train_pass``; publishes ``noise/squeal`` (rail_msgs/SquealPrediction). Parameters:
+the site and its rolling-stock table, and ``squeal.*`` (rail_monitor.squeal_risk.SQUEAL_SPECS:
+wheel mode, contact geometry, creep curves per friction state, receiver, risk thresholds).
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import Any
+
+from rail_monitor.nodes.base import declare, run_node
+from rail_monitor.nodes.convert import squeal_prediction_msg
+from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.qos import STREAM_QOS
+from rail_monitor.passes import PassTable
+from rail_monitor.squeal_risk import SQUEAL_SPECS, predict, squeal_config
+from rail_msgs.msg import SquealPrediction, TrainPass
+
+
+class SquealRiskModel(PassModelNode):
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("squeal_risk_model", **kwargs)
+        values = declare(self, SQUEAL_SPECS, prefix="squeal.")
+        self.cfg = squeal_config({f"squeal.{k}": v for k, v in values.items()})
+        self.published = 0
+        self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
+
+    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
+        self.pub.publish(squeal_prediction_msg(predict(self.cfg, self.site, table), 0, msg))
+        self.published += 1
+
+    def diagnostic_values(self) -> dict[str, Any]:
+        return {**super().diagnostic_values(), "published": self.published}
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_node(SquealRiskModel, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

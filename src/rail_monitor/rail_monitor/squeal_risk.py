@@ -1,0 +1,174 @@
+"""Squeal risk at a site: the site's squeal parameters and the prediction for each train pass.
+
+Glue between the pass table and :mod:`rail_monitor.models.squeal`, shared by the
+``squeal_risk_model`` node, batch mode and ``rail-monitor predict squeal``. Per pass:
+V0 = speed, Vc = V0 sin(angle of attack), W = the pass's wheel load (or its class's nominal
+load); the contact is the class's wheel (rolling radius = diameter / 2, transverse radius
+``wheel_transverse_radius_m``) on a straight rail of head radius ``rail_head_radius_m``; the creep
+curve is the friction state's. One dominant wheel mode per site (modal mass, damping,
+stiffness at the contact, lateral).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.errors import ConfigError
+from rail_monitor.models import hertz, kalker, squeal
+from rail_monitor.params import ParamSpec, resolve
+from rail_monitor.passes import FRICTION_MODIFIER, FRICTION_NAMES, PassTable
+from rail_monitor.site import Site
+
+# SquealPrediction.RISK_* values.
+RISK_NONE, RISK_LOW, RISK_MEDIUM, RISK_HIGH = range(4)
+
+# Creep curves per friction state (k1 = friction peak, k2 = sliding slope per unit xi').
+# Dry: the seed's rig values (k1 = 0.27, k2 = -0.02, section 3.3) rounded to a rail steel
+# peak of 0.3; wet: lower peak, milder fall; friction modifier: mu about 0.35 with a positive
+# slope (seed section 2.1, ref. [12]); contaminated (leaf film): low adhesion. Site-tunable.
+CREEP_DEFAULTS: dict[str, tuple[float, float]] = {
+    "dry": (0.30, -0.02),
+    "wet": (0.20, -0.008),
+    "friction_modifier": (0.35, 0.01),
+    "contaminated": (0.10, -0.01),
+}
+
+SQUEAL_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("modal_mass_kg", 40.0, "Modal mass of the squealing wheel mode at the contact, lateral [kg].",
+              0.01, 1.0e4),
+    ParamSpec("modal_damping_nspm", 60.0, "Modal damping c of the mode [N s/m] (60: damping ratio 1e-4, an "
+              "undamped wheel).", 0.0, 1.0e6),
+    ParamSpec("modal_stiffness_npm", 2.27e9, "Modal stiffness k of the mode [N/m] (with 40 kg: 1.2 kHz).",
+              1.0, 1.0e13),
+    ParamSpec("young_modulus_pa", 210.0e9, "Young's modulus of wheel and rail steel [Pa].", 1.0e9, 1.0e12),
+    ParamSpec("poisson_ratio", 0.28, "Poisson's ratio of wheel and rail steel [-].", 0.0, 0.5),
+    ParamSpec("rail_head_radius_m", 0.3, "Transverse radius of the rail head at the contact [m].", 0.01, 100.0),
+    ParamSpec("wheel_transverse_radius_m", 1.0e6, "Transverse radius of the wheel tread at the contact [m] "
+              "(1e6: a conical tread).", 0.05, 1.0e9),
+    ParamSpec("k3_convention", "kalker_unit", "How k3 follows from Kalker's C22 (models.squeal."
+              "lateral_creep_stiffness).", choices=squeal.K3_CONVENTIONS),
+    ParamSpec("k3_n", 0.0, "Lateral creep stiffness k3 given directly [N]; 0: from contact mechanics.", 0.0, 1.0e12),
+    *(
+        spec
+        for state, (k1, k2) in CREEP_DEFAULTS.items()
+        for spec in (
+            ParamSpec(f"creep.{state}.k1", k1, f"Friction peak k1 of the {state} creep curve [-].", 0.01, 1.5),
+            ParamSpec(f"creep.{state}.k2", k2, f"Sliding-branch slope k2 of the {state} creep curve, per unit "
+                      "normalised creepage [-] (< 0 falling).", -0.5, 0.5),
+        )
+    ),
+    ParamSpec("receiver_distance_m", 7.5, "Distance from the wheel to the receiver [m].", 0.05, 1000.0),
+    ParamSpec("radiating_area_m2", 0.9, "Radiating area of the wheel (both sides) [m2].", 0.001, 10.0),
+    ParamSpec("radiation_efficiency", 1.0, "Radiation efficiency of the squealing mode [-].", 0.0, 2.0),
+    ParamSpec("spatial_average", 0.5, "Surface-averaged over contact-point squared velocity [-].", 0.0, 1.0),
+    ParamSpec("reference_amplitude_mps", 1.0, "A w_ref of the relative level 20 lg(A w / A w_ref) [m/s].",
+              1.0e-6, 100.0),
+    ParamSpec("background_level_dba", 80.0, "Other noise of a pass at the receiver (rolling noise), against "
+              "which a friction modifier's benefit is judged [dB(A)].", 0.0, 200.0),
+    ParamSpec("risk_medium_dba", 85.0, "Squeal level from which the risk is medium [dB(A)].", 0.0, 200.0),
+    ParamSpec("risk_high_dba", 95.0, "Squeal level from which the risk is high [dB(A)].", 0.0, 200.0),
+)
+
+
+@dataclass(frozen=True)
+class SquealConfig:
+    """The site's squeal parameters (names and units as in SQUEAL_SPECS)."""
+
+    values: Mapping[str, Any]
+
+    def __getitem__(self, key: str) -> Any:
+        return self.values[key]
+
+    def creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """k1, k2 [-] per pass for TrainPass.FRICTION_* values."""
+        k1 = np.full(friction_state.shape, np.nan)
+        k2 = np.full(friction_state.shape, np.nan)
+        for code, name in FRICTION_NAMES.items():
+            sel = friction_state == code
+            k1[sel], k2[sel] = self[f"creep.{name}.k1"], self[f"creep.{name}.k2"]
+        return k1, k2
+
+
+def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealConfig:
+    """Checked squeal parameters from flat parameter values (keys under prefix)."""
+    sub = {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
+    unknown = sorted(set(sub) - {s.name for s in SQUEAL_SPECS})
+    if unknown:
+        raise ConfigError(f"unknown squeal parameter(s): {', '.join(prefix + u for u in unknown)}")
+    values = resolve(SQUEAL_SPECS, sub, where=prefix)
+    if values["risk_high_dba"] < values["risk_medium_dba"]:
+        raise ConfigError(f"parameter '{prefix}risk_high_dba' must not be below '{prefix}risk_medium_dba'")
+    return SquealConfig(values)
+
+
+def _levels(cfg: SquealConfig, amplitude: np.ndarray, frequency: np.ndarray) -> squeal.RadiatedLevel:
+    return squeal.radiated_level(
+        amplitude, frequency, radiating_area=cfg["radiating_area_m2"],
+        radiation_efficiency=cfg["radiation_efficiency"], spatial_average=cfg["spatial_average"],
+        distance=cfg["receiver_distance_m"])
+
+
+def _with_background(level_dba: np.ndarray, background_dba: float) -> np.ndarray:
+    """Energy sum of a squeal level (-inf: none) and the background [dB(A)]."""
+    return 10.0 * np.log10(10.0 ** (level_dba / 10.0) + 10.0 ** (background_dba / 10.0))
+
+
+def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.ndarray]:
+    """SquealPrediction fields per pass (arrays, units as in the message), vectorised.
+
+    ``passes`` must be valid for the site with class defaults filled
+    (:func:`rail_monitor.passes.with_class_defaults`).
+    """
+    v0 = passes.speed_mps
+    vc = v0 * np.sin(np.abs(passes.angle_of_attack_rad))
+    load = passes.wheel_load_n
+    k1, k2 = cfg.creep(passes.friction_state)
+    k3 = _k3(cfg, site, passes, k1)
+    mass, damping, stiffness = cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"]
+    lc = squeal.limit_cycle_amplitude(v0, vc, load, damping, k1, k2, k3)
+    freq = np.broadcast_to(squeal.squeal_frequency(mass, stiffness), v0.shape)
+    lev = _levels(cfg, lc.amplitude, freq)
+
+    # The same passes with the friction-modifier curve: the benefit against the background.
+    fm_k1, fm_k2 = cfg.creep(np.full_like(passes.friction_state, FRICTION_MODIFIER))
+    fm = squeal.limit_cycle_amplitude(v0, vc, load, damping, fm_k1, fm_k2, _k3(cfg, site, passes, fm_k1))
+    fm_lev = _levels(cfg, fm.amplitude, freq)
+    bg = cfg["background_level_dba"]
+    benefit = _with_background(lev.level_dba, bg) - _with_background(fm_lev.level_dba, bg)
+
+    risk = np.where(~lc.unstable, RISK_NONE,
+                    np.where(lev.level_dba >= cfg["risk_high_dba"], RISK_HIGH,
+                             np.where(lev.level_dba >= cfg["risk_medium_dba"], RISK_MEDIUM, RISK_LOW)))
+    return {
+        "friction_state": passes.friction_state,
+        "speed_mps": v0,
+        "crabbing_velocity_mps": vc,
+        "critical_slip_velocity_mps": lc.critical_slip,
+        "effective_damping_nspm": lc.effective_damping,
+        "unstable": lc.unstable,
+        "regime": lc.regime,
+        "velocity_amplitude_mps": lc.amplitude,
+        "frequency_hz": freq,
+        "level_db": lev.level_db,
+        "level_dba": lev.level_dba,
+        "relative_level_db": squeal.relative_level(lc.amplitude, cfg["reference_amplitude_mps"]),
+        "friction_modifier_benefit_db": benefit,
+        "risk": risk.astype(np.int8),
+    }
+
+
+def _k3(cfg: SquealConfig, site: Site, passes: PassTable, mu0: np.ndarray) -> np.ndarray:
+    """k3 [N] per pass: given directly, or from the Hertz contact of the class's wheel and the rail."""
+    if cfg["k3_n"] > 0.0:
+        return np.full(len(passes), cfg["k3_n"])
+    wheel_radius = np.array([site.vehicle(c).wheel_diameter_m / 2.0 for c in passes.vehicle_class])
+    e, nu = cfg["young_modulus_pa"], cfg["poisson_ratio"]
+    contact = hertz.contact_ellipse(wheel_radius, cfg["wheel_transverse_radius_m"], np.inf, cfg["rail_head_radius_m"],
+                                    hertz.contact_modulus(e, nu), passes.wheel_load_n)
+    c22 = kalker.creep_coefficients(contact.a / contact.b, nu).c22
+    return squeal.lateral_creep_stiffness(squeal.shear_modulus(e, nu), contact.a, contact.b, c22, mu0,
+                                          cfg["k3_convention"])
