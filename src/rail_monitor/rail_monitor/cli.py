@@ -1,4 +1,4 @@
-"""rail-monitor: command-line front end (simulate, replay, record, monitor, demo, info).
+"""rail-monitor: command-line front end (simulate, replay, record, monitor, demo, info, predict).
 
 Node options are generated from the same ParamSpecs the nodes declare, so --help shows every
 unit, range and default; they become ``-p name:=value`` ROS arguments. Errors the user can act
@@ -166,6 +166,64 @@ def cmd_demo(ns: argparse.Namespace) -> int:
     return _monitor(ns, str(ns.source), ns.output)
 
 
+def cmd_predict_squeal(ns: argparse.Namespace) -> int:
+    import dataclasses
+    import json
+
+    from rail_monitor import squeal_risk
+    from rail_monitor.models.squeal import REGIME_NAMES
+    from rail_monitor.passes import FRICTION_BY_NAME
+    from rail_monitor.site import load_parameter_file, site_from_values
+
+    if ns.rig and ns.load:
+        raise RailMonitorError("--load does not apply to --rig: the rig's k3 is for its 1000 N (Figure 5)")
+    if ns.rig:
+        case = squeal_risk.rig_case(ns.k3_convention or "kalker_unit")
+        where = "seed rig (Figure 5)"
+    else:
+        values = load_parameter_file(_site_file(ns.site))
+        if ns.k3_convention:
+            values["squeal.k3_convention"] = ns.k3_convention
+        site = site_from_values(values)
+        cls = ns.vehicle_class or next(iter(site.vehicles))
+        speed = ns.speed or site.vehicle(cls).speed_mean_mps
+        case = squeal_risk.site_case(squeal_risk.squeal_config(values), site, cls, FRICTION_BY_NAME[ns.friction],
+                                     speed, ns.load or 0.0)
+        where = f"site {site.site_id}, class {cls}, {ns.friction}"
+    overrides = {k: getattr(ns, k) for k in ("speed_mps", "load_n", "mass_kg", "damping_nspm", "stiffness_npm",
+                                             "k1", "k2", "k3_n") if getattr(ns, k, None) is not None}
+    if ns.rig and ns.speed:
+        overrides["speed_mps"] = ns.speed
+    case = dataclasses.replace(case, **overrides)
+    if ns.sweep:
+        start, stop, count = ns.sweep
+        vc = np.linspace(start, stop, int(count))
+    elif ns.crabbing is not None:
+        vc = np.array([ns.crabbing])
+    else:
+        vc = np.array([case.speed_mps * np.sin(1e-3 * (ns.aoa_mrad if ns.aoa_mrad is not None else 10.0))])
+    rows = squeal_risk.sweep(case, vc, reference_mps=ns.reference, ode=ns.ode)
+    if ns.json:
+        print(json.dumps({"case": dataclasses.asdict(case), "where": where,
+                          "rows": [{k: (v[i].item() if np.isfinite(v[i]) else None) for k, v in rows.items()}
+                                   for i in range(len(vc))]}, indent=1))
+    else:
+        print(f"# {where}: V0 {case.speed_mps:g} m/s, W {case.load_n:g} N, m {case.mass_kg:g} kg, "
+              f"c {case.damping_nspm:g} N s/m, k {case.stiffness_npm:g} N/m, k1 {case.k1:g}, k2 {case.k2:g}, "
+              f"k3 {case.k3_n:.4g} N, u_s {rows['critical_slip_velocity_mps'][0]:.4g} m/s")
+        head = f"{'Vc [m/s]':>9} {'AoA [mrad]':>10} {'A w [m/s]':>10} {'rel [dB]':>9} {'regime':<16}"
+        print(head + (f" {'ODE A w':>9}" if ns.ode else ""))
+        for i in range(len(vc)):
+            line = (f"{vc[i]:9.4f} {rows['angle_of_attack_mrad'][i]:10.2f} {rows['velocity_amplitude_mps'][i]:10.4f} "
+                    f"{rows['relative_level_db'][i]:9.2f} {REGIME_NAMES[int(rows['regime'][i])]:<16}")
+            print(line + (f" {rows['ode_amplitude_mps'][i]:9.4f}" if ns.ode else ""))
+    if ns.plot:
+        from rail_monitor.plots import squeal_sweep
+
+        print(f"plot: {squeal_sweep(rows, ns.plot, title=where)}", file=sys.stderr)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from rail_monitor.nodes.mcap_recorder import RECORDER_SPECS
     from rail_monitor.nodes.pass_replayer import REPLAYER_SPECS
@@ -202,6 +260,32 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--namespace", help="site namespace (relative topic names resolve under it)")
     _add_specs(s, RECORDER_SPECS, skip=("output",))
     s.set_defaults(func=cmd_record)
+
+    s = sub.add_parser("predict", help="run one model on physical inputs")
+    models = s.add_subparsers(dest="model", required=True)
+    q = models.add_parser("squeal", help="squeal amplitude and level for a crabbing velocity, or a sweep",
+                          formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    q.add_argument("--rig", action="store_true", help="the seed's two-disc rig (Figure 5) instead of a site")
+    q.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    q.add_argument("--vehicle-class", help="vehicle class of the site (default: its first)")
+    q.add_argument("--friction", default="dry", choices=("dry", "wet", "friction_modifier", "contaminated"))
+    q.add_argument("--speed", type=float, help="rolling speed V0 [m/s] (default: the class's mean)")
+    q.add_argument("--load", type=float, help="wheel load W [N] (default: the class's nominal)")
+    g = q.add_mutually_exclusive_group()
+    g.add_argument("--aoa-mrad", type=float, help="angle of attack [mrad] (default 10)")
+    g.add_argument("--crabbing", type=float, help="crabbing velocity Vc [m/s]")
+    g.add_argument("--sweep", type=float, nargs=3, metavar=("VC_START", "VC_STOP", "N"),
+                   help="sweep the crabbing velocity [m/s]")
+    q.add_argument("--k3-convention", choices=("kalker_unit", "kalker_peak", "saturation_3x"))
+    for flag, dest, unit in (("--mass", "mass_kg", "kg"), ("--damping", "damping_nspm", "N s/m"),
+                             ("--stiffness", "stiffness_npm", "N/m"), ("--k1", "k1", "-"), ("--k2", "k2", "-"),
+                             ("--k3", "k3_n", "N")):
+        q.add_argument(flag, dest=dest, type=float, help=f"override [{unit}]")
+    q.add_argument("--reference", type=float, help="A w_ref of the relative level [m/s] (default: the largest A w)")
+    q.add_argument("--ode", action="store_true", help="also integrate the ODE for every row (about 1 s each)")
+    q.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    q.add_argument("--plot", help="save amplitude and relative level against Vc to this PNG")
+    q.set_defaults(func=cmd_predict_squeal)
 
     for name, helptext in (("monitor", "run the whole graph in one process on a history"),
                            ("demo", "the main job: the bundled sample history through the whole graph")):

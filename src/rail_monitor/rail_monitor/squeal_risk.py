@@ -172,3 +172,76 @@ def _k3(cfg: SquealConfig, site: Site, passes: PassTable, mu0: np.ndarray) -> np
     c22 = kalker.creep_coefficients(contact.a / contact.b, nu).c22
     return squeal.lateral_creep_stiffness(squeal.shear_modulus(e, nu), contact.a, contact.b, c22, mu0,
                                           cfg["k3_convention"])
+
+
+@dataclass(frozen=True)
+class SquealCase:
+    """Physical inputs of one squeal calculation (SI units, as in models.squeal)."""
+
+    speed_mps: float
+    load_n: float
+    mass_kg: float
+    damping_nspm: float
+    stiffness_npm: float
+    k1: float
+    k2: float
+    k3_n: float
+
+
+# Seed Figure 5 (two-disc rig): radii of the lower wheel (rolling, transverse) and the upper
+# wheel [m], E [Pa], nu, W [N], m [kg], c [N s/m], k [N/m]; V0 = 17.8 m/s (800 rpm) and the
+# creep curve k1 = 0.27, k2 = -0.02 of section 3.3.
+RIG_RADII_M = (0.213, 0.300, 0.085, 0.040)
+RIG = {"young_modulus_pa": 175e9, "poisson_ratio": 0.28, "load_n": 1000.0, "mass_kg": 3.1, "damping_nspm": 42.0,
+       "stiffness_npm": 1.6e8, "speed_mps": 17.8, "k1": 0.27, "k2": -0.02}
+
+
+def rig_case(convention: str = "kalker_unit") -> SquealCase:
+    """The seed's rig (Figure 5) with k3 from its Hertz contact and Kalker's C22 (convention)."""
+    e, nu = RIG["young_modulus_pa"], RIG["poisson_ratio"]
+    c = hertz.contact_ellipse(*RIG_RADII_M, hertz.contact_modulus(e, nu), RIG["load_n"])
+    c22 = kalker.creep_coefficients(c.a / c.b, nu).c22
+    k3 = float(squeal.lateral_creep_stiffness(squeal.shear_modulus(e, nu), c.a, c.b, c22, RIG["k1"], convention))
+    return SquealCase(RIG["speed_mps"], RIG["load_n"], RIG["mass_kg"], RIG["damping_nspm"], RIG["stiffness_npm"],
+                      RIG["k1"], RIG["k2"], k3)
+
+
+def site_case(cfg: SquealConfig, site: Site, vehicle_class: str, friction_state: int, speed_mps: float,
+              load_n: float = 0.0) -> SquealCase:
+    """The site's wheel mode, contact and creep curve for one vehicle class and friction state."""
+    vehicle = site.vehicle(vehicle_class)
+    load = load_n or vehicle.wheel_load_n
+    k1, k2 = (float(x[0]) for x in cfg.creep(np.array([friction_state])))
+    one = PassTable.from_rows([{
+        "stamp_ns": 1, "train_id": "case", "vehicle_class": vehicle_class, "vehicle_count": 1,
+        "axle_count": vehicle.axles_per_vehicle, "speed_mps": speed_mps, "angle_of_attack_rad": 0.0,
+        "wheel_load_n": load, "friction_state": friction_state, "train_length_m": vehicle.vehicle_length_m}])
+    k3 = float(_k3(cfg, site, one, np.array([k1]))[0])
+    return SquealCase(speed_mps, load, cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"],
+                      k1, k2, k3)
+
+
+def sweep(case: SquealCase, crabbing_mps: np.ndarray, reference_mps: float | None = None,
+          ode: bool = False) -> dict[str, np.ndarray]:
+    """Amplitude, regime and relative level over crabbing velocities [m/s] for one case.
+
+    The relative level is 20 lg(A w / A w_ref), A w_ref = reference_mps or the largest
+    amplitude of the sweep. With ``ode``, each row also gets the time-domain amplitude.
+    """
+    vc = np.asarray(crabbing_mps, float)
+    lc = squeal.limit_cycle_amplitude(case.speed_mps, vc, case.load_n, case.damping_nspm, case.k1, case.k2, case.k3_n)
+    ref = reference_mps or (float(np.max(lc.amplitude)) if np.any(lc.amplitude > 0) else 1.0)
+    out = {
+        "crabbing_velocity_mps": vc,
+        "angle_of_attack_mrad": 1e3 * np.arcsin(np.clip(vc / case.speed_mps, -1.0, 1.0)),
+        "velocity_amplitude_mps": lc.amplitude,
+        "regime": lc.regime,
+        "relative_level_db": squeal.relative_level(lc.amplitude, ref),
+        "critical_slip_velocity_mps": np.broadcast_to(lc.critical_slip, vc.shape),
+        "effective_damping_nspm": np.broadcast_to(lc.effective_damping, vc.shape),
+    }
+    if ode:
+        out["ode_amplitude_mps"] = np.array([
+            squeal.simulate_limit_cycle(case.speed_mps, float(v), case.load_n, case.mass_kg, case.damping_nspm,
+                                        case.stiffness_npm, case.k1, case.k2, case.k3_n).amplitude for v in vc])
+    return out
