@@ -147,6 +147,19 @@ def test_spl_trend_follows_20_lg_amplitude():
 
 # --- the general solver --------------------------------------------------------------------
 
+
+def test_phase_solves_the_energy_balance_equation():
+    # The returned half adhesion angle satisfies sin 2phi - 2phi = 2 pi (c + s2) / (s1 - s2)
+    # (module docstring) to round-off, from just past the onset to the edge of existence.
+    k3, v0, w = rig_k3(), RIG["v0"], RIG["load"]
+    k2 = -np.geomspace(1e-4, 0.25, 400)
+    lc = squeal.limit_cycle_amplitude(v0, 0.3, w, 0.0, RIG["k1"], k2, k3)
+    ok = ~np.isnan(lc.phi)
+    assert ok.sum() > 300
+    s1, s2 = RIG["k1"] * k3 / v0, k2 * k3 / v0
+    rhs = 2 * np.pi * s2 / (s1 - s2)
+    np.testing.assert_allclose(np.sin(2 * lc.phi[ok]) - 2 * lc.phi[ok], rhs[ok], rtol=1e-9, atol=1e-15)
+
 # A 2^(4-1) fractional factorial over speed, Vc / u_s, damping and falling slope, on the rig's
 # wheel mode and k3; every case keeps mu > 0 over its cycle and no reverse slip.
 GRID = [

@@ -127,7 +127,8 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     vc = v0 * np.sin(np.abs(passes.angle_of_attack_rad))
     load = passes.wheel_load_n
     k1, k2 = cfg.creep(passes.friction_state)
-    k3 = _k3(cfg, site, passes, k1)
+    kalker_force = _kalker_lateral_force(cfg, site, passes)
+    k3 = _k3(cfg, kalker_force, k1)
     mass, damping, stiffness = cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"]
     lc = squeal.limit_cycle_amplitude(v0, vc, load, damping, k1, k2, k3)
     freq = np.broadcast_to(squeal.squeal_frequency(mass, stiffness), v0.shape)
@@ -135,7 +136,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
 
     # The same passes with the friction-modifier curve: the benefit against the background.
     fm_k1, fm_k2 = cfg.creep(np.full_like(passes.friction_state, FRICTION_MODIFIER))
-    fm = squeal.limit_cycle_amplitude(v0, vc, load, damping, fm_k1, fm_k2, _k3(cfg, site, passes, fm_k1))
+    fm = squeal.limit_cycle_amplitude(v0, vc, load, damping, fm_k1, fm_k2, _k3(cfg, kalker_force, fm_k1))
     fm_lev = _levels(cfg, fm.amplitude, freq)
     bg = cfg["background_level_dba"]
     benefit = _with_background(lev.level_dba, bg) - _with_background(fm_lev.level_dba, bg)
@@ -161,17 +162,23 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     }
 
 
-def _k3(cfg: SquealConfig, site: Site, passes: PassTable, mu0: np.ndarray) -> np.ndarray:
-    """k3 [N] per pass: given directly, or from the Hertz contact of the class's wheel and the rail."""
+def _kalker_lateral_force(cfg: SquealConfig, site: Site, passes: PassTable) -> np.ndarray | None:
+    """G a b C22 [N] per pass from the Hertz contact of the class's wheel and the rail (None if k3 is given)."""
     if cfg["k3_n"] > 0.0:
-        return np.full(len(passes), cfg["k3_n"])
+        return None
     wheel_radius = np.array([site.vehicle(c).wheel_diameter_m / 2.0 for c in passes.vehicle_class])
     e, nu = cfg["young_modulus_pa"], cfg["poisson_ratio"]
     contact = hertz.contact_ellipse(wheel_radius, cfg["wheel_transverse_radius_m"], np.inf, cfg["rail_head_radius_m"],
                                     hertz.contact_modulus(e, nu), passes.wheel_load_n)
     c22 = kalker.creep_coefficients(contact.a / contact.b, nu).c22
-    return squeal.lateral_creep_stiffness(squeal.shear_modulus(e, nu), contact.a, contact.b, c22, mu0,
-                                          cfg["k3_convention"])
+    return squeal.shear_modulus(e, nu) * contact.a * contact.b * c22
+
+
+def _k3(cfg: SquealConfig, kalker_force: np.ndarray | None, mu0: np.ndarray) -> np.ndarray:
+    """k3 [N] per pass: given directly, or from G a b C22 under the configured convention."""
+    if kalker_force is None:
+        return np.full(mu0.shape, cfg["k3_n"])
+    return squeal.lateral_creep_stiffness(1.0, kalker_force, 1.0, 1.0, mu0, cfg["k3_convention"])
 
 
 @dataclass(frozen=True)
@@ -216,7 +223,7 @@ def site_case(cfg: SquealConfig, site: Site, vehicle_class: str, friction_state:
         "stamp_ns": 1, "train_id": "case", "vehicle_class": vehicle_class, "vehicle_count": 1,
         "axle_count": vehicle.axles_per_vehicle, "speed_mps": speed_mps, "angle_of_attack_rad": 0.0,
         "wheel_load_n": load, "friction_state": friction_state, "train_length_m": vehicle.vehicle_length_m}])
-    k3 = float(_k3(cfg, site, one, np.array([k1]))[0])
+    k3 = float(_k3(cfg, _kalker_lateral_force(cfg, site, one), np.array([k1]))[0])
     return SquealCase(speed_mps, load, cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"],
                       k1, k2, k3)
 

@@ -22,6 +22,7 @@ every length as P^(1/3).
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -70,6 +71,7 @@ def _ratio_for_axis_ratio(k: float) -> float:
     return (ee / p - kk) / (kk - ee)
 
 
+@lru_cache(maxsize=4096)  # a site has a handful of geometries; the live graph asks once per pass
 def _axis_ratio(curvature_ratio: float) -> float:
     """Minor/major axis ratio k of the contact ellipse for a curvature ratio B_1/A_1 >= 1."""
     if curvature_ratio <= 1.0 + 1e-12:
@@ -121,7 +123,7 @@ def contact_ellipse(
     c_major_axis = np.minimum(curv_x, curv_y)  # the longer semi-axis lies along the smaller curvature
     ratio = np.maximum(curv_x, curv_y) / c_major_axis
     uniq, inverse = np.unique(np.round(ratio, 12), return_inverse=True)
-    k = np.array([_axis_ratio(r) for r in uniq])[inverse].reshape(ratio.shape)
+    k = np.array([_axis_ratio(float(r)) for r in uniq])[inverse].reshape(ratio.shape)
 
     major = np.cbrt(3.0 * load * _k_minus_e_over_m(k) / (2.0 * np.pi * e_star * c_major_axis))
     minor = k * major

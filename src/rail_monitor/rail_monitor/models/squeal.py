@@ -142,15 +142,18 @@ class LimitCycle(NamedTuple):
 
 
 def _solve_x_minus_sin(q: FloatArray) -> FloatArray:
-    """x in [0, pi] with x - sin x = q for 0 <= q <= pi (vectorised bisection, then Newton)."""
-    lo, hi = np.zeros_like(q), np.full_like(q, np.pi)
-    for _ in range(60):  # 2^-60 pi: far below any physical tolerance
-        mid = 0.5 * (lo + hi)
-        low_side = mid - np.sin(mid) < q
-        lo, hi = np.where(low_side, mid, lo), np.where(low_side, hi, mid)
-    x = 0.5 * (lo + hi)
-    slope = 1.0 - np.cos(x)
-    return np.where(slope > 1e-12, x - (x - np.sin(x) - q) / np.where(slope > 1e-12, slope, 1.0), x)
+    """x in [0, pi] with x - sin x = q for 0 <= q <= pi (vectorised Newton).
+
+    Starts from the small-x inverse x = (6 q)^(1/3), exact as q -> 0 and within 16 % at q = pi.
+    x - sin x is increasing and convex on [0, pi], so after the first step the iterates approach
+    the root monotonically from above; eight steps reach machine precision.
+    """
+    x = np.minimum(np.cbrt(6.0 * q), np.pi)
+    for _ in range(8):
+        slope = 1.0 - np.cos(x)
+        step = np.where(slope > 1e-300, (x - np.sin(x) - q) / np.where(slope > 1e-300, slope, 1.0), 0.0)
+        x = np.clip(x - step, 0.0, np.pi)
+    return x
 
 
 def limit_cycle_amplitude(

@@ -1,0 +1,79 @@
+"""Squeal benchmark: closed form against time integration, vectorised throughput.
+
+Run: ros2_ws/run python bench/squeal.py [--ode-cases N]
+Prints figures measured in this run only (compare ratios, not absolute times, across machines).
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import time
+
+import numpy as np
+
+from rail_monitor import squeal_risk
+from rail_monitor.models import squeal
+from rail_monitor.passes import PassTable, with_class_defaults
+from rail_monitor.site import load_parameter_file, site_from_values
+
+
+def best_of(fn, repeat: int = 5) -> float:
+    """Shortest wall time of repeat calls [s] (the least disturbed by other load)."""
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--ode-cases", type=int, default=5, help="crabbing velocities integrated in time")
+    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
+    ns = ap.parse_args()
+    case = squeal_risk.rig_case()
+    args = (case.speed_mps, case.load_n, case.damping_nspm, case.k1, case.k2, case.k3_n)
+    vcs = np.linspace(0.2, 0.5, ns.ode_cases)
+
+    print(f"# squeal benchmark, {platform.node()}, {platform.processor() or platform.machine()}, "
+          f"numpy {np.__version__}")
+    one = best_of(lambda: squeal.limit_cycle_amplitude(args[0], 0.39, *args[1:]), 50)
+    ode_times, errs = [], []
+    for vc in vcs:
+        t = time.perf_counter()
+        r = squeal.simulate_limit_cycle(case.speed_mps, float(vc), case.load_n, case.mass_kg, case.damping_nspm,
+                                        case.stiffness_npm, case.k1, case.k2, case.k3_n)
+        ode_times.append(time.perf_counter() - t)
+        cf = float(squeal.limit_cycle_amplitude(args[0], vc, *args[1:]).amplitude)
+        errs.append(abs(r.amplitude / cf - 1))
+    ode = float(np.median(ode_times))
+    print(f"closed form, one case:          {one * 1e6:10.1f} us")
+    print(f"time integration, one case:     {ode * 1e3:10.1f} ms  (median of {len(vcs)}, DOP853 to a settled cycle)")
+    print(f"ratio ODE / closed form:        {ode / one:10.0f} x")
+    print(f"largest |ODE / closed - 1|:     {max(errs):10.2e}")
+    for n in (10**4, 10**5, 10**6):
+        vc = np.random.default_rng(1).uniform(0.0, 0.6, n)
+        t = best_of(lambda vc=vc: squeal.limit_cycle_amplitude(args[0], vc, *args[1:]), 3)
+        print(f"closed form, {n:>9,} cases:    {n / t:10.3g} cases/s")
+
+    values = load_parameter_file(ns.site)
+    site, cfg = site_from_values(values), squeal_risk.squeal_config(values)
+    n = 10**5
+    rng = np.random.default_rng(2)
+    table = with_class_defaults(PassTable(
+        stamp_ns=np.arange(1, n + 1), train_id=["T"] * n, vehicle_class=["emu"] * n, vehicle_count=[4] * n,
+        axle_count=[0] * n, speed_mps=rng.uniform(12, 22, n), angle_of_attack_rad=rng.uniform(0, 0.02, n),
+        wheel_load_n=rng.uniform(55e3, 75e3, n), friction_state=rng.integers(1, 5, n), train_length_m=[0.0] * n),
+        site)
+    t = best_of(lambda: squeal_risk.predict(cfg, site, table), 3)
+    print(f"site prediction (contact, k3, limit cycle, levels, friction-modifier what-if), {n:,} passes: "
+          f"{n / t:.3g} passes/s")
+    one_pass = table.take(slice(0, 1))
+    t1 = best_of(lambda: squeal_risk.predict(cfg, site, one_pass), 50)
+    print(f"site prediction, one pass (the node's call):  {t1 * 1e6:.0f} us")
+
+
+if __name__ == "__main__":
+    main()
