@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import os
 import subprocess
+import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -67,3 +70,26 @@ def run_cmd(*args: str, timeout: float = 120.0, **kw) -> subprocess.CompletedPro
     env = {**os.environ, **kw.pop("env", {})}
     return subprocess.run(list(args), capture_output=True, text=True, timeout=timeout, env=env, cwd=TOP, **kw)
 
+
+
+@contextlib.contextmanager
+def spinning(ctx, *nodes) -> Iterator[object]:
+    """Spin nodes on a SingleThreadedExecutor in a background thread; shut it down on exit."""
+    from rclpy.executors import SingleThreadedExecutor
+
+    ex = SingleThreadedExecutor(context=ctx)
+    for node in nodes:
+        ex.add_node(node)
+    threading.Thread(target=ex.spin, daemon=True).start()
+    try:
+        yield ex
+    finally:
+        ex.shutdown(timeout_sec=2)
+
+
+def wait_until(condition, timeout_s: float = 10.0, period_s: float = 0.01) -> bool:
+    """Poll condition() until it is true or timeout_s passes; return its last value."""
+    deadline = time.monotonic() + timeout_s
+    while not condition() and time.monotonic() < deadline:
+        time.sleep(period_s)
+    return bool(condition())

@@ -3,13 +3,10 @@
 from __future__ import annotations
 
 import json
-import threading
-import time
 
 import numpy as np
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray
-from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
@@ -22,7 +19,7 @@ from rail_monitor.nodes.squeal_risk_model import SquealRiskModel
 from rail_monitor.passes import FRICTION_DRY, FRICTION_MODIFIER, PassTable, rejection_reasons, with_class_defaults
 from rail_msgs.msg import SquealPrediction, TrainPass
 
-from conftest import run_cmd
+from conftest import run_cmd, spinning, wait_until
 
 
 def _passes(site, aoa_mrad, friction=FRICTION_DRY, speed=19.0) -> PassTable:
@@ -93,28 +90,16 @@ def test_node_predicts_valid_passes_and_counts_rejections(ros_context, site, sit
     probe.create_subscription(SquealPrediction, "noise/squeal", got.append, STREAM_QOS)
     probe.create_subscription(DiagnosticArray, "/diagnostics", diags.append, 10)
     pub = probe.create_publisher(TrainPass, "train_pass", STREAM_QOS)
-    ex = SingleThreadedExecutor(context=ctx)
-    ex.add_node(model)
-    ex.add_node(probe)
-    spin = threading.Thread(target=ex.spin, daemon=True)
-    spin.start()
-    try:
-        deadline = time.monotonic() + 10
-        while pub.get_subscription_count() < 1 and time.monotonic() < deadline:
-            time.sleep(0.01)
+    with spinning(ctx, model, probe):
+        wait_until(lambda: pub.get_subscription_count() >= 1)
         good = _passes(site, [3, 8, 12, 16])
         bad = [dict(good.row(0), speed_mps=float("nan"), train_id="nan-speed"),
                dict(good.row(0), friction_state=9, train_id="bad-friction"),
                dict(good.row(0), vehicle_class="tram", train_id="unknown-class"),
                dict(good.row(0), angle_of_attack_rad=0.5, train_id="aoa")]
-        rows = [good.row(0), *bad, good.row(1), good.row(2), good.row(3)]
-        for r in rows:
+        for r in [good.row(0), *bad, good.row(1), good.row(2), good.row(3)]:
             pub.publish(train_pass_msg(r, "curve_250"))
-        deadline = time.monotonic() + 10
-        while (len(got) < 4 or not any(_rejected(d) == 4 for d in diags)) and time.monotonic() < deadline:
-            time.sleep(0.02)
-    finally:
-        ex.shutdown(timeout_sec=2)
+        wait_until(lambda: len(got) >= 4 and any(_rejected(d) == 4 for d in diags))
     assert [m.train_id for m in got] == ["T0", "T1", "T2", "T3"]
     assert model.taken == 8 and model.accepted.count == 4
     expected = squeal_risk.predict(squeal_risk.squeal_config(site_values), site, good)
