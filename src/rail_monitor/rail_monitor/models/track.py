@@ -1,0 +1,189 @@
+"""Vertical track receptance: rail as an Euler or Timoshenko beam on a two-layer support.
+
+The one track model of the project (corrugation growth and rolling noise both use it).
+Support per rail seat: rail pad k_p (1 + i eta_p), half-sleeper mass m_s, ballast
+k_b (1 + i eta_b), at spacing d. Its dynamic stiffness is
+
+    K(w) = k_p* (k_b* - m_s w^2) / (k_p* + k_b* - m_s w^2)                                  [N/m]
+
+*Continuous support* smears it to s = K / d per metre. Fourier-transforming the beam equations
+(Timoshenko: shear stiffness kappa G A, rotary inertia rho I) gives the displacement
+spectrum W(xi) / F = (EI xi^2 + g) / (a xi^4 + b xi^2 + c) with g = kappa G A - rho I w^2,
+a = EI kappa G A, b = (s - m' w^2) EI - kappa G A rho I w^2, c = (s - m' w^2) g. With the roots
+u1, u2 of a u^2 + b u + c = 0 and k_j = sqrt(u_j) in the upper half plane, residues give the
+transfer receptance at distance x
+
+    alpha(x) = (i / 2) sum_j A_j exp(i k_j |x|) / k_j,    A_j = (EI u_j + g) / (a (u_j - u_other))
+
+(Euler: EI xi^4 + s - m' w^2, A_j = +-1 / (EI (u1 - u2))). The static limit is the Winkler
+result 1 / alpha = 2 s / beta, beta = (s / 4EI)^(1/4) (Hetenyi 1946; Knothe & Grassie, Vehicle
+System Dynamics 22 (1993) 209-262, for the track models and their resonances).
+
+*Discrete supports* use the free rail's Green's function G(x) (s = 0) and the support forces
+-K w_n at x_n = n d, n = -N..N: (I + K G(x_m - x_n)) w = G(x_m - x_F) F, then
+w_F = G(0) F - sum_n G(x_F - x_n) K w_n. This resolves the pinned-pinned resonance (peak at
+mid-span, dip above a sleeper, near 1 kHz for UIC60 on 0.6 m bays).
+
+Loss factors enter as complex moduli: E (1 + i eta_r), G (1 + i eta_r). Time dependence
+exp(+i w t); a receptance is displacement over force in the force's direction (static > 0).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+ComplexArray = NDArray[np.complex128]
+
+BEAMS = ("timoshenko", "euler")
+
+
+@dataclass(frozen=True)
+class Track:
+    """Track parameters (SI). Defaults: UIC60 rail on a typical ballasted track (MODELS.md
+    section 2: E = 210 GPa, A = 7.69e-3 m2, I = 30.55e-6 m4, m' = 60.4 kg/m, kappa = 0.4,
+    eta_r = 0.02; pad 350 MN/m, eta 0.25; half sleeper 150 kg; ballast 50 MN/m, eta 1.0; d = 0.6 m).
+    """
+
+    young_modulus_pa: float = 210e9
+    poisson_ratio: float = 0.3
+    area_m2: float = 7.69e-3
+    second_moment_m4: float = 30.55e-6
+    mass_per_length_kgpm: float = 60.4
+    shear_coefficient: float = 0.4
+    rail_loss_factor: float = 0.02
+    pad_stiffness_npm: float = 350e6
+    pad_loss_factor: float = 0.25
+    sleeper_mass_kg: float = 150.0
+    ballast_stiffness_npm: float = 50e6
+    ballast_loss_factor: float = 1.0
+    sleeper_spacing_m: float = 0.6
+
+    def with_(self, **changes: float) -> Track:
+        return replace(self, **changes)
+
+    @property
+    def bending_stiffness(self) -> complex:
+        """E* I [N m2] with the rail's loss factor."""
+        return self.young_modulus_pa * (1 + 1j * self.rail_loss_factor) * self.second_moment_m4
+
+    @property
+    def shear_stiffness(self) -> complex:
+        """kappa G* A [N] with the rail's loss factor."""
+        g = self.young_modulus_pa / (2 * (1 + self.poisson_ratio))
+        return self.shear_coefficient * g * (1 + 1j * self.rail_loss_factor) * self.area_m2
+
+    @property
+    def rotary_inertia(self) -> float:
+        """rho I [kg m] (rho = m' / A)."""
+        return self.mass_per_length_kgpm / self.area_m2 * self.second_moment_m4
+
+
+def support_stiffness(frequency: ArrayLike, track: Track) -> ComplexArray:
+    """Dynamic stiffness K [N/m] of one rail seat (pad, half-sleeper mass, ballast) at frequency [Hz]."""
+    w2 = (2 * np.pi * np.asarray(frequency, float)) ** 2
+    kp = track.pad_stiffness_npm * (1 + 1j * track.pad_loss_factor)
+    kb = track.ballast_stiffness_npm * (1 + 1j * track.ballast_loss_factor)
+    lower = kb - track.sleeper_mass_kg * w2
+    return kp * lower / (kp + lower)
+
+
+def _poles(w: NDArray[np.float64], s: ComplexArray, track: Track, beam: str) -> tuple[ComplexArray, ...]:
+    """Upper-half-plane wavenumbers k1, k2 [1/m] and residue weights A1, A2 of the beam on support s [N/m2]."""
+    ei, mass = track.bending_stiffness, track.mass_per_length_kgpm
+    dyn = s - mass * w**2
+    if beam == "euler":
+        root = np.sqrt(-dyn / ei + 0j)
+        u1, u2 = root, -root
+        a1 = 1.0 / (ei * (u1 - u2))
+        a2 = -a1
+    elif beam == "timoshenko":
+        kga, rho_i = track.shear_stiffness, track.rotary_inertia
+        g = kga - rho_i * w**2
+        a = ei * kga
+        b = dyn * ei - kga * rho_i * w**2
+        c = dyn * g
+        disc = np.sqrt(b * b - 4 * a * c + 0j)
+        u1, u2 = (-b + disc) / (2 * a), (-b - disc) / (2 * a)
+        a1 = (ei * u1 + g) / (a * (u1 - u2))
+        a2 = (ei * u2 + g) / (a * (u2 - u1))
+    else:
+        raise ValueError(f"unknown beam {beam!r}; use one of {BEAMS}")
+    k1, k2 = np.sqrt(u1 + 0j), np.sqrt(u2 + 0j)
+    k1 = np.where(k1.imag < 0, -k1, k1)  # the pole closing the upper half plane decays along +x
+    k2 = np.where(k2.imag < 0, -k2, k2)
+    return k1, k2, a1, a2
+
+
+def _green(x: ArrayLike, poles: tuple[ComplexArray, ...]) -> ComplexArray:
+    """Transfer receptance alpha(x) [m/N] of an infinite beam from its poles (broadcast x against them)."""
+    k1, k2, a1, a2 = poles
+    ax = np.abs(np.asarray(x, float))
+    return 0.5j * (a1 * np.exp(1j * k1 * ax) / k1 + a2 * np.exp(1j * k2 * ax) / k2)
+
+
+def continuous_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko",
+                          distance: ArrayLike = 0.0) -> ComplexArray:
+    """Rail receptance [m/N] on the smeared support s = K / d, at distance [m] from the force."""
+    f = np.asarray(frequency, float)
+    w = 2 * np.pi * f
+    s = support_stiffness(f, track) / track.sleeper_spacing_m
+    return _green(distance, _poles(w, s, track, beam))
+
+
+def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", position: float = 0.5,
+                        supports: int = 121) -> ComplexArray:
+    """Rail point receptance [m/N] on discrete supports, the force at ``position`` of a bay.
+
+    position: fraction of the sleeper spacing from a support (0 above a sleeper, 0.5 mid-span).
+    supports: number of rail seats (odd; the force sits between the middle two or above the
+    middle one). Vectorised over frequency [Hz] (one dense solve per frequency).
+    """
+    if supports < 3 or supports % 2 == 0:
+        raise ValueError("supports must be odd and at least 3")
+    f = np.atleast_1d(np.asarray(frequency, float))
+    w = 2 * np.pi * f
+    half = supports // 2
+    xn = np.arange(-half, half + 1) * track.sleeper_spacing_m
+    xf = position * track.sleeper_spacing_m
+    free = _poles(w, np.zeros_like(w, dtype=complex), track, beam)
+    per_f = tuple(p[:, None, None] for p in free)
+    g_nn = _green(xn[None, :, None] - xn[None, None, :], per_f)            # (F, N, N)
+    g_nf = _green(xn[None, :, None] - xf, per_f)[..., 0]                   # (F, N)
+    k = support_stiffness(f, track)[:, None, None]
+    system = np.eye(supports)[None] + k * g_nn
+    wn = np.linalg.solve(system, g_nf[..., None])[..., 0]                  # support displacements per unit F
+    g0 = _green(0.0, free)
+    out = g0 - support_stiffness(f, track) * np.einsum("fn,fn->f", g_nf, wn)
+    return out.reshape(np.shape(frequency))
+
+
+def bay_averaged_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", positions: int = 8,
+                            supports: int = 121) -> ComplexArray:
+    """Discrete-support receptance [m/N] averaged over ``positions`` equally spaced points of a bay."""
+    xs = (np.arange(positions) + 0.5) / positions
+    return np.mean([discrete_receptance(frequency, track, beam, x, supports) for x in xs], axis=0)
+
+
+def static_stiffness(track: Track) -> float:
+    """Winkler static stiffness 2 s / beta [N/m] of the continuous model (Hetenyi 1946), s = K(0) / d."""
+    s = 1.0 / (1.0 / track.pad_stiffness_npm + 1.0 / track.ballast_stiffness_npm) / track.sleeper_spacing_m
+    beta = (s / (4.0 * track.young_modulus_pa * track.second_moment_m4)) ** 0.25
+    return 2.0 * s / beta
+
+
+def wheel_receptance(frequency: ArrayLike, unsprung_mass: float = 600.0,
+                     modes: tuple[tuple[float, float, float], ...] = ()) -> ComplexArray:
+    """Vertical wheel receptance [m/N] at the contact: rigid unsprung mass [kg] plus modes.
+
+    modes: (natural frequency [Hz], modal mass [kg], damping ratio [-]) of each wheel mode
+    seen at the contact, added as 1 / (m_n (w_n^2 - w^2 + 2 i zeta_n w_n w)).
+    """
+    w = 2 * np.pi * np.asarray(frequency, float)
+    out = -1.0 / (unsprung_mass * w**2) + 0j
+    for fn, mn, zn in modes:
+        wn = 2 * np.pi * fn
+        out = out + 1.0 / (mn * (wn**2 - w**2 + 2j * zn * wn * w))
+    return out
