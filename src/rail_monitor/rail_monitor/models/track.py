@@ -133,38 +133,36 @@ def continuous_receptance(frequency: ArrayLike, track: Track, beam: str = "timos
     return _green(distance, _poles(w, s, track, beam))
 
 
-def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", position: float = 0.5,
+def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", position: ArrayLike = 0.5,
                         supports: int = 121) -> ComplexArray:
     """Rail point receptance [m/N] on discrete supports, the force at ``position`` of a bay.
 
-    position: fraction of the sleeper spacing from a support (0 above a sleeper, 0.5 mid-span).
-    supports: number of rail seats (odd; the force sits between the middle two or above the
-    middle one). Vectorised over frequency [Hz] (one dense solve per frequency).
+    position: fraction of the sleeper spacing from a support (0 above a sleeper, 0.5 mid-span);
+    several positions share one factorisation per frequency. supports: number of rail seats
+    (odd, at least 3). Returns shape frequency.shape + position.shape.
     """
     if supports < 3 or supports % 2 == 0:
         raise ValueError("supports must be odd and at least 3")
     f = np.atleast_1d(np.asarray(frequency, float))
+    xf = np.atleast_1d(np.asarray(position, float)) * track.sleeper_spacing_m
     w = 2 * np.pi * f
     half = supports // 2
     xn = np.arange(-half, half + 1) * track.sleeper_spacing_m
-    xf = position * track.sleeper_spacing_m
     free = _poles(w, np.zeros_like(w, dtype=complex), track, beam)
     per_f = tuple(p[:, None, None] for p in free)
     g_nn = _green(xn[None, :, None] - xn[None, None, :], per_f)            # (F, N, N)
-    g_nf = _green(xn[None, :, None] - xf, per_f)[..., 0]                   # (F, N)
-    k = support_stiffness(f, track)[:, None, None]
-    system = np.eye(supports)[None] + k * g_nn
-    wn = np.linalg.solve(system, g_nf[..., None])[..., 0]                  # support displacements per unit F
-    g0 = _green(0.0, free)
-    out = g0 - support_stiffness(f, track) * np.einsum("fn,fn->f", g_nf, wn)
-    return out.reshape(np.shape(frequency))
+    g_nf = _green(xn[None, :, None] - xf[None, None, :], per_f)            # (F, N, P)
+    k = support_stiffness(f, track)
+    wn = np.linalg.solve(np.eye(supports)[None] + k[:, None, None] * g_nn, g_nf)  # support displacements per unit F
+    out = _green(0.0, free)[:, None] - k[:, None] * np.einsum("fnp,fnp->fp", g_nf, wn)
+    return out.reshape(np.shape(frequency) + np.shape(position))
 
 
 def bay_averaged_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", positions: int = 8,
                             supports: int = 121) -> ComplexArray:
     """Discrete-support receptance [m/N] averaged over ``positions`` equally spaced points of a bay."""
     xs = (np.arange(positions) + 0.5) / positions
-    return np.mean([discrete_receptance(frequency, track, beam, x, supports) for x in xs], axis=0)
+    return discrete_receptance(frequency, track, beam, xs, supports).mean(axis=-1)
 
 
 def static_stiffness(track: Track) -> float:
