@@ -21,10 +21,8 @@ def rig_contact() -> hertz.HertzContact:
 
 
 def rig_k3(convention: str = "kalker_unit") -> float:
-    c = rig_contact()
-    c22 = kalker.creep_coefficients(c.a / c.b, RIG["nu"]).c22
-    return float(squeal.lateral_creep_stiffness(squeal.shear_modulus(RIG["e"], RIG["nu"]), c.a, c.b, c22, RIG["k1"],
-                                                convention))
+    g_ab_c22 = squeal.kalker_lateral_stiffness(rig_contact(), RIG["e"], RIG["nu"])
+    return float(squeal.lateral_creep_stiffness(g_ab_c22, RIG["k1"], convention))
 
 
 def rig_amplitude(vc, convention: str = "kalker_unit") -> squeal.LimitCycle:

@@ -166,6 +166,12 @@ def cmd_demo(ns: argparse.Namespace) -> int:
     return _monitor(ns, str(ns.source), ns.output)
 
 
+# predict squeal: option, SquealCase field, unit
+_SQUEAL_OVERRIDES = {"mass_kg": ("--mass", "kg"), "damping_nspm": ("--damping", "N s/m"),
+                     "stiffness_npm": ("--stiffness", "N/m"), "k1": ("--k1", "-"), "k2": ("--k2", "-"),
+                     "k3_n": ("--k3", "N")}
+
+
 def cmd_predict_squeal(ns: argparse.Namespace) -> int:
     import dataclasses
     import json
@@ -190,9 +196,8 @@ def cmd_predict_squeal(ns: argparse.Namespace) -> int:
         case = squeal_risk.site_case(squeal_risk.squeal_config(values), site, cls, FRICTION_BY_NAME[ns.friction],
                                      speed, ns.load or 0.0)
         where = f"site {site.site_id}, class {cls}, {ns.friction}"
-    overrides = {k: getattr(ns, k) for k in ("speed_mps", "load_n", "mass_kg", "damping_nspm", "stiffness_npm",
-                                             "k1", "k2", "k3_n") if getattr(ns, k, None) is not None}
-    if ns.rig and ns.speed:
+    overrides = {k: getattr(ns, k) for k in _SQUEAL_OVERRIDES if getattr(ns, k) is not None}
+    if ns.speed:
         overrides["speed_mps"] = ns.speed
     case = dataclasses.replace(case, **overrides)
     if ns.sweep:
@@ -225,10 +230,12 @@ def cmd_predict_squeal(ns: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from rail_monitor.models.squeal import K3_CONVENTIONS
     from rail_monitor.nodes.mcap_recorder import RECORDER_SPECS
     from rail_monitor.nodes.pass_replayer import REPLAYER_SPECS
     from rail_monitor.nodes.pass_source import PUBLISH_SPECS
     from rail_monitor.nodes.wayside_monitor import MONITOR_SPECS
+    from rail_monitor.passes import FRICTION_BY_NAME
 
     p = argparse.ArgumentParser(prog="rail-monitor", description=__doc__.split("\n\n")[0],
                                 formatter_class=argparse.ArgumentDefaultsHelpFormatter)
@@ -268,7 +275,7 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--rig", action="store_true", help="the seed's two-disc rig (Figure 5) instead of a site")
     q.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
     q.add_argument("--vehicle-class", help="vehicle class of the site (default: its first)")
-    q.add_argument("--friction", default="dry", choices=("dry", "wet", "friction_modifier", "contaminated"))
+    q.add_argument("--friction", default="dry", choices=tuple(FRICTION_BY_NAME))
     q.add_argument("--speed", type=float, help="rolling speed V0 [m/s] (default: the class's mean)")
     q.add_argument("--load", type=float, help="wheel load W [N] (default: the class's nominal)")
     g = q.add_mutually_exclusive_group()
@@ -276,10 +283,8 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--crabbing", type=float, help="crabbing velocity Vc [m/s]")
     g.add_argument("--sweep", type=float, nargs=3, metavar=("VC_START", "VC_STOP", "N"),
                    help="sweep the crabbing velocity [m/s]")
-    q.add_argument("--k3-convention", choices=("kalker_unit", "kalker_peak", "saturation_3x"))
-    for flag, dest, unit in (("--mass", "mass_kg", "kg"), ("--damping", "damping_nspm", "N s/m"),
-                             ("--stiffness", "stiffness_npm", "N/m"), ("--k1", "k1", "-"), ("--k2", "k2", "-"),
-                             ("--k3", "k3_n", "N")):
+    q.add_argument("--k3-convention", choices=K3_CONVENTIONS)
+    for dest, (flag, unit) in _SQUEAL_OVERRIDES.items():
         q.add_argument(flag, dest=dest, type=float, help=f"override [{unit}]")
     q.add_argument("--reference", type=float, help="A w_ref of the relative level [m/s] (default: the largest A w)")
     q.add_argument("--ode", action="store_true", help="also integrate the ODE for every row (about 1 s each)")

@@ -73,8 +73,16 @@ class ParamSpec:
         return out if is_list else out[0]
 
 
-def resolve(specs: Sequence[ParamSpec], values: Mapping[str, Any], where: str = "") -> dict[str, Value]:
-    """Apply specs to a flat mapping of dotted names: defaults filled in, every value checked."""
+def resolve(specs: Sequence[ParamSpec], values: Mapping[str, Any], where: str = "",
+            strict: bool = False) -> dict[str, Value]:
+    """Apply specs to a flat mapping of dotted names: defaults filled in, every value checked.
+
+    strict: a name no spec knows (a typo in the YAML) is a ConfigError instead of ignored.
+    """
+    if strict:
+        unknown = sorted(set(values) - {s.name for s in specs})
+        if unknown:
+            raise ConfigError(f"unknown parameter(s): {', '.join(where + u for u in unknown)}")
     return {s.name: s.check(values[s.name], where) if s.name in values else s.default for s in specs}
 
 

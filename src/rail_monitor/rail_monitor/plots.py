@@ -10,6 +10,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from rail_monitor.models.squeal import REGIME_STICK_SLIP_BOUND
+
 
 def squeal_sweep(rows: dict[str, np.ndarray], path: str | Path, title: str = "") -> Path:
     """Amplitude and relative level against crabbing velocity (the shape of the seed's Figure 7a)."""
@@ -20,7 +22,7 @@ def squeal_sweep(rows: dict[str, np.ndarray], path: str | Path, title: str = "")
     if "ode_amplitude_mps" in rows:
         ax1.plot(vc, rows["ode_amplitude_mps"], "o", mfc="none", label="time integration")
     ax1.plot(vc, vc, ":", color="grey", label="A w = Vc")
-    bound = rows["regime"] == 2
+    bound = rows["regime"] == REGIME_STICK_SLIP_BOUND
     if np.any(bound):
         ax1.plot(vc[bound], amp[bound], "x", color="tab:red", label="stick-slip bound")
     ax1.set_ylabel("velocity amplitude A w [m/s]")

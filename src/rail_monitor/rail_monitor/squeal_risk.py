@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.errors import ConfigError
-from rail_monitor.models import hertz, kalker, squeal
+from rail_monitor.models import hertz, squeal
 from rail_monitor.params import ParamSpec, resolve
 from rail_monitor.passes import FRICTION_MODIFIER, FRICTION_NAMES, PassTable
 from rail_monitor.site import Site
@@ -96,10 +96,7 @@ class SquealConfig:
 def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealConfig:
     """Checked squeal parameters from flat parameter values (keys under prefix)."""
     sub = {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
-    unknown = sorted(set(sub) - {s.name for s in SQUEAL_SPECS})
-    if unknown:
-        raise ConfigError(f"unknown squeal parameter(s): {', '.join(prefix + u for u in unknown)}")
-    values = resolve(SQUEAL_SPECS, sub, where=prefix)
+    values = resolve(SQUEAL_SPECS, sub, where=prefix, strict=True)
     if values["risk_high_dba"] < values["risk_medium_dba"]:
         raise ConfigError(f"parameter '{prefix}risk_high_dba' must not be below '{prefix}risk_medium_dba'")
     return SquealConfig(values)
@@ -127,7 +124,8 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     vc = v0 * np.sin(np.abs(passes.angle_of_attack_rad))
     load = passes.wheel_load_n
     k1, k2 = cfg.creep(passes.friction_state)
-    kalker_force = _kalker_lateral_force(cfg, site, passes)
+    wheel_radius = np.array([site.vehicle(c).wheel_diameter_m / 2.0 for c in passes.vehicle_class])
+    kalker_force = _kalker_lateral_force(cfg, wheel_radius, load)
     k3 = _k3(cfg, kalker_force, k1)
     mass, damping, stiffness = cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"]
     lc = squeal.limit_cycle_amplitude(v0, vc, load, damping, k1, k2, k3)
@@ -162,23 +160,26 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     }
 
 
-def _kalker_lateral_force(cfg: SquealConfig, site: Site, passes: PassTable) -> np.ndarray | None:
-    """G a b C22 [N] per pass from the Hertz contact of the class's wheel and the rail (None if k3 is given)."""
+def _wheel_rail_contact(cfg: SquealConfig, wheel_radius_m: np.ndarray, load_n: np.ndarray) -> hertz.HertzContact:
+    """Hertz contact of a wheel of rolling radius [m] on the straight rail head, under load [N]."""
+    e_star = hertz.contact_modulus(cfg["young_modulus_pa"], cfg["poisson_ratio"])
+    return hertz.contact_ellipse(wheel_radius_m, cfg["wheel_transverse_radius_m"], np.inf, cfg["rail_head_radius_m"],
+                                 e_star, load_n)
+
+
+def _kalker_lateral_force(cfg: SquealConfig, wheel_radius_m: np.ndarray, load_n: np.ndarray) -> np.ndarray | None:
+    """G a b C22 [N] of the wheel-rail contact (None when k3 is given directly)."""
     if cfg["k3_n"] > 0.0:
         return None
-    wheel_radius = np.array([site.vehicle(c).wheel_diameter_m / 2.0 for c in passes.vehicle_class])
-    e, nu = cfg["young_modulus_pa"], cfg["poisson_ratio"]
-    contact = hertz.contact_ellipse(wheel_radius, cfg["wheel_transverse_radius_m"], np.inf, cfg["rail_head_radius_m"],
-                                    hertz.contact_modulus(e, nu), passes.wheel_load_n)
-    c22 = kalker.creep_coefficients(contact.a / contact.b, nu).c22
-    return squeal.shear_modulus(e, nu) * contact.a * contact.b * c22
+    contact = _wheel_rail_contact(cfg, wheel_radius_m, load_n)
+    return squeal.kalker_lateral_stiffness(contact, cfg["young_modulus_pa"], cfg["poisson_ratio"])
 
 
 def _k3(cfg: SquealConfig, kalker_force: np.ndarray | None, mu0: np.ndarray) -> np.ndarray:
     """k3 [N] per pass: given directly, or from G a b C22 under the configured convention."""
     if kalker_force is None:
         return np.full(mu0.shape, cfg["k3_n"])
-    return squeal.lateral_creep_stiffness(1.0, kalker_force, 1.0, 1.0, mu0, cfg["k3_convention"])
+    return squeal.lateral_creep_stiffness(kalker_force, mu0, cfg["k3_convention"])
 
 
 @dataclass(frozen=True)
@@ -206,9 +207,8 @@ RIG = {"young_modulus_pa": 175e9, "poisson_ratio": 0.28, "load_n": 1000.0, "mass
 def rig_case(convention: str = "kalker_unit") -> SquealCase:
     """The seed's rig (Figure 5) with k3 from its Hertz contact and Kalker's C22 (convention)."""
     e, nu = RIG["young_modulus_pa"], RIG["poisson_ratio"]
-    c = hertz.contact_ellipse(*RIG_RADII_M, hertz.contact_modulus(e, nu), RIG["load_n"])
-    c22 = kalker.creep_coefficients(c.a / c.b, nu).c22
-    k3 = float(squeal.lateral_creep_stiffness(squeal.shear_modulus(e, nu), c.a, c.b, c22, RIG["k1"], convention))
+    contact = hertz.contact_ellipse(*RIG_RADII_M, hertz.contact_modulus(e, nu), RIG["load_n"])
+    k3 = float(squeal.lateral_creep_stiffness(squeal.kalker_lateral_stiffness(contact, e, nu), RIG["k1"], convention))
     return SquealCase(RIG["speed_mps"], RIG["load_n"], RIG["mass_kg"], RIG["damping_nspm"], RIG["stiffness_npm"],
                       RIG["k1"], RIG["k2"], k3)
 
@@ -219,11 +219,8 @@ def site_case(cfg: SquealConfig, site: Site, vehicle_class: str, friction_state:
     vehicle = site.vehicle(vehicle_class)
     load = load_n or vehicle.wheel_load_n
     k1, k2 = (float(x[0]) for x in cfg.creep(np.array([friction_state])))
-    one = PassTable.from_rows([{
-        "stamp_ns": 1, "train_id": "case", "vehicle_class": vehicle_class, "vehicle_count": 1,
-        "axle_count": vehicle.axles_per_vehicle, "speed_mps": speed_mps, "angle_of_attack_rad": 0.0,
-        "wheel_load_n": load, "friction_state": friction_state, "train_length_m": vehicle.vehicle_length_m}])
-    k3 = float(_k3(cfg, _kalker_lateral_force(cfg, site, one), np.array([k1]))[0])
+    kalker_force = _kalker_lateral_force(cfg, np.array([vehicle.wheel_diameter_m / 2.0]), np.array([load]))
+    k3 = float(_k3(cfg, kalker_force, np.array([k1]))[0])
     return SquealCase(speed_mps, load, cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"],
                       k1, k2, k3)
 

@@ -37,7 +37,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import solve_ivp
 
+from rail_monitor.models.hertz import HertzContact
 from rail_monitor.models.iec61672 import a_weighting_db
+from rail_monitor.models.kalker import creep_coefficients
 
 FloatArray = NDArray[np.float64]
 
@@ -59,13 +61,19 @@ def shear_modulus(young_pa: ArrayLike, poisson: ArrayLike) -> FloatArray:
     return np.asarray(young_pa, float) / (2.0 * (1.0 + np.asarray(poisson, float)))
 
 
-def lateral_creep_stiffness(
-    shear_pa: ArrayLike, a: ArrayLike, b: ArrayLike, c22: ArrayLike, mu0: ArrayLike, convention: str = "kalker_unit"
-) -> FloatArray:
+def kalker_lateral_stiffness(contact: HertzContact, young_pa: ArrayLike, poisson: ArrayLike) -> FloatArray:
+    """G a b C22 [N]: Kalker's linear lateral creep force per unit creepage of a Hertz contact
+    between two bodies of the same material (E [Pa], nu [-]); C22 from
+    :func:`rail_monitor.models.kalker.creep_coefficients` at the contact's a/b (a along rolling)."""
+    c22 = creep_coefficients(contact.a / contact.b, poisson).c22
+    return shear_modulus(young_pa, poisson) * contact.a * contact.b * c22
+
+
+def lateral_creep_stiffness(kalker_stiffness: ArrayLike, mu0: ArrayLike, convention: str = "kalker_unit") -> FloatArray:
     """k3 [N]: the lateral creep stiffness that normalises the creepage, xi' = zeta k3 / W.
 
-    Kalker's linear lateral creep force is G a b C22 zeta (G [Pa], semi-axes a, b [m],
-    C22 [-] from :func:`rail_monitor.models.kalker.creep_coefficients`). Conventions:
+    kalker_stiffness is Kalker's linear lateral creep force per unit creepage, G a b C22 [N]
+    (:func:`kalker_lateral_stiffness`); mu0 the friction peak k1 [-]. Conventions:
 
     ``kalker_peak``
         The seed's eq. (4) read literally, xi' = zeta G a b C22 / (mu0 W): k3 = G a b C22 / mu0.
@@ -83,7 +91,7 @@ def lateral_creep_stiffness(
         Saturation at three times the linear intercept (the cubic Vermeulen-Johnson curve
         saturates there): k3 = G a b C22 / (3 mu0).
     """
-    g_ab_c22 = np.asarray(shear_pa, float) * np.asarray(a, float) * np.asarray(b, float) * np.asarray(c22, float)
+    g_ab_c22 = np.asarray(kalker_stiffness, float)
     if convention == "kalker_unit":
         return g_ab_c22
     if convention == "kalker_peak":
@@ -189,9 +197,8 @@ def limit_cycle_amplitude(
     has_root = unstable & (q <= np.pi)
     x = _solve_x_minus_sin(np.where(has_root, q, 0.0))
     phi = np.where(has_root, 0.5 * x, np.nan)
-    cos_phi = np.cos(np.where(has_root, phi, 0.0))
-    closed = np.where(has_root & (cos_phi > 0.0), (vc - u_s) / np.where(cos_phi > 0.0, cos_phi, 1.0), np.nan)
-    closed = np.where(has_root & (cos_phi <= 0.0), np.inf, closed)
+    with np.errstate(divide="ignore", invalid="ignore"):  # phi = pi/2 (q = pi): unbounded amplitude
+        closed = (vc - u_s) / np.cos(phi)  # NaN where there is no root
     valid = has_root & (closed <= vc + u_s)
     regime = np.where(~unstable, REGIME_STABLE, np.where(valid, REGIME_LIMIT_CYCLE, REGIME_STICK_SLIP_BOUND))
     amplitude = np.where(regime == REGIME_LIMIT_CYCLE, closed, np.where(regime == REGIME_STICK_SLIP_BOUND, vc, 0.0))

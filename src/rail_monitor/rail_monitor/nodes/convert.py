@@ -46,7 +46,6 @@ def train_pass_row(msg: TrainPass) -> dict[str, Any]:
     }
 
 
-
 _CASTS = {"boolean": bool, "float": float, "double": float, "string": str}
 
 

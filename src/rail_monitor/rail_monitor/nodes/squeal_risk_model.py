@@ -22,8 +22,7 @@ from rail_msgs.msg import SquealPrediction, TrainPass
 class SquealRiskModel(PassModelNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("squeal_risk_model", **kwargs)
-        values = declare(self, SQUEAL_SPECS, prefix="squeal.")
-        self.cfg = squeal_config({f"squeal.{k}": v for k, v in values.items()})
+        self.cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
         self.published = 0
         self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
 
