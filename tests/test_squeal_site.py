@@ -17,6 +17,7 @@ from rail_monitor.nodes.convert import train_pass_msg
 from rail_monitor.nodes.qos import STREAM_QOS
 from rail_monitor.nodes.squeal_risk_model import SquealRiskModel
 from rail_monitor.passes import FRICTION_DRY, FRICTION_MODIFIER, PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.site import site_from_values
 from rail_msgs.msg import SquealPrediction, TrainPass
 
 from conftest import run_cmd, spinning, wait_until
@@ -61,8 +62,12 @@ def test_unknown_or_inconsistent_squeal_parameters_are_refused(site_values):
         squeal_risk.squeal_config({**site_values, "squeal.modal_mas": 1.0})
     with pytest.raises(ConfigError, match="risk_high_dba"):
         squeal_risk.squeal_config({**site_values, "squeal.risk_high_dba": 50.0})
-    with pytest.raises(ConfigError, match=r"squeal.poisson_ratio.*\[0, 0.5\]"):
-        squeal_risk.squeal_config({**site_values, "squeal.poisson_ratio": 0.7})
+    with pytest.raises(ConfigError, match=r"squeal\.poisson_ratio"):  # the contact is the site's, not squeal's
+        squeal_risk.squeal_config({**site_values, "squeal.poisson_ratio": 0.3})
+    with pytest.raises(ConfigError, match=r"contact.poisson_ratio.*\[0, 0.5\]"):
+        site_from_values({**site_values, "contact.poisson_ratio": 0.7})
+    with pytest.raises(ConfigError, match=r"contact\.rail_head_radius"):
+        site_from_values({**site_values, "contact.rail_head_radius": 0.3})
 
 
 def test_batch_prediction_of_the_sample_is_fast_and_complete(site, site_values, sample_passes):

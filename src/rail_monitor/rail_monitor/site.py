@@ -13,9 +13,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from rail_monitor.errors import ConfigError
+from rail_monitor.models import hertz
 from rail_monitor.params import ParamSpec, flatten, resolve
 
 BRAKE_TYPES = ("cast_iron", "composite", "disc")
@@ -26,12 +28,24 @@ SITE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("vehicle_classes", ["emu"], "Names of the vehicle classes of the rolling-stock table."),
 )
 
+# Wheel-rail contact, under contact.: one geometry for every model (squeal's k3, the corrugation
+# kernel's contact stiffness and contact filter, rolling noise).
+CONTACT_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("young_modulus_pa", 210.0e9, "Young's modulus of wheel and rail steel [Pa].", 1.0e9, 1.0e12),
+    ParamSpec("poisson_ratio", 0.28, "Poisson's ratio of wheel and rail steel [-].", 0.0, 0.5),
+    ParamSpec("rail_head_radius_m", 0.3, "Transverse radius of the rail head at the contact [m].", 0.01, 100.0),
+    ParamSpec("wheel_transverse_radius_m", 1.0e6, "Transverse radius of the wheel tread at the contact [m] "
+              "(1e6: a conical tread).", 0.05, 1.0e9),
+)
+
 # Per vehicle class, under vehicle.<name>.: rolling stock, then the traffic it runs in.
 VEHICLE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("axles_per_vehicle", 4, "Axles per vehicle [-].", 1, 12),
     ParamSpec("wheel_diameter_m", 0.84, "Nominal wheel diameter [m].", 0.3, 1.5),
     ParamSpec("brake_type", "disc", "Brake type (sets wheel roughness).", choices=BRAKE_TYPES),
     ParamSpec("wheel_load_n", 60000.0, "Nominal static wheel load [N].", 1.0e3, 2.5e5),
+    ParamSpec("unsprung_mass_kg", 600.0, "Unsprung mass per wheel (half a wheelset and what moves with it) "
+              "[kg].", 50.0, 5000.0),
     ParamSpec("vehicle_length_m", 20.0, "Vehicle length over couplers [m].", 3.0, 40.0),
     ParamSpec("bogie_semi_wheelbase_m", 1.25, "Half the bogie wheelbase (axle to bogie centre) [m].", 0.3, 5.0),
     ParamSpec("traffic_share", 1.0, "Share of the site's trains of this class [-].", 0.0, 1.0),
@@ -53,6 +67,7 @@ class VehicleClass:
     wheel_diameter_m: float
     brake_type: str
     wheel_load_n: float
+    unsprung_mass_kg: float
     vehicle_length_m: float
     bogie_semi_wheelbase_m: float
     traffic_share: float
@@ -65,12 +80,30 @@ class VehicleClass:
 
 
 @dataclass(frozen=True)
+class ContactGeometry:
+    """Materials and transverse radii of the wheel-rail contact (units as in CONTACT_SPECS)."""
+
+    young_modulus_pa: float
+    poisson_ratio: float
+    rail_head_radius_m: float
+    wheel_transverse_radius_m: float
+
+
+@dataclass(frozen=True)
 class Site:
-    """A wayside site: identity, curve and rolling-stock table."""
+    """A wayside site: identity, curve, wheel-rail contact and rolling-stock table."""
 
     site_id: str
     curve_radius_m: float
     vehicles: Mapping[str, VehicleClass]
+    contact: ContactGeometry = ContactGeometry(**{s.name: s.default for s in CONTACT_SPECS})
+
+    def contact_patch(self, wheel_radius_m: np.ndarray | float, load_n: np.ndarray | float) -> hertz.HertzContact:
+        """Hertz contact of a wheel of rolling radius [m] on the straight rail head under load [N]
+        (semi-axis a along the rail)."""
+        c = self.contact
+        return hertz.contact_ellipse(wheel_radius_m, c.wheel_transverse_radius_m, np.inf, c.rail_head_radius_m,
+                                     hertz.contact_modulus(c.young_modulus_pa, c.poisson_ratio), load_n)
 
     def vehicle(self, name: str) -> VehicleClass:
         """The vehicle class called name, or a ConfigError listing the known ones."""
@@ -93,7 +126,9 @@ def site_from_values(values: Mapping[str, Any]) -> Site:
         vehicles[name] = v
     if not vehicles:
         raise ConfigError("parameter 'vehicle_classes' names no vehicle class")
-    return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles)
+    contact = {k[len("contact."):]: v for k, v in values.items() if k.startswith("contact.")}
+    return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles,
+                contact=ContactGeometry(**resolve(CONTACT_SPECS, contact, where="contact.", strict=True)))
 
 
 def load_parameter_file(path: str | Path) -> dict[str, Any]:

@@ -4,7 +4,8 @@ Glue between the pass table and :mod:`rail_monitor.models.squeal`, shared by the
 ``squeal_risk_model`` node, batch mode and ``rail-monitor predict squeal``. Per pass:
 V0 = speed, Vc = V0 sin(angle of attack), W = the pass's wheel load (or its class's nominal
 load); the contact is the class's wheel (rolling radius = diameter / 2, transverse radius
-``wheel_transverse_radius_m``) on a straight rail of head radius ``rail_head_radius_m``; the creep
+the site's ``contact.wheel_transverse_radius_m``) on a straight rail of head radius
+``contact.rail_head_radius_m`` (rail_monitor.site.CONTACT_SPECS); the creep
 curve is the friction state's. One dominant wheel mode per site (modal mass, damping,
 stiffness at the contact, lateral).
 """
@@ -44,11 +45,6 @@ SQUEAL_SPECS: tuple[ParamSpec, ...] = (
               "undamped wheel).", 0.0, 1.0e6),
     ParamSpec("modal_stiffness_npm", 2.27e9, "Modal stiffness k of the mode [N/m] (with 40 kg: 1.2 kHz).",
               1.0, 1.0e13),
-    ParamSpec("young_modulus_pa", 210.0e9, "Young's modulus of wheel and rail steel [Pa].", 1.0e9, 1.0e12),
-    ParamSpec("poisson_ratio", 0.28, "Poisson's ratio of wheel and rail steel [-].", 0.0, 0.5),
-    ParamSpec("rail_head_radius_m", 0.3, "Transverse radius of the rail head at the contact [m].", 0.01, 100.0),
-    ParamSpec("wheel_transverse_radius_m", 1.0e6, "Transverse radius of the wheel tread at the contact [m] "
-              "(1e6: a conical tread).", 0.05, 1.0e9),
     ParamSpec("k3_convention", "kalker_unit", "How k3 follows from Kalker's C22 (models.squeal."
               "lateral_creep_stiffness).", choices=squeal.K3_CONVENTIONS),
     ParamSpec("k3_n", 0.0, "Lateral creep stiffness k3 given directly [N]; 0: from contact mechanics.", 0.0, 1.0e12),
@@ -125,7 +121,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     load = passes.wheel_load_n
     k1, k2 = cfg.creep(passes.friction_state)
     wheel_radius = np.array([site.vehicle(c).wheel_diameter_m / 2.0 for c in passes.vehicle_class])
-    kalker_force = _kalker_lateral_force(cfg, wheel_radius, load)
+    kalker_force = _kalker_lateral_force(cfg, site, wheel_radius, load)
     k3 = _k3(cfg, kalker_force, k1)
     mass, damping, stiffness = cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"]
     lc = squeal.limit_cycle_amplitude(v0, vc, load, damping, k1, k2, k3)
@@ -160,19 +156,14 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     }
 
 
-def _wheel_rail_contact(cfg: SquealConfig, wheel_radius_m: np.ndarray, load_n: np.ndarray) -> hertz.HertzContact:
-    """Hertz contact of a wheel of rolling radius [m] on the straight rail head, under load [N]."""
-    e_star = hertz.contact_modulus(cfg["young_modulus_pa"], cfg["poisson_ratio"])
-    return hertz.contact_ellipse(wheel_radius_m, cfg["wheel_transverse_radius_m"], np.inf, cfg["rail_head_radius_m"],
-                                 e_star, load_n)
-
-
-def _kalker_lateral_force(cfg: SquealConfig, wheel_radius_m: np.ndarray, load_n: np.ndarray) -> np.ndarray | None:
-    """G a b C22 [N] of the wheel-rail contact (None when k3 is given directly)."""
+def _kalker_lateral_force(cfg: SquealConfig, site: Site, wheel_radius_m: np.ndarray,
+                          load_n: np.ndarray) -> np.ndarray | None:
+    """G a b C22 [N] of the site's wheel-rail contact (None when k3 is given directly)."""
     if cfg["k3_n"] > 0.0:
         return None
-    contact = _wheel_rail_contact(cfg, wheel_radius_m, load_n)
-    return squeal.kalker_lateral_stiffness(contact, cfg["young_modulus_pa"], cfg["poisson_ratio"])
+    c = site.contact
+    return squeal.kalker_lateral_stiffness(site.contact_patch(wheel_radius_m, load_n), c.young_modulus_pa,
+                                           c.poisson_ratio)
 
 
 def _k3(cfg: SquealConfig, kalker_force: np.ndarray | None, mu0: np.ndarray) -> np.ndarray:
@@ -219,7 +210,7 @@ def site_case(cfg: SquealConfig, site: Site, vehicle_class: str, friction_state:
     vehicle = site.vehicle(vehicle_class)
     load = load_n or vehicle.wheel_load_n
     k1, k2 = (float(x[0]) for x in cfg.creep(np.array([friction_state])))
-    kalker_force = _kalker_lateral_force(cfg, np.array([vehicle.wheel_diameter_m / 2.0]), np.array([load]))
+    kalker_force = _kalker_lateral_force(cfg, site, np.array([vehicle.wheel_diameter_m / 2.0]), np.array([load]))
     k3 = float(_k3(cfg, kalker_force, np.array([k1]))[0])
     return SquealCase(speed_mps, load, cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"],
                       k1, k2, k3)

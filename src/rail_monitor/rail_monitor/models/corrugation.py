@@ -15,14 +15,26 @@ expected log growth per pass is (seed eq. 2, kept in its ln|.| form, not lineari
 The seed's eq. (1) is a single-mode approximation, G_r = K_b (1 + K_c / (4 zeta (1 + zeta))),
 valid only as K_c -> 0; :func:`single_mode_growth_max` is the exact maximum of K_b Re H for one
 mode (MODELS.md), and the tests check both against the full kernel.
+
+Two additions to the seed's kernel, both cited where they are defined:
+- the contact filter F (models.contact_filter) acts twice, on the roughness the contact sees and
+  on the wear it leaves, so the growth term is K_b F^2 H; without it every wavelength shorter than
+  the contact patch would grow at K_b at least (H -> 1 as the receptances vanish);
+- a band's growth is the mean of ln|1 + K_b F^2 H| over wavelengths spread across the band, so a
+  resonance between band centres is not missed.
+
+Grinding limits (Grassie, Saxon & Smith, J. Sound Vib. 227 (1999) 949-964) and the speed-
+distribution optimiser (a linear programme) are here too.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.optimize import linprog
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -34,6 +46,16 @@ def wavelength_bands(shortest_m: float = 0.01, longest_m: float = 1.0) -> FloatA
     lo = int(np.floor(10 * np.log10(shortest_m) + 1e-9))
     hi = int(np.ceil(10 * np.log10(longest_m) - 1e-9))
     return 10.0 ** (np.arange(lo, hi + 1) / 10.0)
+
+
+def band_sub_wavelengths(centres: ArrayLike, per_band: int = 5) -> FloatArray:
+    """Wavelengths [m] spread evenly (in log) across each 1/3-octave band, shape (bands, per_band).
+
+    Band edges are centre x 10^(+-1/20); the points are the centres of per_band equal log slices.
+    """
+    c = np.asarray(centres, float)[:, None]
+    u = (np.arange(per_band) + 0.5) / per_band - 0.5
+    return c * 10.0 ** (u[None, :] / 10.0)
 
 
 def growth_kernel(contact_stiffness: ArrayLike, receptance_sum: ArrayLike) -> ComplexArray:
@@ -89,3 +111,81 @@ def single_mode_growth_max(wear_sensitivity: ArrayLike, contact_ratio: ArrayLike
     kc = np.asarray(contact_ratio, float)
     z = np.asarray(damping_ratio, float) / np.sqrt(1.0 + kc)
     return np.asarray(wear_sensitivity) * (1.0 + kc / (4.0 * z * (1.0 + z) * (1.0 + kc)))
+
+
+def band_growth(wear_sensitivity: ArrayLike, kernel: ArrayLike, contact_filter: ArrayLike) -> FloatArray:
+    """Per-pass log growth of a band [-]: mean over its sub-wavelengths (last axis) of
+    ln|1 + K_b F^2 H|, with H [-] and F [-] given at the sub-wavelengths (broadcast)."""
+    f = np.asarray(contact_filter)
+    return log_growth_per_pass(wear_sensitivity, f * f * np.asarray(kernel)).mean(axis=-1)
+
+
+# Post-grinding acceptance limits of Grassie, Saxon & Smith (1999), r.m.s. roughness per
+# wavelength range: ((shortest [m], longest [m]), limit [m]).
+GRASSIE_1999_LIMITS: tuple[tuple[tuple[float, float], float], ...] = (
+    ((0.01, 0.03), 3e-6),
+    ((0.03, 0.10), 7e-6),
+    ((0.10, 0.30), 7e-6),
+    ((0.30, 1.00), 45e-6),
+    ((1.00, 3.00), 100e-6),
+)
+
+
+def band_limits(centres: ArrayLike, ranges=GRASSIE_1999_LIMITS) -> FloatArray:
+    """Per-band r.m.s. limit [m] from range limits (default Grassie et al. 1999).
+
+    A range's limit is shared equally by the energy of its 1/3-octave bands: a band gets
+    limit / sqrt(n), n = number of base-10 band centres in [shortest, longest), so a range whose
+    bands all sit at their limit has exactly the range's r.m.s. Bands outside every range get NaN.
+    """
+    c = np.asarray(centres, float)
+    out = np.full(c.shape, np.nan)
+    def inside(x: FloatArray, lo: float, hi: float) -> NDArray[np.bool_]:
+        return (x >= lo * (1 - 1e-9)) & (x < hi * (1 - 1e-9))
+
+    for (lo, hi), limit in ranges:
+        n = int(inside(wavelength_bands(lo, hi), lo, hi).sum())
+        out[inside(c, lo, hi)] = limit / np.sqrt(n)
+    return out
+
+
+@dataclass(frozen=True)
+class SpeedAdvice:
+    """A pass-speed distribution that minimises the peak of g over the bands."""
+
+    speeds: FloatArray          # bin centres [m/s]
+    probability: FloatArray     # recommended share per bin [-] (sums to 1)
+    peak_growth: float          # max over bands of sum_i p_i G[band, i] [1/pass]
+    growth: FloatArray          # per band [1/pass]
+
+
+def optimise_speed_distribution(growth: ArrayLike, speeds: ArrayLike, mean_speed: float,
+                                max_share: float = 1.0) -> SpeedAdvice:
+    """Minimise max_b sum_i p_i G[b, i] over p with sum p = 1, sum p v = mean_speed, 0 <= p <= max_share.
+
+    growth G: per-pass log growth per band (rows) at each speed bin (columns) [1/pass], e.g. from
+    :func:`band_growth`; speeds [m/s], the bins allowed (within the speed limits). Because g is
+    linear in p (seed eq. 2), the minimax is the linear programme min t s.t. G p <= t, solved
+    exactly (HiGHS, scipy.optimize.linprog). max_share caps any one bin so the advice is a spread,
+    not a single speed. Raises ValueError when no distribution meets the constraints.
+    """
+    g = np.asarray(growth, float)
+    v = np.asarray(speeds, float)
+    nb, ns = g.shape
+    if ns != len(v):
+        raise ValueError("growth must have one column per speed bin")
+    if not v.min() <= mean_speed <= v.max() or max_share * ns < 1.0:
+        raise ValueError(f"no distribution over {v.min():g}-{v.max():g} m/s with mean {mean_speed:g} m/s "
+                         f"and at most {max_share:g} per bin")
+    scale = float(np.max(np.abs(g))) or 1.0  # G is of order 1e-5: scale it for the solver's tolerances
+    cost = np.r_[np.zeros(ns), 1.0]
+    a_ub = np.c_[g / scale, -np.ones(nb)]
+    a_eq = np.vstack([np.r_[np.ones(ns), 0.0], np.r_[v / mean_speed, 0.0]])
+    res = linprog(cost, A_ub=a_ub, b_ub=np.zeros(nb), A_eq=a_eq, b_eq=[1.0, 1.0],
+                  bounds=[(0.0, max_share)] * ns + [(None, None)], method="highs")
+    if res.status != 0:
+        raise ValueError(f"speed optimisation failed: {res.message}")
+    p = np.clip(res.x[:ns], 0.0, None)
+    p /= p.sum()
+    per_band = g @ p
+    return SpeedAdvice(v, p, float(per_band.max()), per_band)
