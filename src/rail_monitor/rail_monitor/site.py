@@ -9,7 +9,7 @@ defaults, units and ranges.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +18,7 @@ import yaml
 
 from rail_monitor.errors import ConfigError
 from rail_monitor.models import hertz
+from rail_monitor.models.track import Track
 from rail_monitor.params import ParamSpec, flatten, resolve
 
 BRAKE_TYPES = ("cast_iron", "composite", "disc")
@@ -36,6 +37,26 @@ CONTACT_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("rail_head_radius_m", 0.3, "Transverse radius of the rail head at the contact [m].", 0.01, 100.0),
     ParamSpec("wheel_transverse_radius_m", 1.0e6, "Transverse radius of the wheel tread at the contact [m] "
               "(1e6: a conical tread).", 0.05, 1.0e9),
+)
+
+# Track, under track.: one track model for corrugation and rolling noise (models.track.Track;
+# defaults: UIC60 on a typical ballasted track, MODELS.md section 2).
+TRACK_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("young_modulus_pa", 210.0e9, "Young's modulus of the rail [Pa].", 1.0e9, 1.0e12),
+    ParamSpec("poisson_ratio", 0.3, "Poisson's ratio of the rail [-].", 0.0, 0.5),
+    ParamSpec("area_m2", 7.69e-3, "Rail cross-section area [m2] (UIC60: 7.69e-3).", 1.0e-4, 0.1),
+    ParamSpec("second_moment_m4", 30.55e-6, "Vertical second moment of area of the rail [m4] (UIC60: 30.55e-6).",
+              1.0e-7, 1.0e-3),
+    ParamSpec("mass_per_length_kgpm", 60.4, "Rail mass per metre [kg/m].", 5.0, 500.0),
+    ParamSpec("shear_coefficient", 0.4, "Timoshenko shear coefficient of the rail section [-].", 0.05, 1.0),
+    ParamSpec("rail_loss_factor", 0.02, "Loss factor of the rail [-].", 0.0, 1.0),
+    ParamSpec("pad_stiffness_npm", 350.0e6, "Rail pad stiffness per rail seat [N/m] (soft 100e6 to stiff 1e9).",
+              1.0e6, 1.0e11),
+    ParamSpec("pad_loss_factor", 0.25, "Rail pad loss factor [-].", 0.0, 2.0),
+    ParamSpec("sleeper_mass_kg", 150.0, "Half-sleeper mass per rail seat [kg].", 1.0, 2000.0),
+    ParamSpec("ballast_stiffness_npm", 50.0e6, "Ballast stiffness under a half sleeper [N/m].", 1.0e5, 1.0e10),
+    ParamSpec("ballast_loss_factor", 1.0, "Ballast loss factor [-].", 0.0, 5.0),
+    ParamSpec("sleeper_spacing_m", 0.6, "Sleeper spacing [m].", 0.2, 2.0),
 )
 
 # Per vehicle class, under vehicle.<name>.: rolling stock, then the traffic it runs in.
@@ -96,7 +117,9 @@ class Site:
     site_id: str
     curve_radius_m: float
     vehicles: Mapping[str, VehicleClass]
-    contact: ContactGeometry = ContactGeometry(**{s.name: s.default for s in CONTACT_SPECS})
+    contact: ContactGeometry = field(default_factory=lambda: ContactGeometry(**{s.name: s.default
+                                                                                for s in CONTACT_SPECS}))
+    track: Track = field(default_factory=Track)
 
     def contact_patch(self, wheel_radius_m: np.ndarray | float, load_n: np.ndarray | float) -> hertz.HertzContact:
         """Hertz contact of a wheel of rolling radius [m] on the straight rail head under load [N]
@@ -119,16 +142,21 @@ def site_from_values(values: Mapping[str, Any]) -> Site:
     vehicles = {}
     for name in top["vehicle_classes"]:
         prefix = f"vehicle.{name}."
-        sub = {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
-        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, sub, where=prefix))
+        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, _section(values, prefix), where=prefix))
         if v.vehicles_min > v.vehicles_max or v.speed_min_mps > v.speed_max_mps:
             raise ConfigError(f"vehicle class {name!r}: a minimum exceeds its maximum (vehicles or speed)")
         vehicles[name] = v
     if not vehicles:
         raise ConfigError("parameter 'vehicle_classes' names no vehicle class")
-    contact = {k[len("contact."):]: v for k, v in values.items() if k.startswith("contact.")}
     return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles,
-                contact=ContactGeometry(**resolve(CONTACT_SPECS, contact, where="contact.", strict=True)))
+                contact=ContactGeometry(**resolve(CONTACT_SPECS, _section(values, "contact."), "contact.",
+                                                  strict=True)),
+                track=Track(**resolve(TRACK_SPECS, _section(values, "track."), "track.", strict=True)))
+
+
+def _section(values: Mapping[str, Any], prefix: str) -> dict[str, Any]:
+    """The values under prefix, with the prefix taken off their names."""
+    return {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
 
 
 def load_parameter_file(path: str | Path) -> dict[str, Any]:

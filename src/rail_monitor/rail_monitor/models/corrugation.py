@@ -20,8 +20,10 @@ Two additions to the seed's kernel, both cited where they are defined:
 - the contact filter F (models.contact_filter) acts twice, on the roughness the contact sees and
   on the wear it leaves, so the growth term is K_b F^2 H; without it every wavelength shorter than
   the contact patch would grow at K_b at least (H -> 1 as the receptances vanish);
-- a band's growth is the mean of ln|1 + K_b F^2 H| over wavelengths spread across the band, so a
-  resonance between band centres is not missed.
+- a band is tracked as components at wavelengths spread across it (:func:`band_sub_wavelengths`),
+  each growing at its own rate; the band's r.m.s. is their energy sum (:func:`band_amplitude`)
+  and tends to grow at the rate of its fastest component, so a resonance between band centres
+  is not missed.
 
 Grinding limits (Grassie, Saxon & Smith, J. Sound Vib. 227 (1999) 949-964) and the speed-
 distribution optimiser (a linear programme) are here too.
@@ -113,11 +115,45 @@ def single_mode_growth_max(wear_sensitivity: ArrayLike, contact_ratio: ArrayLike
     return np.asarray(wear_sensitivity) * (1.0 + kc / (4.0 * z * (1.0 + z) * (1.0 + kc)))
 
 
-def band_growth(wear_sensitivity: ArrayLike, kernel: ArrayLike, contact_filter: ArrayLike) -> FloatArray:
-    """Per-pass log growth of a band [-]: mean over its sub-wavelengths (last axis) of
-    ln|1 + K_b F^2 H|, with H [-] and F [-] given at the sub-wavelengths (broadcast)."""
+def filtered_log_growth(wear_sensitivity: ArrayLike, kernel: ArrayLike, contact_filter: ArrayLike) -> FloatArray:
+    """ln|1 + K_b F^2 H| [-]: one wheel pass's log growth with the contact filter F [-] applied to
+    the roughness the contact sees and to the wear it leaves (models.contact_filter)."""
     f = np.asarray(contact_filter)
-    return log_growth_per_pass(wear_sensitivity, f * f * np.asarray(kernel)).mean(axis=-1)
+    return log_growth_per_pass(wear_sensitivity, f * f * np.asarray(kernel))
+
+
+def band_amplitude(log_components: ArrayLike) -> FloatArray:
+    """r.m.s. of each band [m] from the ln amplitudes [ln m] of its components (last axis):
+    sqrt(sum_p Z_p^2), computed without overflow."""
+    x = np.asarray(log_components, float)
+    top = x.max(axis=-1, keepdims=True)
+    return np.exp(top[..., 0] + 0.5 * np.log(np.sum(np.exp(2.0 * (x - top)), axis=-1)))
+
+
+def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level: ArrayLike) -> FloatArray:
+    """Passes n [-] until a band's r.m.s. reaches a level: sum_p Z_p^2 exp(2 g_p n) = Z_level^2.
+
+    log_components: ln Z_p [ln m] (..., P); growth g_p [1/pass] (..., P); log_level [ln m] (...).
+    0 where the band is already at or past the level, inf where no component grows. The left side
+    is convex and increasing in n wherever a g_p > 0, so Newton's method from n = 0 converges
+    (after its first step, from above).
+    """
+    x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
+    target = np.asarray(log_level, float)
+    n = np.zeros(x.shape[:-1])
+    grows = np.any(g > 0, axis=-1)
+    for _ in range(100):
+        e = 2.0 * (x + g * n[..., None])
+        top = e.max(axis=-1, keepdims=True)
+        w = np.exp(e - top)
+        f = 0.5 * (top[..., 0] + np.log(w.sum(axis=-1))) - target
+        df = np.sum(w * g, axis=-1) / w.sum(axis=-1)
+        step = np.where(grows & (f < 0) | (n > 0), -f / np.where(df > 0, df, np.inf), 0.0)
+        n = np.maximum(n + step, 0.0)
+        if np.all(np.abs(step) <= 1e-10 * np.maximum(n, 1.0)):
+            break
+    at_level = 0.5 * np.log(np.sum(np.exp(2.0 * x), axis=-1)) >= target
+    return np.where(at_level, 0.0, np.where(grows, n, np.inf))
 
 
 # Post-grinding acceptance limits of Grassie, Saxon & Smith (1999), r.m.s. roughness per
@@ -155,16 +191,16 @@ class SpeedAdvice:
 
     speeds: FloatArray          # bin centres [m/s]
     probability: FloatArray     # recommended share per bin [-] (sums to 1)
-    peak_growth: float          # max over bands of sum_i p_i G[band, i] [1/pass]
-    growth: FloatArray          # per band [1/pass]
+    peak_growth: float          # max over rows of sum_i p_i G[row, i] [1/pass]
+    growth: FloatArray          # per row [1/pass]
 
 
 def optimise_speed_distribution(growth: ArrayLike, speeds: ArrayLike, mean_speed: float,
                                 max_share: float = 1.0) -> SpeedAdvice:
     """Minimise max_b sum_i p_i G[b, i] over p with sum p = 1, sum p v = mean_speed, 0 <= p <= max_share.
 
-    growth G: per-pass log growth per band (rows) at each speed bin (columns) [1/pass], e.g. from
-    :func:`band_growth`; speeds [m/s], the bins allowed (within the speed limits). Because g is
+    growth G: per-pass log growth of each wavelength (rows) at each speed bin (columns) [1/pass],
+    e.g. from :func:`filtered_log_growth`; speeds [m/s], the bins allowed (within the speed limits). Because g is
     linear in p (seed eq. 2), the minimax is the linear programme min t s.t. G p <= t, solved
     exactly (HiGHS, scipy.optimize.linprog). max_share caps any one bin so the advice is a spread,
     not a single speed. Raises ValueError when no distribution meets the constraints.

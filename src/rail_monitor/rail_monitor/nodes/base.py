@@ -18,7 +18,7 @@ from rclpy.node import Node
 from rail_monitor.errors import ConfigError, RailMonitorError
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
 from rail_monitor.params import ParamSpec
-from rail_monitor.site import CONTACT_SPECS, SITE_SPECS, VEHICLE_SPECS, Site, site_from_values
+from rail_monitor.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
 
 
 def _descriptor(spec: ParamSpec, prefix: str) -> ParameterDescriptor:
@@ -59,9 +59,10 @@ def declare(node: Node, specs: Sequence[ParamSpec], prefix: str = "") -> dict[st
 
 
 def declare_site(node: Node) -> Site:
-    """Declare the site parameters, the contact geometry and the rolling-stock table, and build the Site."""
+    """Declare the site parameters, the contact geometry, the track and the rolling-stock table, and build the Site."""
     flat = declare(node, SITE_SPECS)
-    flat.update({f"contact.{k}": v for k, v in declare(node, CONTACT_SPECS, prefix="contact.").items()})
+    for prefix, specs in (("contact.", CONTACT_SPECS), ("track.", TRACK_SPECS)):
+        flat.update({prefix + k: v for k, v in declare(node, specs, prefix=prefix).items()})
     for name in flat["vehicle_classes"]:
         for key, value in declare(node, VEHICLE_SPECS, prefix=f"vehicle.{name}.").items():
             flat[f"vehicle.{name}.{key}"] = value
