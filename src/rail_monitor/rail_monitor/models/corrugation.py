@@ -134,25 +134,31 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
     """Passes n [-] until a band's r.m.s. reaches a level: sum_p Z_p^2 exp(2 g_p n) = Z_level^2.
 
     log_components: ln Z_p [ln m] (..., P); growth g_p [1/pass] (..., P); log_level [ln m] (...).
-    0 where the band is already at or past the level, inf where no component grows. The left side
-    is convex and increasing in n wherever a g_p > 0, so Newton's method from n = 0 converges
-    (after its first step, from above).
+    0 where the band is already at or past the level, inf where no component grows. The left
+    side's log is convex in n; Newton's method started where the fastest-growing component alone
+    reaches the level (at or beyond the root) converges to the root monotonically from above.
     """
     x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
-    target = np.asarray(log_level, float)
-    n = np.zeros(x.shape[:-1])
+    target = np.broadcast_to(np.asarray(log_level, float), x.shape[:-1])
     grows = np.any(g > 0, axis=-1)
-    for _ in range(100):
+
+    def excess(n: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """ln(band r.m.s.) - ln(level) after n passes, and its slope in n."""
         e = 2.0 * (x + g * n[..., None])
         top = e.max(axis=-1, keepdims=True)
         w = np.exp(e - top)
-        f = 0.5 * (top[..., 0] + np.log(w.sum(axis=-1))) - target
-        df = np.sum(w * g, axis=-1) / w.sum(axis=-1)
-        step = np.where(grows & (f < 0) | (n > 0), -f / np.where(df > 0, df, np.inf), 0.0)
-        n = np.maximum(n + step, 0.0)
-        if np.all(np.abs(step) <= 1e-10 * np.maximum(n, 1.0)):
+        return 0.5 * (top[..., 0] + np.log(w.sum(axis=-1))) - target, np.sum(w * g, axis=-1) / w.sum(axis=-1)
+
+    at_level = excess(np.zeros(target.shape))[0] >= 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        alone = np.where(g > 0, (target[..., None] - x) / g, np.inf)
+    n = np.where(grows & ~at_level, np.min(alone, axis=-1), 0.0)
+    for _ in range(200):
+        f, df = excess(n)
+        step = np.where(grows & ~at_level & (f > 0), f / np.where(df > 0, df, np.inf), 0.0)
+        n = n - step
+        if np.all(step <= 1e-12 * np.maximum(n, 1.0)):
             break
-    at_level = 0.5 * np.log(np.sum(np.exp(2.0 * x), axis=-1)) >= target
     return np.where(at_level, 0.0, np.where(grows, n, np.inf))
 
 
