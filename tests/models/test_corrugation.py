@@ -12,8 +12,8 @@ from scipy.optimize import minimize_scalar
 
 from rail_monitor.models import corrugation as cg
 from rail_monitor.models import hertz
-from rail_monitor.models.contact_filter import hertzian_line_filter
 from rail_monitor.models import track as tr
+from rail_monitor.models.contact_filter import hertzian_line_filter
 
 CASES = [(kc, zeta) for kc in (1e-3, 0.1, 1.0, 10.0, 100.0) for zeta in (0.05, 0.2, 0.5)]
 
