@@ -26,6 +26,7 @@ setup(
             "pass_simulator = rail_monitor.nodes.pass_simulator:main",
             "mcap_recorder = rail_monitor.nodes.mcap_recorder:main",
             "squeal_risk_model = rail_monitor.nodes.squeal_risk_model:main",
+            "corrugation_estimator = rail_monitor.nodes.corrugation_estimator:main",
             "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
             "rail-monitor = rail_monitor.cli:main",
         ],

@@ -241,6 +241,7 @@ class CorrugationEstimator:
         self.log_components = self._flat(self.post_grinding)
         self.pass_count = self.axle_pass_count = self.total_pass_count = 0
         self.last_grinding_ns = self.newest_ns = 0
+        self.last_survey_ns = 0                                        # last survey or grinding applied
         self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
         self.recent = _Recent()
         self._seen: set[tuple[int, str]] = set()
@@ -351,7 +352,7 @@ class CorrugationEstimator:
             raise ValueError("no survey wavelength matches a band of the state")
         return out, matched
 
-    def apply_survey(self, wavelength: np.ndarray, amplitude: np.ndarray) -> float | None:
+    def apply_survey(self, wavelength: np.ndarray, amplitude: np.ndarray, stamp_ns: int = 0) -> float | None:
         """Take a measured roughness survey: re-fit K_b against the previous survey, then set the
         measured bands to the measurement. Returns the K_b scale applied, or None without a fit.
 
@@ -373,6 +374,7 @@ class CorrugationEstimator:
                 self.tables.set_k_b(self.tables.k_b * s)
         self.log_components[matched] += (np.log(z[matched]) - self.log_amplitude[matched])[:, None]
         self.survey_log_amplitude = np.where(matched, np.log(np.where(matched, z, 1.0)), np.nan)
+        self.last_survey_ns = max(self.last_survey_ns, int(stamp_ns))
         return scale
 
     def apply_grinding(self, stamp_ns: int, wavelength: np.ndarray | None = None,
@@ -387,6 +389,7 @@ class CorrugationEstimator:
         self.log_components = self._flat(rms)
         self.pass_count = self.axle_pass_count = 0
         self.last_grinding_ns = int(stamp_ns)
+        self.last_survey_ns = max(self.last_survey_ns, int(stamp_ns))
 
     @property
     def amplitude(self) -> np.ndarray:
@@ -478,7 +481,8 @@ class CorrugationEstimator:
         path = Path(path)
         meta = {"version": CHECKPOINT_VERSION, "site_id": self.site.site_id, "pass_count": self.pass_count,
                 "axle_pass_count": self.axle_pass_count, "total_pass_count": self.total_pass_count,
-                "last_grinding_ns": self.last_grinding_ns, "newest_ns": self.newest_ns}
+                "last_grinding_ns": self.last_grinding_ns, "newest_ns": self.newest_ns,
+                "last_survey_ns": self.last_survey_ns}
         buf = io.BytesIO()
         np.savez(buf, meta=np.array(json.dumps(meta)), bands=self.bands, log_components=self.log_components,
                  k_b=self.k_b, survey_log_amplitude=self.survey_log_amplitude,
@@ -514,7 +518,8 @@ class CorrugationEstimator:
         self.log_components = data["log_components"].astype(float)
         self.tables.set_k_b(data["k_b"])
         self.survey_log_amplitude = data["survey_log_amplitude"].astype(float)
-        for key in ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns"):
+        for key in ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns",
+                    "last_survey_ns"):
             setattr(self, key, int(meta[key]))
         self.recent = _Recent(**{n: data[f"recent_{n}"] for n in _RECENT})
         self.recent.train_id = self.recent.train_id.astype(object)

@@ -7,7 +7,7 @@ from typing import Any
 from builtin_interfaces.msg import Time
 
 from rail_monitor.timeutil import from_sec_nanosec, to_sec_nanosec
-from rail_msgs.msg import SquealPrediction, TrainPass
+from rail_msgs.msg import CorrugationState, SpeedAdvisory, SquealPrediction, TrainPass
 
 
 def time_msg(ns: int) -> Time:
@@ -65,3 +65,36 @@ def squeal_prediction_msg(values: dict[str, Any], i: int, source: TrainPass) -> 
     """Row i of rail_monitor.squeal_risk.predict as a SquealPrediction for the pass source."""
     msg = SquealPrediction(header=source.header, train_id=source.train_id)
     return fill_fields(msg, values, i)
+
+
+def corrugation_state_msg(est: Any, fc: Any, frame_id: str) -> CorrugationState:
+    """A rail_monitor.corrugation_state.CorrugationEstimator and its Forecast as a CorrugationState."""
+    msg = CorrugationState()
+    msg.header.stamp = time_msg(est.newest_ns)
+    msg.header.frame_id = frame_id
+    msg.pass_count, msg.axle_pass_count, msg.total_pass_count = est.pass_count, est.axle_pass_count, est.total_pass_count
+    msg.last_grinding_time = time_msg(est.last_grinding_ns)
+    msg.wavelength_m = est.bands.tolist()
+    msg.amplitude_m = est.amplitude.tolist()
+    msg.growth_per_axle_pass = fc.growth_per_axle_pass.tolist()
+    msg.threshold_m = est.threshold.tolist()
+    msg.worst_band = fc.worst_band
+    msg.worst_wavelength_m = float(est.bands[fc.worst_band])
+    msg.passes_to_threshold = float(fc.passes_to_threshold)
+    msg.days_to_threshold = float(fc.days_to_threshold)
+    msg.passes_per_day = float(fc.passes_per_day)
+    msg.grinding_due = fc.grinding_due
+    # builtin_interfaces/Time has an int32 second: a forecast past 2038 is sent as "never" (zero).
+    msg.grinding_due_time = time_msg(fc.grinding_due_ns if fc.grinding_due_ns < 2**31 * 10**9 else 0)
+    msg.k_b_by_friction = [float(k) for k in est.k_b]
+    return msg
+
+
+def speed_advisory_msg(advice: Any, stamp_ns: int, frame_id: str) -> SpeedAdvisory:
+    """A rail_monitor.corrugation_state.Advice as a SpeedAdvisory."""
+    msg = SpeedAdvisory()
+    msg.header.stamp = time_msg(stamp_ns)
+    msg.header.frame_id = frame_id
+    for name, value in vars(advice).items():
+        setattr(msg, name, value.tolist() if hasattr(value, "tolist") and getattr(value, "ndim", 0) else float(value))
+    return msg

@@ -1,0 +1,155 @@
+"""corrugation_estimator: rail roughness per wavelength band at the site, grinding forecast, speed advice.
+
+Subscribes ``train_pass`` (each accepted pass advances the state once: passes are identified by
+(stamp, train_id)) and ``roughness_survey`` (rail_msgs/RoughnessSurvey: a survey re-fits K_b, a
+grinding event resets the state). Publishes ``corrugation/state`` (rail_msgs/CorrugationState,
+per pass or at most every ``state_period_s``) and ``speed_advisory`` (rail_msgs/SpeedAdvisory,
+every ``advisory_period_s``), both latched; serves ``evaluate_speed_distribution``. With
+``checkpoint_path`` set, the state is written atomically every ``checkpoint_every_passes``
+passes, after every survey and at shutdown, and a restart resumes from it.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from collections import Counter
+from typing import Any
+
+from rail_monitor.corrugation_state import CORRUGATION_SPECS, CorrugationEstimator, corrugation_config
+from rail_monitor.nodes.base import declare, run_node, wall_timer
+from rail_monitor.nodes.convert import corrugation_state_msg, speed_advisory_msg, time_ns
+from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS
+from rail_monitor.params import ParamSpec
+from rail_monitor.passes import PassTable
+from rail_monitor.timeutil import format_iso_ns
+from rail_msgs.msg import CorrugationState, RoughnessSurvey, SpeedAdvisory, TrainPass
+from rail_msgs.srv import EvaluateSpeedDistribution
+
+NODE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("checkpoint_path", "", "File the state is checkpointed to and resumed from ('' : none)."),
+    ParamSpec("checkpoint_every_passes", 100, "Counted passes between checkpoints [-].", 1, 10**9),
+    ParamSpec("state_period_s", 0.0, "Least wall time between corrugation/state messages [s] (0: every pass).",
+              0.0, 86_400.0),
+    ParamSpec("advisory_period_s", 60.0, "Wall time between speed advisories [s].", 0.01, 86_400.0),
+)
+
+
+class CorrugationEstimatorNode(PassModelNode):
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("corrugation_estimator", **kwargs)
+        self.params = declare(self, NODE_SPECS)
+        cfg = corrugation_config(declare(self, CORRUGATION_SPECS, prefix="corrugation."), prefix="")
+        self.est = CorrugationEstimator(self.site, cfg)
+        self.checkpoint = self.params["checkpoint_path"]
+        self.counts: Counter[str] = Counter()
+        self.surveys_rejected: Counter[str] = Counter()
+        if self.checkpoint and os.path.exists(self.checkpoint):
+            self.est.load(self.checkpoint)  # a checkpoint it cannot use is a ConfigError: no silent fresh start
+            self.get_logger().info(f"resumed from {self.checkpoint}: {self.est.total_pass_count} passes")
+        self._since_checkpoint = 0
+        self._last_state_t = float("-inf")
+        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", LATEST_QOS)
+        self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
+        self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
+        self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
+        wall_timer(self, self.params["advisory_period_s"], self.publish_advisory)
+
+    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
+        if not self.est.advance(table)[0]:
+            self.counts["not counted (already counted, or older than the history)"] += 1
+            return
+        self.counts["counted"] += 1
+        self._since_checkpoint += 1
+        if self._since_checkpoint >= self.params["checkpoint_every_passes"]:
+            self.save()
+        now = time.monotonic()
+        if now - self._last_state_t >= self.params["state_period_s"]:
+            self.publish_state()
+            self._last_state_t = now
+
+    def publish_state(self) -> None:
+        self.state_pub.publish(corrugation_state_msg(self.est, self.est.forecast(), self.site.site_id))
+
+    def publish_advisory(self) -> None:
+        if not len(self.est.recent.stamp_ns):
+            return
+        try:
+            advice = self.est.advise()
+        except ValueError as exc:
+            self.get_logger().warning(f"no speed advice: {exc}", throttle_duration_sec=60.0)
+            return
+        self.advisory_pub.publish(speed_advisory_msg(advice, self.est.newest_ns, self.site.site_id))
+
+    def _on_survey(self, msg: RoughnessSurvey) -> None:
+        stamp = time_ns(msg.header.stamp)
+        try:
+            if stamp <= self.est.last_survey_ns:
+                raise ValueError("not newer than the last survey or grinding applied")
+            if msg.kind == RoughnessSurvey.KIND_SURVEY:
+                scale = self.est.apply_survey(msg.wavelength_m, msg.amplitude_m, stamp)
+                self.counts["surveys"] += 1
+                if scale is not None:
+                    self.get_logger().info(f"survey re-fitted K_b by x{scale:.3g}: {self.est.k_b.tolist()}")
+            elif msg.kind == RoughnessSurvey.KIND_GRINDING:
+                self.est.apply_grinding(stamp, msg.wavelength_m, msg.amplitude_m)
+                self.counts["grindings"] += 1
+            else:
+                raise ValueError(f"unknown kind {msg.kind}")
+        except ValueError as exc:
+            self.surveys_rejected[str(exc)] += 1
+            self.get_logger().warning(f"roughness survey rejected: {exc}")
+            return
+        self.save()
+        self.publish_state()
+
+    def _on_evaluate(self, req: EvaluateSpeedDistribution.Request,
+                     res: EvaluateSpeedDistribution.Response) -> EvaluateSpeedDistribution.Response:
+        try:
+            ev = self.est.evaluate(req.speed_mps, req.probability, req.friction_state, req.passes_per_day)
+        except ValueError as exc:
+            res.success, res.message = False, str(exc)
+            return res
+        res.success = True
+        res.wavelength_m = self.est.bands.tolist()
+        res.growth_per_axle_pass = ev.growth_per_axle_pass.tolist()
+        res.peak_growth, res.peak_wavelength_m = ev.peak_growth, ev.peak_wavelength_m
+        res.grinding_interval_factor, res.days_to_threshold = ev.grinding_interval_factor, ev.days_to_threshold
+        return res
+
+    def save(self) -> None:
+        if not self.checkpoint:
+            return
+        try:
+            self.est.save(self.checkpoint)
+            self.counts["checkpoints"] += 1
+        except OSError as exc:
+            self.counts["checkpoint failures"] += 1
+            self.get_logger().error(f"checkpoint to {self.checkpoint} failed: {exc}", throttle_duration_sec=60.0)
+        self._since_checkpoint = 0
+
+    def close(self) -> None:
+        """Final checkpoint (run_node calls it at shutdown)."""
+        if self._since_checkpoint:
+            self.save()
+
+    def diagnostic_values(self) -> dict[str, Any]:
+        fc = self.est.forecast()
+        values = {**super().diagnostic_values(), **self.counts,
+                  "amplitude_worst_um": f"{1e6 * self.est.amplitude[fc.worst_band]:.3g}",
+                  "days_to_threshold": f"{fc.days_to_threshold:.4g}",
+                  "grinding_due": fc.grinding_due,
+                  "state_age_s": f"{(time.time_ns() - self.est.newest_ns) / 1e9:.0f}" if self.est.newest_ns else "",
+                  "last_grinding": format_iso_ns(self.est.last_grinding_ns) if self.est.last_grinding_ns else ""}
+        values.update({f"survey rejected: {why}": n for why, n in sorted(self.surveys_rejected.items())})
+        return values
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_node(CorrugationEstimatorNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
