@@ -72,7 +72,8 @@ def corrugation_state_msg(est: Any, fc: Any, frame_id: str) -> CorrugationState:
     msg = CorrugationState()
     msg.header.stamp = time_msg(est.newest_ns)
     msg.header.frame_id = frame_id
-    msg.pass_count, msg.axle_pass_count, msg.total_pass_count = est.pass_count, est.axle_pass_count, est.total_pass_count
+    msg.pass_count, msg.axle_pass_count = est.pass_count, est.axle_pass_count
+    msg.total_pass_count = est.total_pass_count
     msg.last_grinding_time = time_msg(est.last_grinding_ns)
     msg.wavelength_m = est.bands.tolist()
     msg.amplitude_m = est.amplitude.tolist()
