@@ -134,3 +134,18 @@ def test_restart_resumes_from_the_checkpoint(ros_context, site, site_values, tmp
     pure.advance(passes)
     np.testing.assert_allclose(probe.states[-1].amplitude_m, pure.amplitude, rtol=1e-12)
     assert probe.states[-1].total_pass_count == 40
+
+
+def test_the_site_file_configures_the_node_through_its_own_section(ros_context, tmp_path):
+    # The shipped file's '/**/corrugation_estimator' section reaches this node (rcl's wildcard match).
+    from conftest import SITE_FILE
+
+    text = SITE_FILE.read_text().replace("advisory_period_s: 60.0", "advisory_period_s: 7.5")
+    text = text.replace("lead_time_days: 60.0", "lead_time_days: 30.0")
+    f = tmp_path / "site.yaml"
+    f.write_text(text)
+    node = CorrugationEstimatorNode(context=ros_context, namespace="/curve_250",
+                                    cli_args=["--ros-args", "--params-file", str(f)])
+    assert node.params["advisory_period_s"] == 7.5 and node.est.cfg["lead_time_days"] == 30.0
+    assert node.site.site_id == "curve_250"
+    node.destroy_node()

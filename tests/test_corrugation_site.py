@@ -212,3 +212,38 @@ def test_bad_configuration_is_refused():
         corrugation_config({"corrugation.shortest_wavelength_m": 2.0, "corrugation.longest_wavelength_m": 1.0})
     with pytest.raises(ConfigError, match=r"corrugation\.k_b\.dyr"):
         corrugation_config({"corrugation.k_b.dyr": 1e-5})
+
+
+def test_predict_corrugation_command(tmp_path, site_, tables):
+    import json
+
+    from conftest import run_cmd
+
+    png = tmp_path / "growth.png"
+    out = run_cmd("rail-monitor", "predict", "corrugation", "--speed-mean", "17", "--speed-cv", "0.05",
+                  "--passes-per-day", "100", "--advise", "--json", "--plot-growth", str(png))
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    est = _estimator(site_, tables)
+    v = 17 * (1 + 0.05 * np.linspace(-3, 3, 121))
+    want = est.evaluate(v, np.exp(-0.5 * ((v - 17) / 0.85) ** 2), FRICTION_DRY, 100.0)
+    assert doc["peak_growth"] == pytest.approx(want.peak_growth, rel=1e-12)
+    assert doc["days_to_threshold"] == pytest.approx(want.days_to_threshold, rel=1e-9)
+    assert len(doc["bands"]) == len(est.bands) and doc["advice"]["grinding_interval_factor"] > 1.0
+    assert png.stat().st_size > 10_000
+    bad = tmp_path / "broken.mcap"
+    bad.write_bytes(b"\x89MCAP0\r\n garbage")
+    out = run_cmd("rail-monitor", "predict", "corrugation", "--history", str(bad))
+    assert out.returncode == 2 and out.stderr.count("\n") == 1 and "Traceback" not in out.stderr
+
+
+def test_running_forecast_sums_match_a_recount_after_pruning(site_, tables, sample):
+    # The forecast keeps running sums over the kept passes (added per pass, removed as passes age
+    # out of the history); they must equal a recount from the kept passes.
+    est = _estimator(site_, tables)
+    for chunk in range(0, 3000, 250):
+        est.advance(sample.take(slice(chunk, chunk + 250)))
+    assert len(est.recent.stamp_ns) < 3000                     # 90 days of history, 28 kept
+    running = est.recent_growth().copy()
+    est._resum()
+    np.testing.assert_allclose(running, est.recent_growth(), rtol=1e-9, atol=1e-18)

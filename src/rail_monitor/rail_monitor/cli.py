@@ -229,6 +229,100 @@ def cmd_predict_squeal(ns: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_predict_corrugation(ns: argparse.Namespace) -> int:
+    import json
+
+    from rail_monitor.corrugation_state import CorrugationEstimator, corrugation_config
+    from rail_monitor.passes import FRICTION_BY_NAME, rejection_reasons, with_class_defaults
+    from rail_monitor.site import load_parameter_file, site_from_values
+
+    values = load_parameter_file(_site_file(ns.site))
+    site = site_from_values(values)
+    est = CorrugationEstimator(site, corrugation_config(values))
+    friction = FRICTION_BY_NAME[ns.friction] if ns.friction else 0
+    if ns.history:
+        from rail_monitor.bagio.reader import read_passes
+
+        table = read_passes(Path(ns.history))
+        ok = rejection_reasons(table, site) == ""
+        est.advance(with_class_defaults(table.take(ok), site))
+        where = f"site {site.site_id}, history {ns.history} ({int(ok.sum())} passes, {int((~ok).sum())} rejected)"
+        if not len(est.recent.stamp_ns):
+            raise RailMonitorError(f"{ns.history}: no valid pass for site {site.site_id}")
+        speeds, weights = est.recent.speed, est.recent.axles.astype(float)
+    else:
+        cls = site.vehicle(ns.vehicle_class or next(iter(site.vehicles)))
+        if ns.speeds:
+            speeds = np.asarray(ns.speeds, float)
+            weights = np.asarray(ns.weights, float) if ns.weights else np.ones_like(speeds)
+            if weights.shape != speeds.shape:
+                raise RailMonitorError("--weights needs one weight per --speeds value")
+        else:
+            mean = ns.speed_mean or cls.speed_mean_mps
+            cv = ns.speed_cv if ns.speed_cv is not None else cls.speed_sd_mps / cls.speed_mean_mps
+            speeds = mean * (1 + cv * np.linspace(-3, 3, 121)) if cv > 0 else np.array([mean])
+            weights = np.exp(-0.5 * ((speeds - mean) / (mean * cv)) ** 2) if cv > 0 else np.ones(1)
+        friction = friction or FRICTION_BY_NAME["dry"]
+        where = f"site {site.site_id}, post-grinding rail, {ns.friction or 'dry'}"
+    try:
+        ev = est.evaluate(speeds, weights, friction, ns.passes_per_day or 0.0)
+        advice = est.advise(None if ns.history and not ns.friction else speeds, weights, friction) \
+            if ns.advise else None
+    except ValueError as exc:
+        raise RailMonitorError(str(exc)) from None
+    fc = est.forecast(est.growth_at_speeds(speeds, friction) @ (weights / weights.sum()), ns.passes_per_day)
+    rows = [{"wavelength_m": float(est.bands[i]), "growth_per_axle_pass": float(ev.growth_per_axle_pass[i]),
+             "amplitude_m": float(est.amplitude[i]), "threshold_m": float(est.threshold[i])}
+            for i in range(len(est.bands))]
+    summary = {"where": where, "peak_growth": ev.peak_growth, "peak_wavelength_m": ev.peak_wavelength_m,
+               "worst_wavelength_m": float(est.bands[fc.worst_band]), "passes_to_threshold": fc.passes_to_threshold,
+               "days_to_threshold": fc.days_to_threshold, "passes_per_day": fc.passes_per_day,
+               "k_b_by_friction": est.k_b.tolist()}
+    if advice is not None:
+        summary["advice"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in vars(advice).items()}
+    if ns.json:
+        print(json.dumps({**summary, "bands": rows}, indent=1, default=lambda x: None))
+    else:
+        print(f"# {where}; K_b {', '.join(f'{k:.3g}' for k in est.k_b)} (dry, wet, modifier, contaminated)")
+        print(f"{'lambda [mm]':>11} {'g [1/axle]':>11} {'Z [um]':>8} {'limit [um]':>10}")
+        for r in rows:
+            print(f"{1e3 * r['wavelength_m']:11.1f} {r['growth_per_axle_pass']:11.3e} {1e6 * r['amplitude_m']:8.3f} "
+                  f"{1e6 * r['threshold_m']:10.3f}")
+        print(f"peak g {ev.peak_growth:.3e} per axle pass at {1e3 * ev.peak_wavelength_m:.1f} mm; worst band "
+              f"{1e3 * est.bands[fc.worst_band]:.1f} mm reaches its limit in {fc.passes_to_threshold:.4g} train passes"
+              f" = {fc.days_to_threshold:.4g} days at {fc.passes_per_day:.4g} passes/day")
+        if advice is not None:
+            used = advice.recommended_probability > 1e-6
+            mix = zip(advice.speed_bin_centres_mps[used], advice.recommended_probability[used], strict=True)
+            factor = advice.grinding_interval_factor
+            print(f"advice: same mean {advice.mean_speed_mps:.2f} m/s, speeds "
+                  + ", ".join(f"{v:.2f} ({100 * p:.0f} %)" for v, p in mix)
+                  + f"; peak growth -{100 * advice.peak_growth_reduction:.0f} %, grinding interval x{factor:.2f}, "
+                  f"grinding cost -{100 * (1 - 1 / factor):.0f} %")
+    if ns.plot_receptance:
+        from rail_monitor.models import track as tr
+        from rail_monitor.plots import track_receptance
+
+        f = np.geomspace(20.0, 5000.0, 600)
+        mid, above = tr.discrete_receptance(f, site.track, position=np.array([0.5, 0.0])).T
+        curves = {"continuous, Timoshenko": tr.continuous_receptance(f, site.track),
+                  "continuous, Euler": tr.continuous_receptance(f, site.track, "euler"),
+                  "discrete, mid-span": mid, "discrete, above a sleeper": above,
+                  f"wheel ({site.vehicle(next(iter(site.vehicles))).unsprung_mass_kg:g} kg)":
+                      tr.wheel_receptance(f, site.vehicle(next(iter(site.vehicles))).unsprung_mass_kg)}
+        print(f"plot: {track_receptance(f, curves, ns.plot_receptance, title=f'track of {site.site_id}')}",
+              file=sys.stderr)
+    if ns.plot_growth:
+        from rail_monitor.plots import corrugation_growth
+
+        curves = {"current speeds": ev.growth_per_axle_pass}
+        if advice is not None:
+            curves["advised speeds"] = est.evaluate(advice.speed_bin_centres_mps, advice.recommended_probability,
+                                                    friction).growth_per_axle_pass
+        print(f"plot: {corrugation_growth(est.bands, curves, ns.plot_growth, title=where)}", file=sys.stderr)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from rail_monitor.models.squeal import K3_CONVENTIONS
     from rail_monitor.nodes.mcap_recorder import RECORDER_SPECS
@@ -291,6 +385,26 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--json", action="store_true", help="print JSON instead of a table")
     q.add_argument("--plot", help="save amplitude and relative level against Vc to this PNG")
     q.set_defaults(func=cmd_predict_squeal)
+
+    c = models.add_parser("corrugation", help="corrugation growth per wavelength band, time to the grinding "
+                          "threshold, and speed advice", formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    c.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    g = c.add_mutually_exclusive_group()
+    g.add_argument("--history", help="pass history (bag folder, .mcap, .db3 or .csv): state, speeds and traffic "
+                   "from it")
+    g.add_argument("--speeds", type=float, nargs="+", help="speed histogram bin centres [m/s]")
+    c.add_argument("--weights", type=float, nargs="+", help="weights of --speeds (default: equal)")
+    c.add_argument("--vehicle-class", help="vehicle class without --history (default: the site's first)")
+    c.add_argument("--speed-mean", type=float, help="mean speed of a normal distribution [m/s] (default: the class's)")
+    c.add_argument("--speed-cv", type=float, help="its coefficient of variation [-] (default: the class's sd/mean)")
+    c.add_argument("--friction", choices=tuple(FRICTION_BY_NAME),
+                   help="friction state (default: dry, or the history's mix)")
+    c.add_argument("--passes-per-day", type=float, help="train passes per day (default: the history's)")
+    c.add_argument("--advise", action="store_true", help="also propose a speed distribution with the same mean")
+    c.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    c.add_argument("--plot-receptance", metavar="PNG", help="save the track and wheel receptances to this PNG")
+    c.add_argument("--plot-growth", metavar="PNG", help="save growth against wavelength (current and advised)")
+    c.set_defaults(func=cmd_predict_corrugation)
 
     for name, helptext in (("monitor", "run the whole graph in one process on a history"),
                            ("demo", "the main job: the bundled sample history through the whole graph")):

@@ -245,6 +245,9 @@ class CorrugationEstimator:
         self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
         self.recent = _Recent()
         self._seen: set[tuple[int, str]] = set()
+        # Running sums over the kept passes of axles x per-axle growth, and of axles (forecast).
+        self._growth_sum = np.zeros_like(self.log_components)
+        self._axle_sum = 0
 
     # -- passes ---------------------------------------------------------------------------------
     def advance(self, passes: PassTable) -> np.ndarray:
@@ -270,6 +273,8 @@ class CorrugationEstimator:
         growth = self.tables.at(cls, new.friction_state, new.speed_mps) * new.axle_count[:, None, None]
         # Sequential sum (cumsum), so a batch adds as the same passes one by one would.
         self.log_components = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[-1]
+        self._growth_sum += growth.sum(axis=0)
+        self._axle_sum += int(new.axle_count.sum())
         m = int(counted.sum())
         self.pass_count += m
         self.total_pass_count += m
@@ -283,8 +288,20 @@ class CorrugationEstimator:
     def _prune(self) -> None:
         keep = self.recent.stamp_ns >= self.newest_ns - self.history_ns
         if not keep.all():
-            self.recent.keep(keep)
-            self._seen = set(zip(self.recent.stamp_ns.tolist(), self.recent.train_id.tolist(), strict=True))
+            r = self.recent
+            gone = ~keep
+            self._growth_sum -= np.einsum("n,nbp->bp", r.axles[gone], self.tables.at(r.class_idx[gone],
+                                                                                     r.friction[gone], r.speed[gone]))
+            self._axle_sum -= int(r.axles[gone].sum())
+            self._seen.difference_update(zip(r.stamp_ns[gone].tolist(), r.train_id[gone].tolist(), strict=True))
+            r.keep(keep)
+
+    def _resum(self) -> None:
+        """Recompute the running sums from the kept passes (after K_b changes or a load)."""
+        r = self.recent
+        self._growth_sum = np.einsum("n,nbp->bp", r.axles, self.tables.at(r.class_idx, r.friction, r.speed)) \
+            if len(r.stamp_ns) else np.zeros_like(self.log_components)
+        self._axle_sum = int(r.axles.sum())
 
     # -- forecast -------------------------------------------------------------------------------
     def _flat(self, band_rms: np.ndarray) -> np.ndarray:
@@ -293,11 +310,9 @@ class CorrugationEstimator:
 
     def recent_growth(self) -> np.ndarray:
         """g per component (B, P) [1/axle pass]: the kept passes' growth, averaged per axle pass."""
-        r = self.recent
-        if len(r.stamp_ns) == 0:
+        if self._axle_sum == 0:
             return np.zeros((len(self.bands), self.points))
-        per_axle = self.tables.at(r.class_idx, r.friction, r.speed)
-        return np.einsum("n,nbp->bp", r.axles, per_axle) / r.axles.sum()
+        return self._growth_sum / self._axle_sum
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic: (train passes per day, axles per train); NaN rate with fewer than 2 passes."""
@@ -372,6 +387,7 @@ class CorrugationEstimator:
             if s > 0:
                 scale = s
                 self.tables.set_k_b(self.tables.k_b * s)
+                self._resum()
         self.log_components[matched] += (np.log(z[matched]) - self.log_amplitude[matched])[:, None]
         self.survey_log_amplitude = np.where(matched, np.log(np.where(matched, z, 1.0)), np.nan)
         self.last_survey_ns = max(self.last_survey_ns, int(stamp_ns))
@@ -450,25 +466,36 @@ class CorrugationEstimator:
         return Evaluation(band_g, peak, float(self.bands[int(np.argmax(band_g))]),
                           float(current / peak) if peak > 0 else float("inf"), fc.days_to_threshold)
 
-    def advise(self) -> Advice:
-        """The distribution of the recent mean speed, within the advice limits, with the least peak g."""
+    def advise(self, speeds: np.ndarray | None = None, weights: np.ndarray | None = None,
+               friction_state: int = 0) -> Advice:
+        """The distribution with the current mean speed, within the advice limits, with the least peak g.
+
+        Current distribution: the recent passes (axle-weighted), or the given speeds [m/s] with
+        weights; the traffic mix is the recent one unless friction_state fixes it.
+        """
         r = self.recent
-        if len(r.stamp_ns) == 0:
-            raise ValueError("no recent passes to advise on")
+        recent = speeds is None
+        if recent:
+            if len(r.stamp_ns) == 0:
+                raise ValueError("no recent passes to advise on")
+            speeds, weights = r.speed, r.axles.astype(float)
+        v = np.asarray(speeds, float)
+        w = np.ones_like(v) if weights is None else np.asarray(weights, float)
         vs = self.site.vehicles.values()
         lo = self.cfg["advice_min_speed_mps"] or min(v.speed_min_mps for v in vs)
         hi = self.cfg["advice_max_speed_mps"] or max(v.speed_max_mps for v in vs)
         width = self.cfg["advice_bin_mps"]
         edges = np.arange(lo, hi + 0.5 * width, width)
         centres = 0.5 * (edges[:-1] + edges[1:])
-        current_p = np.histogram(np.clip(r.speed, lo, hi), edges, weights=r.axles.astype(float))[0]
+        current_p = np.histogram(np.clip(v, lo, hi), edges, weights=w)[0]
         current_p /= current_p.sum()
-        mean = float(np.average(r.speed, weights=r.axles))
-        mean = float(np.clip(mean, centres[0], centres[-1]))
-        grid = self.growth_at_speeds(centres)
+        mean = float(np.clip(np.average(v, weights=w), centres[0], centres[-1]))
+        grid = self.growth_at_speeds(centres, friction_state)
         best = cg.optimise_speed_distribution(grid.reshape(-1, len(centres)), centres, mean,
                                               self.cfg["advice_max_share"])
-        g_now = self.recent_growth().max(axis=1)
+        # Each recent pass with its own class and friction; a given distribution with the mix.
+        g_now = (self.recent_growth() if recent and not friction_state
+                 else self.growth_at_speeds(v, friction_state) @ (w / w.sum())).max(axis=1)
         cur_peak = float(g_now.max())
         rec = min(best.peak_growth, cur_peak)
         return Advice(mean, float(lo), float(hi), centres, current_p, best.probability, cur_peak, rec,
@@ -524,3 +551,4 @@ class CorrugationEstimator:
         self.recent = _Recent(**{n: data[f"recent_{n}"] for n in _RECENT})
         self.recent.train_id = self.recent.train_id.astype(object)
         self._seen = set(zip(self.recent.stamp_ns.tolist(), self.recent.train_id.tolist(), strict=True))
+        self._resum()

@@ -35,8 +35,45 @@ def squeal_sweep(rows: dict[str, np.ndarray], path: str | Path, title: str = "")
     ax2.grid(True, alpha=0.3)
     if title:
         ax1.set_title(title)
+    return _save(fig, path)
+
+
+def _save(fig, path: str | Path) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def track_receptance(frequency: np.ndarray, curves: dict[str, np.ndarray], path: str | Path, title: str = "") -> Path:
+    """Magnitude and phase of vertical receptances [m/N] against frequency [Hz] (log-log)."""
+    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.0), constrained_layout=True)
+    for label, r in curves.items():
+        ax1.loglog(frequency, np.abs(r), label=label)
+        ax2.semilogx(frequency, np.degrees(np.angle(r)), label=label)
+    ax1.set_ylabel("|receptance| [m/N]")
+    ax1.legend(loc="lower left", fontsize="small")
+    ax2.set_ylabel("phase [deg]")
+    ax2.set_xlabel("frequency [Hz]")
+    for ax in (ax1, ax2):
+        ax.grid(True, which="both", alpha=0.3)
+    if title:
+        ax1.set_title(title)
+    return _save(fig, path)
+
+
+def corrugation_growth(wavelength: np.ndarray, curves: dict[str, np.ndarray], path: str | Path,
+                       title: str = "") -> Path:
+    """Growth per axle pass g [1/axle pass] against wavelength [m], one curve per speed distribution."""
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), constrained_layout=True)
+    for label, g in curves.items():
+        ax.semilogx(1e3 * wavelength, g, "o-", ms=3, label=label)
+    ax.axhline(0.0, color="grey", lw=0.8)
+    ax.set_xlabel("wavelength [mm]")
+    ax.set_ylabel("growth g per axle pass [-]")
+    ax.legend(fontsize="small")
+    ax.grid(True, which="both", alpha=0.3)
+    if title:
+        ax.set_title(title)
+    return _save(fig, path)
