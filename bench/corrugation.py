@@ -13,20 +13,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+from timing import best_of
 
 from rail_monitor.corrugation_state import CorrugationEstimator, GrowthTables, _rail_receptance, corrugation_config
 from rail_monitor.passes import PassTable, with_class_defaults
 from rail_monitor.site import load_parameter_file, site_from_values
-
-
-def best_of(fn, repeat: int = 5) -> float:
-    """Shortest wall time of repeat calls [s] (the least disturbed by other load)."""
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 def passes(site, n: int, seed: int = 1, start: int = 0) -> PassTable:

@@ -11,21 +11,12 @@ import platform
 import time
 
 import numpy as np
+from timing import best_of
 
 from rail_monitor import squeal_risk
 from rail_monitor.models import squeal
 from rail_monitor.passes import PassTable, with_class_defaults
 from rail_monitor.site import load_parameter_file, site_from_values
-
-
-def best_of(fn, repeat: int = 5) -> float:
-    """Shortest wall time of repeat calls [s] (the least disturbed by other load)."""
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 def main() -> None:

@@ -34,7 +34,7 @@ from rail_monitor.errors import ConfigError
 from rail_monitor.models import corrugation as cg
 from rail_monitor.models import track as tr
 from rail_monitor.models.contact_filter import hertzian_line_filter
-from rail_monitor.params import ParamSpec, resolve
+from rail_monitor.params import ParamSpec, ParamValues, resolve, section
 from rail_monitor.passes import FRICTION_NAMES, MAX_SPEED_MPS, PassTable
 from rail_monitor.site import Site
 
@@ -75,13 +75,8 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
 
 
 @dataclass(frozen=True)
-class CorrugationConfig:
+class CorrugationConfig(ParamValues):
     """The site's corrugation parameters (names and units as in CORRUGATION_SPECS)."""
-
-    values: Mapping[str, Any]
-
-    def __getitem__(self, key: str) -> Any:
-        return self.values[key]
 
     @property
     def k_b(self) -> np.ndarray:
@@ -91,8 +86,7 @@ class CorrugationConfig:
 
 def corrugation_config(values: Mapping[str, Any], prefix: str = "corrugation.") -> CorrugationConfig:
     """Checked corrugation parameters from flat parameter values (keys under prefix)."""
-    sub = {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
-    out = resolve(CORRUGATION_SPECS, sub, where=prefix, strict=True)
+    out = resolve(CORRUGATION_SPECS, section(values, prefix), where=prefix, strict=True)
     if out["shortest_wavelength_m"] >= out["longest_wavelength_m"]:
         raise ConfigError(f"parameter '{prefix}shortest_wavelength_m' must be below '{prefix}longest_wavelength_m'")
     if out["advice_max_speed_mps"] and out["advice_min_speed_mps"] >= out["advice_max_speed_mps"]:

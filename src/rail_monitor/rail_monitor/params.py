@@ -86,6 +86,21 @@ def resolve(specs: Sequence[ParamSpec], values: Mapping[str, Any], where: str = 
     return {s.name: s.check(values[s.name], where) if s.name in values else s.default for s in specs}
 
 
+def section(values: Mapping[str, Any], prefix: str) -> dict[str, Any]:
+    """The values under a dotted prefix (e.g. 'squeal.'), with the prefix taken off their names."""
+    return {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
+
+
+@dataclass(frozen=True)
+class ParamValues:
+    """Checked values of one parameter section, by spec name (``cfg["name"]``)."""
+
+    values: Mapping[str, Any]
+
+    def __getitem__(self, key: str) -> Any:
+        return self.values[key]
+
+
 def flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     """Flatten a nested YAML mapping into dotted names, as ROS 2 parameter files do."""
     flat: dict[str, Any] = {}

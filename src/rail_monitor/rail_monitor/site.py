@@ -19,7 +19,7 @@ import yaml
 from rail_monitor.errors import ConfigError
 from rail_monitor.models import hertz
 from rail_monitor.models.track import Track
-from rail_monitor.params import ParamSpec, flatten, resolve
+from rail_monitor.params import ParamSpec, flatten, resolve, section
 
 BRAKE_TYPES = ("cast_iron", "composite", "disc")
 
@@ -142,21 +142,17 @@ def site_from_values(values: Mapping[str, Any]) -> Site:
     vehicles = {}
     for name in top["vehicle_classes"]:
         prefix = f"vehicle.{name}."
-        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, _section(values, prefix), where=prefix))
+        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, section(values, prefix), where=prefix))
         if v.vehicles_min > v.vehicles_max or v.speed_min_mps > v.speed_max_mps:
             raise ConfigError(f"vehicle class {name!r}: a minimum exceeds its maximum (vehicles or speed)")
         vehicles[name] = v
     if not vehicles:
         raise ConfigError("parameter 'vehicle_classes' names no vehicle class")
     return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles,
-                contact=ContactGeometry(**resolve(CONTACT_SPECS, _section(values, "contact."), "contact.",
+                contact=ContactGeometry(**resolve(CONTACT_SPECS, section(values, "contact."), "contact.",
                                                   strict=True)),
-                track=Track(**resolve(TRACK_SPECS, _section(values, "track."), "track.", strict=True)))
+                track=Track(**resolve(TRACK_SPECS, section(values, "track."), "track.", strict=True)))
 
-
-def _section(values: Mapping[str, Any], prefix: str) -> dict[str, Any]:
-    """The values under prefix, with the prefix taken off their names."""
-    return {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
 
 
 def load_parameter_file(path: str | Path) -> dict[str, Any]:

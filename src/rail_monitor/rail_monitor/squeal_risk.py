@@ -20,7 +20,7 @@ import numpy as np
 
 from rail_monitor.errors import ConfigError
 from rail_monitor.models import hertz, squeal
-from rail_monitor.params import ParamSpec, resolve
+from rail_monitor.params import ParamSpec, ParamValues, resolve, section
 from rail_monitor.passes import FRICTION_MODIFIER, FRICTION_NAMES, PassTable
 from rail_monitor.site import Site
 
@@ -71,13 +71,8 @@ SQUEAL_SPECS: tuple[ParamSpec, ...] = (
 
 
 @dataclass(frozen=True)
-class SquealConfig:
+class SquealConfig(ParamValues):
     """The site's squeal parameters (names and units as in SQUEAL_SPECS)."""
-
-    values: Mapping[str, Any]
-
-    def __getitem__(self, key: str) -> Any:
-        return self.values[key]
 
     def creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """k1, k2 [-] per pass for TrainPass.FRICTION_* values."""
@@ -91,8 +86,7 @@ class SquealConfig:
 
 def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealConfig:
     """Checked squeal parameters from flat parameter values (keys under prefix)."""
-    sub = {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
-    values = resolve(SQUEAL_SPECS, sub, where=prefix, strict=True)
+    values = resolve(SQUEAL_SPECS, section(values, prefix), where=prefix, strict=True)
     if values["risk_high_dba"] < values["risk_medium_dba"]:
         raise ConfigError(f"parameter '{prefix}risk_high_dba' must not be below '{prefix}risk_medium_dba'")
     return SquealConfig(values)
