@@ -27,9 +27,15 @@ def generate_launch_description() -> LaunchDescription:
         DeclareLaunchArgument("output", default_value="", description="bag folder to record into"),
         DeclareLaunchArgument("rate", default_value="0.0",
                               description="replay speed: 0 as fast as the graph takes it, 1 recorded timing"),
+        DeclareLaunchArgument("checkpoint", default_value="",
+                              description="corrugation state file to resume from and checkpoint to ('' : none)"),
         Node(package="rail_monitor", executable="mcap_recorder", namespace=ns,
              parameters=[site, common, {"output": LaunchConfiguration("output")}]),
+        Node(package="rail_monitor", executable="squeal_risk_model", namespace=ns, parameters=[site, common]),
+        Node(package="rail_monitor", executable="corrugation_estimator", namespace=ns,
+             parameters=[site, common, {"checkpoint_path": LaunchConfiguration("checkpoint")}]),
+        # The replayer starts once the recorder and both models subscribe, so no pass is lost.
         Node(package="rail_monitor", executable="pass_replayer", namespace=ns,
              parameters=[site, {"source": LaunchConfiguration("source"), "rate": LaunchConfiguration("rate"),
-                                "wait_for_subscribers": 1}]),
+                                "wait_for_subscribers": 3}]),
     ])
