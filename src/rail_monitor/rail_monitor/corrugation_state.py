@@ -120,7 +120,7 @@ class GrowthTables:
         self.speeds = np.arange(1, round(MAX_SPEED_MPS / SPEED_STEP_MPS) + 1) * SPEED_STEP_MPS
         sub = cg.band_sub_wavelengths(self.bands, cfg["points_per_band"])
         f_rail, r_rail = _rail_receptance(site.track)
-        kernels, self.contact_stiffness, self.semi_length = [], [], []
+        kernels = []
         for name in self.classes:
             v = site.vehicle(name)
             patch = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
@@ -129,8 +129,6 @@ class GrowthTables:
             freq = self.speeds[None, :, None] / sub[:, None, :]
             filt = hertzian_line_filter(sub, a)[:, None, :]
             kernels.append(filt * filt * _interp_log(freq, f_rail, h))
-            self.contact_stiffness.append(kc)
-            self.semi_length.append(a)
         self.filtered_kernel = np.stack(kernels)          # (C, B, V, P)
         self.table = np.empty(0)
         self.k_b = np.full(4, np.nan)
@@ -330,8 +328,7 @@ class CorrugationEstimator:
         if passes_per_day:
             rate = passes_per_day
         if not np.isfinite(axles):
-            axles = float(np.mean([v.axles_per_vehicle * (v.vehicles_min + v.vehicles_max) / 2
-                                   for v in self.site.vehicles.values()]))
+            axles = float(np.mean([v.mean_axles_per_train for v in self.site.vehicles.values()]))
         margin = np.log(self.threshold) - self.log_amplitude
         axle_passes = cg.passes_to_band_level(self.log_components, g, np.log(self.threshold))
         worst = int(np.argmin(axle_passes)) if np.isfinite(axle_passes).any() else int(np.argmin(margin))
@@ -375,7 +372,7 @@ class CorrugationEstimator:
         scale = None
         both = matched & np.isfinite(self.survey_log_amplitude)
         dm = self.log_amplitude[both] - self.survey_log_amplitude[both]
-        if both.any() and self.axle_pass_count and np.dot(dm, dm) > 0:
+        if both.any() and np.dot(dm, dm) > 0:  # no passes since the last survey: nothing to fit
             measured = np.log(z[both]) - self.survey_log_amplitude[both]
             s = float(np.dot(measured, dm) / np.dot(dm, dm))
             if s > 0:
@@ -428,7 +425,7 @@ class CorrugationEstimator:
             vs = [self.site.vehicle(c) for c in self.tables.classes]
             cls = np.arange(len(vs))
             fr = np.ones(len(vs), np.int64)
-            weight = np.array([v.traffic_share * v.axles_per_vehicle * (v.vehicles_min + v.vehicles_max) for v in vs])
+            weight = np.array([v.traffic_share * v.mean_axles_per_train for v in vs])
         if friction_state:
             fr = np.full_like(fr, friction_state)
         return cls, fr, weight / weight.sum()
@@ -475,9 +472,9 @@ class CorrugationEstimator:
             speeds, weights = r.speed, r.axles.astype(float)
         v = np.asarray(speeds, float)
         w = np.ones_like(v) if weights is None else np.asarray(weights, float)
-        vs = self.site.vehicles.values()
-        lo = self.cfg["advice_min_speed_mps"] or min(v.speed_min_mps for v in vs)
-        hi = self.cfg["advice_max_speed_mps"] or max(v.speed_max_mps for v in vs)
+        classes = self.site.vehicles.values()
+        lo = self.cfg["advice_min_speed_mps"] or min(c.speed_min_mps for c in classes)
+        hi = self.cfg["advice_max_speed_mps"] or max(c.speed_max_mps for c in classes)
         width = self.cfg["advice_bin_mps"]
         edges = np.arange(lo, hi + 0.5 * width, width)
         centres = 0.5 * (edges[:-1] + edges[1:])

@@ -99,6 +99,11 @@ class VehicleClass:
     speed_min_mps: float
     speed_max_mps: float
 
+    @property
+    def mean_axles_per_train(self) -> float:
+        """Axles of a consist of the mean length (vehicles_min to vehicles_max) [-]."""
+        return self.axles_per_vehicle * (self.vehicles_min + self.vehicles_max) / 2
+
 
 @dataclass(frozen=True)
 class ContactGeometry:
