@@ -8,6 +8,7 @@ setup(
     name=package_name,
     version="0.1.0",
     packages=find_packages(exclude=["test", "tests"]),
+    package_data={package_name: ["data/*.csv"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
         (f"share/{package_name}", ["package.xml"]),
@@ -27,6 +28,7 @@ setup(
             "mcap_recorder = rail_monitor.nodes.mcap_recorder:main",
             "squeal_risk_model = rail_monitor.nodes.squeal_risk_model:main",
             "corrugation_estimator = rail_monitor.nodes.corrugation_estimator:main",
+            "rolling_noise_predictor = rail_monitor.nodes.rolling_noise_predictor:main",
             "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
             "rail-monitor = rail_monitor.cli:main",
         ],

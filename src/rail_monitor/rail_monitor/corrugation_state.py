@@ -40,7 +40,8 @@ from rail_monitor.site import Site
 
 NS_PER_DAY = 86_400 * 10**9
 SPEED_STEP_MPS = 0.1          # speed grid of the growth tables [m/s]
-CHECKPOINT_VERSION = 1
+CHECKPOINT_VERSION = 2
+READABLE_VERSIONS = (1, 2)  # 1: before grinding_amplitude (read as the post-grinding default)
 
 # K_b per friction state [-/axle pass]. MODELS.md section 2: K_b of order 1e-5 (1 nm of wear per
 # pass at 75 kN, k_c = 1.3e9 N/m) for dry rail in partial slip. The wear that drives growth scales
@@ -231,6 +232,7 @@ class CorrugationEstimator:
         self.history_ns = int(cfg["history_days"] * NS_PER_DAY)
         self.points = cfg["points_per_band"]
         self.log_components = self._flat(self.post_grinding)
+        self.grinding_amplitude = self.post_grinding.copy()             # r.m.s. after the last grinding
         self.pass_count = self.axle_pass_count = self.total_pass_count = 0
         self.last_grinding_ns = self.newest_ns = 0
         self.last_survey_ns = 0                                        # last survey or grinding applied
@@ -394,6 +396,7 @@ class CorrugationEstimator:
             rms[matched] = z[matched]
             self.survey_log_amplitude[matched] = np.log(z[matched])
         self.log_components = self._flat(rms)
+        self.grinding_amplitude = rms
         self.pass_count = self.axle_pass_count = 0
         self.last_grinding_ns = int(stamp_ns)
         self.last_survey_ns = max(self.last_survey_ns, int(stamp_ns))
@@ -504,6 +507,7 @@ class CorrugationEstimator:
         buf = io.BytesIO()
         np.savez(buf, meta=np.array(json.dumps(meta)), bands=self.bands, log_components=self.log_components,
                  k_b=self.k_b, survey_log_amplitude=self.survey_log_amplitude,
+                 grinding_amplitude=self.grinding_amplitude,
                  **{f"recent_{n}": self.recent.train_id.astype(str) if n == "train_id" else getattr(self.recent, n)
                     for n in _RECENT})
         tmp = path.with_name(f".{path.name}.tmp")
@@ -527,7 +531,7 @@ class CorrugationEstimator:
             meta = json.loads(str(data["meta"]))
         except (OSError, ValueError, KeyError) as exc:
             raise ConfigError(f"{path}: not a corrugation checkpoint: {str(exc).splitlines()[0]}") from None
-        if meta.get("version") != CHECKPOINT_VERSION or meta.get("site_id") != self.site.site_id:
+        if meta.get("version") not in READABLE_VERSIONS or meta.get("site_id") != self.site.site_id:
             raise ConfigError(f"{path}: checkpoint of site {meta.get('site_id')!r} version {meta.get('version')}, "
                               f"not of site {self.site.site_id!r} version {CHECKPOINT_VERSION}")
         if data["bands"].shape != self.bands.shape or not np.allclose(data["bands"], self.bands) \
@@ -536,6 +540,7 @@ class CorrugationEstimator:
         self.log_components = data["log_components"].astype(float)
         self.tables.set_k_b(data["k_b"])
         self.survey_log_amplitude = data["survey_log_amplitude"].astype(float)
+        self.grinding_amplitude = data.get("grinding_amplitude", self.post_grinding).astype(float)
         for key in ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns",
                     "last_survey_ns"):
             setattr(self, key, int(meta[key]))

@@ -83,11 +83,16 @@ class Track:
 
 def support_stiffness(frequency: ArrayLike, track: Track) -> ComplexArray:
     """Dynamic stiffness K [N/m] of one rail seat (pad, half-sleeper mass, ballast) at frequency [Hz]."""
+    kp, lower = _seat(frequency, track)
+    return kp * lower / (kp + lower)
+
+
+def _seat(frequency: ArrayLike, track: Track) -> tuple[complex, ComplexArray]:
+    """Pad stiffness k_p* and the stiffness under it, k_b* - m_s w^2 [N/m], of one rail seat."""
     w2 = (2 * np.pi * np.asarray(frequency, float)) ** 2
     kp = track.pad_stiffness_npm * (1 + 1j * track.pad_loss_factor)
     kb = track.ballast_stiffness_npm * (1 + 1j * track.ballast_loss_factor)
-    lower = kb - track.sleeper_mass_kg * w2
-    return kp * lower / (kp + lower)
+    return kp, kb - track.sleeper_mass_kg * w2
 
 
 def _poles(w: NDArray[np.float64], s: ComplexArray, track: Track, beam: str) -> tuple[ComplexArray, ...]:
@@ -131,6 +136,27 @@ def continuous_receptance(frequency: ArrayLike, track: Track, beam: str = "timos
     w = 2 * np.pi * f
     s = support_stiffness(f, track) / track.sleeper_spacing_m
     return _green(distance, _poles(w, s, track, beam))
+
+
+def decay_rate(frequency: ArrayLike, track: Track, beam: str = "timoshenko") -> NDArray[np.float64]:
+    """Track decay rate [dB/m] of the continuous model: 20 lg(e) Im(k) of its propagating wave.
+
+    Of the two wavenumbers, the propagating one has the smaller Im(k) (the other is the near field
+    or, above the cut-on, the second wave). The squared vibration of a rail excited at x = 0
+    falls as exp(-2 Im(k) |x|), so its integral along the rail is |v0|^2 / Im(k) (Thompson,
+    Railway Noise and Vibration, Elsevier 2009, section 5.6: the effective radiating length of
+    the rail, 2 x 4.343 / decay rate).
+    """
+    f = np.asarray(frequency, float)
+    s = support_stiffness(f, track) / track.sleeper_spacing_m
+    k1, k2, _, _ = _poles(2 * np.pi * f, s, track, beam)
+    return 20.0 * np.log10(np.e) * np.minimum(k1.imag, k2.imag)
+
+
+def sleeper_transmissibility(frequency: ArrayLike, track: Track) -> ComplexArray:
+    """Half-sleeper over rail displacement [-] at a rail seat: k_p* / (k_p* + k_b* - m_s w^2)."""
+    kp, lower = _seat(frequency, track)
+    return kp / (kp + lower)
 
 
 def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", position: ArrayLike = 0.5,

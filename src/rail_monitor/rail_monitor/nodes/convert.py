@@ -79,6 +79,7 @@ def corrugation_state_msg(est: Any, fc: Any, frame_id: str) -> CorrugationState:
     msg.amplitude_m = est.amplitude.tolist()
     msg.growth_per_axle_pass = fc.growth_per_axle_pass.tolist()
     msg.threshold_m = est.threshold.tolist()
+    msg.post_grinding_m = est.grinding_amplitude.tolist()
     msg.worst_band = fc.worst_band
     msg.worst_wavelength_m = float(est.bands[fc.worst_band])
     msg.passes_to_threshold = float(fc.passes_to_threshold)

@@ -1,0 +1,289 @@
+"""CNOSSOS-EU railway source model: rolling, impact, bridge and curve-squeal sound power.
+
+Commission Directive (EU) 2015/996, Annex II section 2.3 (the source model for railway
+traffic), corrected by the corrigendum of OJ L 5, 10.1.2018 (f = v / lambda with v in m/s), as
+amended by Commission Delegated Directive (EU) 2021/1226 (new Tables G-1b, G-2, G-3a, G-4 and
+G-7). The tables of Appendix G are the package's data files ``data/cnossos_eu_2021_*.csv``
+(edition 2021, with their citation). Equation numbers are the Directive's.
+
+Per 1/3-octave band i (24 bands, nominal 50 Hz to 10 kHz), for one vehicle of N_ax axles:
+
+    L_R,TOT(lambda) = 10 lg(10^(L_r,TR/10) + 10^(L_r,VEH/10)) + A_3(lambda)       (2.3.6)
+    L_W,0,TR,i      = L_R,TOT,i + L_H,TR,i + 10 lg N_ax                          (2.3.7)
+    L_W,0,VEH,i     = L_R,TOT,i + L_H,VEH,i + 10 lg N_ax                         (2.3.8)
+    L_W,0,VEH,SUP,i = L_R,TOT,i + L_H,VEH,SUP,i + 10 lg N_ax                     (2.3.9)
+
+L_R,TOT,i is the wavelength spectrum read at lambda = v / f_i (v in m/s, f_i the nominal band
+centre). The Directive says only that the tables are "averaged energetically and
+proportionally"; two rules are offered (``INTERPOLATION_RULES``):
+
+* ``reference`` (default), the European reference module's: the dB values interpolated
+  linearly in wavelength, end values held outside the table;
+* ``energy_log_frequency``: energy (10^(L/10)) interpolated linearly against lg(lambda), that
+  is against lg(f), end values held.
+
+Impact noise adds the joint roughness to L_R,TOT in energy: L_R,IMPACT = L_R,IMPACT-SINGLE +
+10 lg(n_l / 0.01), n_l joints per metre (2.3.10-2.3.11). A bridge adds L_R,TOT + L_H,BRIDGE +
+10 lg N_ax (2.3.14). Curve squeal adds 8 dB to the rolling-noise power for R <= 300 m and 5 dB
+for 300 m < R <= 500 m (2.3.2, "squeal"). Directivity: horizontal 10 lg(0.01 + 0.99 sin^2 phi)
+(2.3.15); vertical, for source A (h = 1) above the source, 40/3 [2/3 sin(2 psi) - sin psi]
+lg((f + 600) / 200) (2.3.16). Sound power per metre of line for a flow of Q
+vehicles per hour at v km/h: L_W',eq,line = L_W,0,dir + 10 lg(Q / (1000 v)) (2.3.1).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rail_monitor.models.iec61260 import band_index
+from rail_monitor.models.levels import level, power
+
+FloatArray = NDArray[np.float64]
+
+EDITION = "2021"
+INTERPOLATION_RULES = ("reference", "energy_log_frequency")
+RAIL_ROUGHNESS_CLASSES = ("E", "M")
+BRAKE_COLUMNS = {"cast_iron": "cast_iron", "composite": "composite", "disc": "disc"}
+SLEEPER_TYPES = ("monoblock", "biblock", "wooden", "direct_fastening")
+PAD_CLASSES = ("soft", "medium", "hard")
+BRIDGE_TYPES = ("none", "concrete", "steel")
+# Table G-3a pad classes by dynamic stiffness [N/m]: soft 150-250, medium 250-800, hard 800-1000 MN/m.
+PAD_CLASS_UPPER_NPM = (250e6, 800e6)
+
+
+def _read(name: str) -> tuple[list[str], FloatArray]:
+    text = resources.files("rail_monitor").joinpath("data", name).read_text(encoding="utf-8")
+    rows = [r for r in csv.reader(io.StringIO(text)) if r and not r[0].startswith("#")]
+    return rows[0], np.array(rows[1:], float)
+
+
+@dataclass(frozen=True)
+class Tables:
+    """Appendix G of the 2021 edition. Wavelength tables on an ascending wavelength grid [m];
+    frequency tables on the 24 nominal band centres (band numbers x of IEC 61260-1)."""
+
+    wavelength_m: FloatArray
+    by_wavelength: dict[str, FloatArray]
+    band: NDArray[np.int64]
+    band_hz: FloatArray
+    by_frequency: dict[str, FloatArray]
+
+    @property
+    def contact_filters(self) -> dict[tuple[float, float], FloatArray]:
+        """A_3 [dB] by (wheel load [N], wheel diameter [m]) (Table G-2)."""
+        out = {}
+        for name, col in self.by_wavelength.items():
+            if name.startswith("contact_filter_"):
+                load, dia = name.removeprefix("contact_filter_").split("_")
+                out[(float(load.removesuffix("kN")) * 1e3, float(dia.removesuffix("mm")) / 1e3)] = col
+        return out
+
+    @property
+    def vehicle_transfers(self) -> dict[float, FloatArray]:
+        """L_H,VEH [dB] by wheel diameter [m] (Table G-3b)."""
+        return {float(n.removeprefix("vehicle_wheel_").removesuffix("mm")) / 1e3: c
+                for n, c in self.by_frequency.items() if n.startswith("vehicle_wheel_")}
+
+
+@lru_cache(maxsize=1)
+def tables() -> Tables:
+    """The Appendix G tables (read once)."""
+    head, data = _read("cnossos_eu_2021_wavelength.csv")
+    order = np.argsort(data[:, 0])
+    by_wl = {h: data[order, j] for j, h in enumerate(head) if j}
+    fhead, fdata = _read("cnossos_eu_2021_frequency.csv")
+    return Tables(wavelength_m=data[order, 0] / 1e3, by_wavelength=by_wl, band=band_index(fdata[:, 0]),
+                  band_hz=fdata[:, 0], by_frequency={h: fdata[:, j] for j, h in enumerate(fhead) if j})
+
+
+def printed_wheel_roughness() -> tuple[FloatArray, dict[str, FloatArray]]:
+    """Table G-1a as printed (rounded): wavelength labels [m] and levels by column [dB re 1 um]."""
+    head, data = _read("cnossos_eu_2021_g1a_printed.csv")
+    return data[:, 0] / 1e3, {h: data[:, j] for j, h in enumerate(head) if j}
+
+
+# -- roughness and contact filter (wavelength domain) --------------------------------------------
+def rail_roughness(roughness_class: str) -> FloatArray:
+    """Rail roughness [dB re 1 um] of class E (EN ISO 3095:2013) or M (average network), Table G-1b."""
+    names = {"E": "rail_roughness_E_iso3095", "M": "rail_roughness_M_average_network"}
+    if roughness_class not in names:
+        raise ValueError(f"rail roughness class must be one of {RAIL_ROUGHNESS_CLASSES}")
+    return tables().by_wavelength[names[roughness_class]]
+
+
+def wheel_roughness(brake_type: str) -> FloatArray:
+    """Wheel roughness [dB re 1 um] by brake type (cast_iron, composite, disc), Table G-1a."""
+    if brake_type not in BRAKE_COLUMNS:
+        raise ValueError(f"brake type must be one of {tuple(BRAKE_COLUMNS)}")
+    return tables().by_wavelength[f"wheel_roughness_{BRAKE_COLUMNS[brake_type]}_unrounded"]
+
+
+def contact_filter(wheel_load_n: float, wheel_diameter_m: float) -> tuple[tuple[float, float], FloatArray]:
+    """A_3 [dB] of Table G-2 for the nearest (load, diameter) entry in lg(load) and lg(diameter).
+
+    The table gives five cases; the nearest is taken, diameter first (the filter scales with the
+    contact length, which grows with both). Returns the entry and its column.
+    """
+    entries = tables().contact_filters
+    key = min(entries, key=lambda k: (abs(np.log(k[1] / wheel_diameter_m)), abs(np.log(k[0] / wheel_load_n))))
+    return key, entries[key]
+
+
+def impact_roughness(joints_per_m: float) -> FloatArray:
+    """L_R,IMPACT [dB re 1 um] for a joint density n_l [1/m] (eq. 2.3.11; table for 1 per 100 m)."""
+    return tables().by_wavelength["impact_single_joint_per_100m"] + 10.0 * np.log10(joints_per_m / 0.01)
+
+
+def total_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike,
+                    impact_db: ArrayLike | None = None) -> FloatArray:
+    """L_R,TOT [dB re 1 um] (eq. 2.3.6), with the impact roughness added in energy (eq. 2.3.10)."""
+    total = level(power(rail_db) + power(wheel_db)) + np.asarray(contact_filter_db, float)
+    if impact_db is not None:
+        total = level(power(total) + power(impact_db))
+    return total
+
+
+def at_band_frequencies(level_db: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
+                        rule: str = "reference", wavelength_m: ArrayLike | None = None) -> FloatArray:
+    """A wavelength spectrum [dB] read at lambda = v / f_i: shape speed.shape + (bands,).
+
+    level_db: on ``wavelength_m`` (ascending; default the tables' grid), last axis; it may carry
+    leading axes matching speed (one spectrum per pass). band_hz: nominal band centres
+    (default the tables'). rule: one of INTERPOLATION_RULES (module docstring).
+    """
+    t = tables()
+    grid = t.wavelength_m if wavelength_m is None else np.asarray(wavelength_m, float)
+    f = t.band_hz if band_hz is None else np.asarray(band_hz, float)
+    speed = np.asarray(speed_mps, float)
+    lam = speed[..., None] / f                                        # [m]
+    lv = np.broadcast_to(np.asarray(level_db, float), speed.shape + grid.shape)
+    if rule == "reference":
+        x, xp, fp = lam, grid, lv
+    elif rule == "energy_log_frequency":
+        x, xp, fp = np.log(lam), np.log(grid), power(lv)
+    else:
+        raise ValueError(f"unknown interpolation rule {rule!r}; use one of {INTERPOLATION_RULES}")
+    out = _interp_rows(x, xp, fp)
+    return out if rule == "reference" else level(out)
+
+
+def _interp_rows(x: FloatArray, xp: FloatArray, fp: FloatArray) -> FloatArray:
+    """np.interp per row: x (..., m), fp (..., n) on one ascending xp (n,); ends held."""
+    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
+    w = np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
+    lo = np.take_along_axis(fp, j, axis=-1)
+    hi = np.take_along_axis(fp, j + 1, axis=-1)
+    return lo + w * (hi - lo)
+
+
+# -- transfer functions (frequency domain) ---------------------------------------------------------
+def pad_class(pad_stiffness_npm: float) -> str:
+    """Table G-3a pad class of a dynamic pad stiffness [N/m] (below 150 MN/m: soft; above 1000: hard)."""
+    soft, medium = PAD_CLASS_UPPER_NPM
+    return "soft" if pad_stiffness_npm < soft else "medium" if pad_stiffness_npm <= medium else "hard"
+
+
+def track_transfer(sleeper_type: str, pad_stiffness_npm: float) -> tuple[str, FloatArray]:
+    """L_H,TR [dB per axle] (Table G-3a) for a sleeper type and pad stiffness: (column, values)."""
+    by_f = tables().by_frequency
+    if sleeper_type == "wooden":
+        name = "track_wooden_sleepers"
+    elif sleeper_type == "direct_fastening":
+        name = "track_direct_fastening_bridge"
+    elif sleeper_type in ("monoblock", "biblock"):
+        name = f"track_{sleeper_type}_{pad_class(pad_stiffness_npm)}_pad"
+    else:
+        raise ValueError(f"sleeper type must be one of {SLEEPER_TYPES}")
+    return name, by_f[name]
+
+
+def vehicle_transfer(wheel_diameter_m: float) -> tuple[float, FloatArray]:
+    """L_H,VEH [dB per axle] (Table G-3b) of the nearest tabulated wheel diameter: (diameter [m], values)."""
+    entries = tables().vehicle_transfers
+    key = min(entries, key=lambda dia: abs(np.log(dia / wheel_diameter_m)))
+    return key, entries[key]
+
+
+def bridge_transfer(bridge_type: str) -> FloatArray | None:
+    """L_H,BRIDGE [dB per axle] (Table G-7), or None without a bridge."""
+    columns = {"concrete": "bridge_concrete_plus10dBA", "steel": "bridge_steel_ballasted_plus15dBA"}
+    if bridge_type == "none":
+        return None
+    if bridge_type not in columns:
+        raise ValueError(f"bridge type must be one of {BRIDGE_TYPES}")
+    return tables().by_frequency[columns[bridge_type]]
+
+
+# -- sound power ---------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SourcePower:
+    """Sound power per vehicle per band [dB re 1 pW], by component (arrays passes x bands)."""
+
+    track: FloatArray
+    vehicle: FloatArray
+    superstructure: FloatArray
+    bridge: FloatArray | None = None
+
+    def components(self) -> dict[str, FloatArray]:
+        out = {"track": self.track, "vehicle": self.vehicle, "superstructure": self.superstructure}
+        if self.bridge is not None:
+            out["bridge"] = self.bridge
+        return out
+
+    def total(self) -> FloatArray:
+        return level(sum(power(v) for v in self.components().values()))
+
+
+def curve_squeal_db(curve_radius_m: float) -> float:
+    """Curve-squeal correction to rolling-noise power [dB]: 8 for R <= 300 m, 5 up to 500 m, else 0."""
+    return 8.0 if curve_radius_m <= 300.0 else 5.0 if curve_radius_m <= 500.0 else 0.0
+
+
+def rolling_sound_power(total_roughness_f_db: ArrayLike, axles_per_vehicle: ArrayLike, track_db: ArrayLike,
+                        vehicle_db: ArrayLike, superstructure_db: ArrayLike = 0.0, bridge_db: ArrayLike | None = None,
+                        squeal_db: float = 0.0) -> SourcePower:
+    """L_W,0 per vehicle [dB re 1 pW] of track, vehicle and superstructure (eqs. 2.3.7-2.3.9), and
+    the bridge (2.3.14), from L_R,TOT at the band frequencies [dB re 1 um] (passes x bands).
+
+    squeal_db (curve_squeal_db) is added to the rolling components, not to the bridge.
+    """
+    lr = np.asarray(total_roughness_f_db, float)
+    axles = 10.0 * np.log10(np.asarray(axles_per_vehicle, float))[..., None] if np.ndim(axles_per_vehicle) \
+        else 10.0 * np.log10(float(axles_per_vehicle))
+    base = lr + axles
+    return SourcePower(
+        track=base + np.asarray(track_db, float) + squeal_db,
+        vehicle=base + np.asarray(vehicle_db, float) + squeal_db,
+        superstructure=base + np.asarray(superstructure_db, float) + squeal_db,
+        bridge=None if bridge_db is None else base + np.asarray(bridge_db, float),
+    )
+
+
+def horizontal_directivity_db(phi_rad: ArrayLike) -> FloatArray:
+    """Delta L_W,dir,hor = 10 lg(0.01 + 0.99 sin^2 phi) [dB] (eq. 2.3.15)."""
+    return 10.0 * np.log10(0.01 + 0.99 * np.sin(np.asarray(phi_rad, float)) ** 2)
+
+
+def vertical_directivity_a_db(psi_rad: ArrayLike, frequency_hz: ArrayLike) -> FloatArray:
+    """Delta L_W,dir,ver of source A (h = 1) [dB] (eq. 2.3.16): 0 at or below the source's height,
+    40/3 [2/3 sin(2 psi) - sin psi] lg((f + 600) / 200) above it (psi > 0).
+
+    Signed as printed: slightly positive up to psi = acos(3/4) = 41 degrees, negative above (the
+    vehicle body shields steep paths). The open implementation NoiseModelling reads it the same way.
+    """
+    psi = np.asarray(psi_rad, float)
+    f = np.asarray(frequency_hz, float)
+    shape = 40.0 / 3.0 * (2.0 / 3.0 * np.sin(2.0 * psi) - np.sin(psi)) * np.log10((f + 600.0) / 200.0)
+    return np.where(psi > 0.0, shape, 0.0)
+
+
+def line_sound_power_db(lw0_dir_db: ArrayLike, vehicles_per_hour: float, speed_kmh: float) -> FloatArray:
+    """L_W',eq,line [dB re 1 pW/m] of a steady flow (eq. 2.3.1): L_W,0,dir + 10 lg(Q / (1000 v))."""
+    return np.asarray(lw0_dir_db, float) + 10.0 * np.log10(vehicles_per_hour / (1000.0 * speed_kmh))

@@ -1,0 +1,54 @@
+"""Level arithmetic: decibels and energy, energy sums, A-weighted totals, octave aggregation.
+
+Levels are 10 lg of a power-like quantity over its reference (sound power re 1 pW, squared
+pressure re (20 uPa)^2, squared roughness re (1 um)^2). Band levels are 1/3-octave bands named
+by their IEC 61260-1 band number x (models.iec61260); the A-weighting is IEC 61672-1's at the
+exact mid-band frequency (models.iec61672).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rail_monitor.models.iec61260 import exact_centre
+from rail_monitor.models.iec61672 import a_weighting_db
+
+FloatArray = NDArray[np.float64]
+
+
+def power(level_db: ArrayLike) -> FloatArray:
+    """10^(L/10): the power ratio of a level [dB]."""
+    return 10.0 ** (np.asarray(level_db, float) / 10.0)
+
+
+def level(power_ratio: ArrayLike) -> FloatArray:
+    """10 lg(power ratio) [dB]; -inf for zero."""
+    with np.errstate(divide="ignore"):
+        return 10.0 * np.log10(np.asarray(power_ratio, float))
+
+
+def energy_sum(level_db: ArrayLike, axis: int | None = -1) -> FloatArray:
+    """Energy sum 10 lg(sum 10^(L/10)) [dB] along axis (-inf levels add nothing)."""
+    return level(np.sum(power(level_db), axis=axis))
+
+
+def a_weighted(level_db: ArrayLike, band: ArrayLike) -> FloatArray:
+    """Band levels [dB] plus the A-weighting of their bands (band numbers x, last axis) [dB(A)]."""
+    return np.asarray(level_db, float) + a_weighting_db(exact_centre(band))
+
+
+def a_weighted_total(level_db: ArrayLike, band: ArrayLike) -> FloatArray:
+    """Overall A-weighted level [dB(A)] of 1/3-octave band levels (bands on the last axis)."""
+    return energy_sum(a_weighted(level_db, band), axis=-1)
+
+
+def octave_levels(level_db: ArrayLike, band: ArrayLike) -> tuple[NDArray[np.int64], FloatArray]:
+    """Octave-band levels from 1/3-octave band levels (last axis): each octave (x divisible by 3)
+    is the energy sum of its three thirds; octaves with a third missing are left out."""
+    band = np.asarray(band, np.int64)
+    lv = np.asarray(level_db, float)
+    octaves = [x for x in range(int(band.min()) + 1, int(band.max())) if x % 3 == 0
+               and {x - 1, x, x + 1} <= set(band.tolist())]
+    cols = [energy_sum(lv[..., np.isin(band, (x - 1, x, x + 1))], axis=-1) for x in octaves]
+    return np.asarray(octaves, np.int64), np.stack(cols, axis=-1) if cols else np.empty(lv.shape[:-1] + (0,))

@@ -1,0 +1,49 @@
+"""Radiation efficiencies of simple radiators, and the radiated power of a vibrating surface.
+
+W = rho0 c0 sigma S <v^2>: sound power [W] of a surface of area S [m2] whose normal velocity has
+the mean square <v^2> [m2/s2] (spatial and time average), with radiation efficiency sigma [-].
+Air: rho0 c0 = 1.204 kg/m3 x 343.2 m/s = 413 rayl at 20 degC and 101.325 kPa (ISO 9613-1:1993).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.special import h1vp, j1
+
+FloatArray = NDArray[np.float64]
+
+AIR_DENSITY = 1.204        # [kg/m3], 20 degC, 101.325 kPa
+SOUND_SPEED = 343.2        # [m/s], 20 degC
+RHO_C = AIR_DENSITY * SOUND_SPEED
+
+
+def wavenumber(frequency_hz: ArrayLike) -> FloatArray:
+    """Acoustic wavenumber k = 2 pi f / c0 [1/m]."""
+    return 2.0 * np.pi * np.asarray(frequency_hz, float) / SOUND_SPEED
+
+
+def oscillating_cylinder(ka: ArrayLike) -> FloatArray:
+    """sigma [-] of an infinitely long rigid cylinder of radius a oscillating across its axis.
+
+    The n = 1 circumferential mode of an infinite cylinder: sigma_1 = 2 / (pi ka |H_1'(ka)|^2)
+    (Junger & Feit, Sound, Structures and Their Interaction, 2nd ed. 1986, section 4.7), with the
+    power normalised by the surface-averaged normal velocity, <v_n^2> = v^2 / 2. Limits:
+    (pi / 2) (ka)^3 for ka << 1 (a line dipole), 1 for ka >> 1.
+    """
+    x = np.asarray(ka, float)
+    return 2.0 / (np.pi * x * np.abs(h1vp(1, x)) ** 2)
+
+
+def baffled_piston(ka: ArrayLike) -> FloatArray:
+    """sigma [-] of a rigid circular piston of radius a in an infinite baffle: 1 - J1(2 ka) / (ka)
+    (Kinsler, Frey, Coppens & Sanders, Fundamentals of Acoustics, 4th ed. 2000, eq. 7.5.11).
+    Limits: (ka)^2 / 2 for ka << 1, 1 for ka >> 1."""
+    x = np.asarray(ka, float)
+    return 1.0 - j1(2.0 * x) / x
+
+
+def radiated_power(mean_square_velocity: ArrayLike, area_m2: ArrayLike, efficiency: ArrayLike) -> FloatArray:
+    """W = rho0 c0 sigma S <v^2> [W]."""
+    return RHO_C * np.asarray(efficiency, float) * np.asarray(area_m2, float) * np.asarray(mean_square_velocity,
+                                                                                          float)

@@ -1,0 +1,135 @@
+"""Rolling noise from roughness: a mechanics model in the spirit of TWINS and the seed's RRNPS.
+
+Chain per 1/3-octave band (Remington, J. Acoust. Soc. Am. 81 (1987) 1805-1823; Thompson,
+J. Sound Vib. 161 (1993) 387-482; Thompson, Railway Noise and Vibration, Elsevier 2009, ch. 5-6):
+
+1. Combined roughness r (rail + wheel, mean square per band) through the contact filter |F|^2
+   (models.contact_filter, band-averaged over the band's wavelengths lambda = v / f).
+2. Vertical velocities at the contact for a unit roughness between wheel and rail, with the
+   wheel, rail and contact-spring receptances alpha_W, alpha_R, alpha_C = 1 / k_H:
+
+       v_R = i w alpha_R r / (alpha_W + alpha_R + alpha_C),
+       v_W = -i w alpha_W r / (alpha_W + alpha_R + alpha_C).
+
+3. Radiated power per wheel-rail contact, W = rho0 c0 sigma S <v^2> (models.radiation):
+   * rail: the vibration decays along the rail at the track decay rate Delta [dB/m]
+     (models.track.decay_rate), so the squared velocity integrated over both sides is
+     |v_R|^2 x 2 x 4.343 / Delta; radiation of an equivalent rigid cylinder of radius a_R
+     oscillating vertically (sigma_1, power rho0 c0 sigma pi a_R v^2 per metre);
+   * sleepers: each rail seat moves with the rail times the seat's transmissibility
+     (models.track.sleeper_transmissibility), summed over the seats under the decaying field,
+     |v_R|^2 x 2 x 4.343 / (Delta d); radiation of a baffled piston of the half-sleeper's top area;
+   * wheel: rigid-body vertical motion of the wheel (the unsprung mass), radiated by its rim as
+     an oscillating cylinder of the wheel's radius and the rim's width.
+
+The result per axle (two contacts) is a transfer L_H,mech = 10 lg(W / r^2) [dB re 1 pW per
+(1 um)^2 of roughness], so that L_W = L_R,TOT + L_H,mech, the form of CNOSSOS-EU's eqs.
+2.3.7-2.3.8 and directly comparable to its tables. Transfers are band averages of the squared
+transfer over ``points`` log-spaced frequencies per band (resonances narrower than a band).
+
+Not modelled (and why the wheel component is a lower bound): the wheel's own modes (for
+0.84-0.92 m wheels, the axial and radial modes above about 1.5 kHz that dominate TWINS's wheel
+noise), lateral rail and wheel motion, and shielding by the vehicle body.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rail_monitor.models import radiation, track
+from rail_monitor.models.contact_filter import hertzian_line_filter
+from rail_monitor.models.iec61260 import G, exact_centre
+
+FloatArray = NDArray[np.float64]
+COMPONENTS = ("rail", "sleeper", "wheel")
+NEPER_DB = 20.0 * np.log10(np.e)   # 8.686 dB per neper: decay rate [dB/m] = 8.686 Im(k)
+
+
+@dataclass(frozen=True)
+class Radiators:
+    """Radiating geometry [m, m2].
+
+    rail_radius_m: equivalent cylinder for vertical rail motion, pi a = twice the foot width of
+    UIC60 (150 mm; EN 13674-1), the high-frequency limit of a rail radiating from its foot's two
+    faces. sleeper_area_m2: top face of half a monoblock sleeper (2.6 m x 0.25 m / 2).
+    wheel_rim_width_m: 135 mm, the UIC rim width (EN 13715 profile S1002).
+    """
+
+    rail_radius_m: float = 0.3 / np.pi
+    sleeper_area_m2: float = 0.325
+    wheel_rim_width_m: float = 0.135
+
+
+def band_frequencies(band: ArrayLike, points: int) -> FloatArray:
+    """``points`` log-spaced frequencies [Hz] inside each 1/3-octave band: shape band.shape + (points,)."""
+    offsets = ((np.arange(points) + 0.5) / points - 0.5) / 3.0      # in octaves, within +-1/6
+    return exact_centre(band)[..., None] * G ** offsets
+
+
+def contact_filter_power(speed_mps: ArrayLike, band: ArrayLike, semi_length_m: ArrayLike,
+                         points: int = 5) -> FloatArray:
+    """Band average of |F|^2 at lambda = v / f [-]: shape speed.shape + band.shape.
+
+    semi_length_m: contact semi-axis along the rail, broadcast against speed.
+    """
+    f = band_frequencies(band, points)                                   # (B, P)
+    v = np.asarray(speed_mps, float)[..., None, None]
+    a = np.asarray(semi_length_m, float)[..., None, None]
+    return np.mean(hertzian_line_filter(v / f, a) ** 2, axis=-1)
+
+
+def contact_velocity_ratios(frequency: ArrayLike, alpha_rail: ArrayLike, alpha_wheel: ArrayLike,
+                            contact_stiffness_npm: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """|v_R / r|^2 and |v_W / r|^2 [1/s2]: squared velocity per unit roughness displacement (module docstring)."""
+    w = 2.0 * np.pi * np.asarray(frequency, float)
+    a_r, a_w = np.asarray(alpha_rail), np.asarray(alpha_wheel)
+    total = a_r + a_w + 1.0 / np.asarray(contact_stiffness_npm, float)
+    return np.abs(w * a_r / total) ** 2, np.abs(w * a_w / total) ** 2
+
+
+def rail_power(v2: ArrayLike, frequency: ArrayLike, decay_db_per_m: ArrayLike, radius_m: float) -> FloatArray:
+    """Power [W] radiated by one rail under one contact of squared velocity v2 [m2/s2]."""
+    sigma = radiation.oscillating_cylinder(radiation.wavenumber(frequency) * radius_m)
+    length = NEPER_DB / np.asarray(decay_db_per_m, float)   # integral of exp(-2 beta |x|) dx = 1 / beta
+    return radiation.radiated_power(np.asarray(v2) / 2.0, 2.0 * np.pi * radius_m, sigma) * length
+
+
+def sleeper_power(v2: ArrayLike, frequency: ArrayLike, decay_db_per_m: ArrayLike, transmissibility: ArrayLike,
+                  spacing_m: float, area_m2: float) -> FloatArray:
+    """Power [W] radiated by the half-sleepers under one rail's decaying field of squared velocity v2."""
+    sigma = radiation.baffled_piston(radiation.wavenumber(frequency) * np.sqrt(area_m2 / np.pi))
+    seats = NEPER_DB / np.asarray(decay_db_per_m, float) / spacing_m      # sum over seats of exp(-2 beta |x_n|)
+    return radiation.radiated_power(np.abs(transmissibility) ** 2 * np.asarray(v2) * seats, area_m2, sigma)
+
+
+def wheel_power(v2: ArrayLike, frequency: ArrayLike, diameter_m: float, rim_width_m: float) -> FloatArray:
+    """Power [W] radiated by a wheel in rigid vertical motion of squared velocity v2 (its rim as a
+    short oscillating cylinder)."""
+    radius = diameter_m / 2.0
+    sigma = radiation.oscillating_cylinder(radiation.wavenumber(frequency) * radius)
+    return radiation.radiated_power(np.asarray(v2) / 2.0, 2.0 * np.pi * radius * rim_width_m, sigma)
+
+
+def axle_transfer(band: ArrayLike, trk: track.Track, unsprung_mass_kg: float, contact_stiffness_npm: float,
+                  wheel_diameter_m: float, radiators: Radiators = Radiators(), points: int = 5,
+                  beam: str = "timoshenko") -> dict[str, FloatArray]:
+    """L_H,mech per component [dB re 1 pW per (1 um)^2 of roughness] for one axle (two contacts).
+
+    Speed-independent: with L_R,TOT [dB re 1 um] (filtered), L_W = L_R,TOT + L_H,mech per axle.
+    """
+    f = band_frequencies(band, points)
+    alpha_r = track.continuous_receptance(f, trk, beam)
+    alpha_w = track.wheel_receptance(f, unsprung_mass_kg)
+    vr2, vw2 = contact_velocity_ratios(f, alpha_r, alpha_w, contact_stiffness_npm)
+    decay = np.maximum(track.decay_rate(f, trk, beam), 1e-3)
+    per_contact = {
+        "rail": rail_power(vr2, f, decay, radiators.rail_radius_m),
+        "sleeper": sleeper_power(vr2, f, decay, track.sleeper_transmissibility(f, trk), trk.sleeper_spacing_m,
+                                 radiators.sleeper_area_m2),
+        "wheel": wheel_power(vw2, f, wheel_diameter_m, radiators.wheel_rim_width_m),
+    }
+    # W per unit r^2 [W/m2] -> dB: r^2 re (1 um)^2 and W re 1 pW cancel (1e-12 both).
+    return {name: 10.0 * np.log10(2.0 * np.mean(w, axis=-1)) for name, w in per_contact.items()}

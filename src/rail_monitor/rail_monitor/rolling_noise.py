@@ -1,0 +1,237 @@
+"""Rolling noise at a site: its noise parameters and the prediction for each train pass.
+
+Glue between the pass table, the site (track, contact, rolling stock), the corrugation state and
+the two source models: :mod:`rail_monitor.models.cnossos` (the EU method, default) and
+:mod:`rail_monitor.models.wheel_rail_noise` (mechanics, sharing :mod:`rail_monitor.models.track`
+with the corrugation model, so pad stiffness and corrugation change the noise for mechanical
+reasons). Both share one roughness input and one propagation (:mod:`rail_monitor.models.passby`).
+
+Roughness. The rail roughness is the site's baseline (ISO 3095 class E, CNOSSOS class M, or a
+measured spectrum in dB re 1 um on 1/3-octave wavelength bands) plus, in energy, the corrugation
+state's r.m.s. amplitude in each of its bands (the nearest baseline wavelength within 1/6
+octave). The level increase due to roughness growth since grinding is LpAeq,Tp with the current
+state minus LpAeq,Tp with the state's post-grinding amplitudes. The wheel roughness is
+CNOSSOS-EU's for the class's brake type.
+
+Per pass: the class's wheel (diameter, nominal load: Hertz contact of ``site.contact``),
+axles and length from the pass (class defaults filled), speed from the pass. Sound power per
+metre of train: L_W' = L_R,TOT + L_H + 10 lg(axles / length) per band.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.errors import ConfigError
+from rail_monitor.models import cnossos as cn
+from rail_monitor.models import wheel_rail_noise as wrn
+from rail_monitor.models.levels import a_weighted_total, level, power
+from rail_monitor.models.passby import Receiver, pass_by
+from rail_monitor.params import ParamSpec, ParamValues, resolve, section
+from rail_monitor.passes import PassTable
+from rail_monitor.site import Site
+
+MODELS = ("cnossos", "mechanics")
+ROUGHNESS_SOURCES = ("E", "M", "measured")
+_CLASS_E = cn.rail_roughness("E")
+
+NOISE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("model", "cnossos", "Source model of noise/rolling: CNOSSOS-EU (Directive 2015/996 as amended by "
+              "2021/1226) or the mechanics model.", choices=MODELS),
+    ParamSpec("interpolation", "reference", "Wavelength-to-frequency rule: the European reference module's (dB "
+              "linear in wavelength, ends held) or energy against lg frequency.", choices=cn.INTERPOLATION_RULES),
+    ParamSpec("rail_roughness", "E", "Baseline rail roughness: class E (EN ISO 3095:2013), class M (CNOSSOS "
+              "average network) or the measured spectrum below.", choices=ROUGHNESS_SOURCES),
+    ParamSpec("rail_roughness_wavelength_m", cn.tables().wavelength_m.tolist(), "Wavelengths of the measured "
+              "rail roughness, ascending [m] (default: the CNOSSOS grid).", 1e-4, 10.0),
+    ParamSpec("rail_roughness_db", _CLASS_E.tolist(), "Measured rail roughness per 1/3-octave wavelength band "
+              "[dB re 1 um] (default: class E).", -60.0, 80.0),
+    ParamSpec("sleeper_type", "monoblock", "Sleeper type for CNOSSOS's track transfer (Table G-3a); the pad class "
+              "follows track.pad_stiffness_npm.", choices=cn.SLEEPER_TYPES),
+    ParamSpec("bridge", "none", "Bridge at the site (CNOSSOS Table G-7).", choices=cn.BRIDGE_TYPES),
+    ParamSpec("joints_per_100m", 0.0, "Rail joints (impact noise, CNOSSOS Table G-4) per 100 m [-]; 0: none.",
+              0.0, 100.0),
+    ParamSpec("curve_squeal", False, "Add CNOSSOS's curve-squeal term (+8 dB R <= 300 m, +5 dB to 500 m) to the "
+              "CNOSSOS rolling noise. Off: squeal is squeal_risk_model's, noise/squeal."),
+    ParamSpec("receiver_distance_m", 7.5, "Horizontal distance of the receiver from the track centre [m].",
+              0.5, 1000.0),
+    ParamSpec("receiver_height_m", 1.2, "Receiver height above the rail head [m].", -10.0, 100.0),
+    ParamSpec("source_height_m", 0.05, "Height of the rolling-noise source line above the rail head [m] "
+              "(CNOSSOS source A).", 0.0, 5.0),
+    ParamSpec("ground_reflection", 1.0, "Energy reflection coefficient of the ground [-] (1: hard, 0: free "
+              "field).", 0.0, 1.0),
+    ParamSpec("ground_depth_m", 0.0, "Depth of the reflecting ground plane below the rail head [m].", 0.0, 10.0),
+    ParamSpec("rail_radius_m", float(wrn.Radiators.rail_radius_m), "Mechanics: radius of the cylinder radiating "
+              "like the rail's vertical motion [m].", 0.01, 1.0),
+    ParamSpec("sleeper_area_m2", wrn.Radiators.sleeper_area_m2, "Mechanics: radiating top area of a half sleeper "
+              "[m2].", 0.0, 5.0),
+    ParamSpec("wheel_rim_width_m", wrn.Radiators.wheel_rim_width_m, "Mechanics: wheel rim width [m].", 0.01, 0.5),
+    ParamSpec("band_points", 5, "Mechanics: frequencies per 1/3-octave band for band averages [-].", 1, 50),
+)
+
+
+@dataclass(frozen=True)
+class NoiseConfig(ParamValues):
+    """The site's noise parameters (names and units as in NOISE_SPECS)."""
+
+    @property
+    def receiver(self) -> Receiver:
+        return Receiver(self["receiver_distance_m"], self["receiver_height_m"], self["source_height_m"],
+                        self["ground_depth_m"], self["ground_reflection"])
+
+    @property
+    def radiators(self) -> wrn.Radiators:
+        return wrn.Radiators(self["rail_radius_m"], self["sleeper_area_m2"], self["wheel_rim_width_m"])
+
+
+def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConfig:
+    """Checked noise parameters from flat parameter values (keys under prefix)."""
+    values = resolve(NOISE_SPECS, section(values, prefix), where=prefix, strict=True)
+    wl, db = values["rail_roughness_wavelength_m"], values["rail_roughness_db"]
+    if len(wl) != len(db) or len(wl) < 2 or np.any(np.diff(wl) <= 0):
+        raise ConfigError(f"parameters '{prefix}rail_roughness_wavelength_m' and '{prefix}rail_roughness_db' must "
+                          "have the same length (at least 2), wavelengths strictly ascending")
+    return NoiseConfig(values)
+
+
+def roughness_level_db(amplitude_m: np.ndarray) -> np.ndarray:
+    """Roughness level [dB re 1 um] of an r.m.s. amplitude [m]."""
+    return level((np.asarray(amplitude_m, float) / 1e-6) ** 2)
+
+
+@dataclass(frozen=True)
+class Corrugation:
+    """The part of a CorrugationState the noise needs: bands [m] and r.m.s. amplitudes [m]."""
+
+    wavelength_m: np.ndarray
+    amplitude_m: np.ndarray
+    post_grinding_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class _ClassTerms:
+    """Per vehicle class, speed-independent: wheel roughness, filters and transfers."""
+
+    wheel_db: np.ndarray                 # on the CNOSSOS wavelength grid [dB re 1 um]
+    a3_db: np.ndarray                    # CNOSSOS contact filter on the grid [dB]
+    semi_length_m: float                 # Hertz semi-axis along the rail [m]
+    cnossos: dict[str, np.ndarray]       # L_H per component [dB per axle], 24 bands
+    mechanics: dict[str, np.ndarray]     # L_H,mech per component [dB per axle]
+
+
+class RollingNoiseModel:
+    """Both source models for one site, with everything speed-independent computed once."""
+
+    def __init__(self, site: Site, cfg: NoiseConfig) -> None:
+        self.site, self.cfg = site, cfg
+        t = cn.tables()
+        self.grid = t.wavelength_m
+        self.band, self.band_hz = t.band, t.band_hz
+        self.receiver = cfg.receiver
+        (_, psi), _ = self.receiver.paths()
+        self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz)
+        self.baseline_db = self._baseline()
+        self.impact_db = cn.impact_roughness(cfg["joints_per_100m"] / 100.0) if cfg["joints_per_100m"] > 0 else None
+        self.track_name, track_db = cn.track_transfer(cfg["sleeper_type"], site.track.pad_stiffness_npm)
+        self.bridge_db = cn.bridge_transfer(cfg["bridge"])
+        self.squeal_db = cn.curve_squeal_db(site.curve_radius_m) if cfg["curve_squeal"] else 0.0
+        self.classes: dict[str, _ClassTerms] = {}
+        for name, v in site.vehicles.items():
+            contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
+            _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m)
+            _, veh = cn.vehicle_transfer(v.wheel_diameter_m)
+            cnossos = {"track": track_db + self.squeal_db, "vehicle": veh + self.squeal_db,
+                       "superstructure": np.full(len(self.band), self.squeal_db)}
+            if self.bridge_db is not None:
+                cnossos["bridge"] = self.bridge_db
+            mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
+                                     v.wheel_diameter_m, cfg.radiators, cfg["band_points"])
+            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type), a3, float(contact.a), cnossos, mech)
+
+    def _baseline(self) -> np.ndarray:
+        source = self.cfg["rail_roughness"]
+        if source != "measured":
+            return cn.rail_roughness(source)
+        wl = np.asarray(self.cfg["rail_roughness_wavelength_m"], float)
+        return np.interp(self.grid, wl, np.asarray(self.cfg["rail_roughness_db"], float))
+
+    def rail_roughness_db(self, corrugation: Corrugation | None = None, post_grinding: bool = False) -> np.ndarray:
+        """Rail roughness on the CNOSSOS wavelength grid [dB re 1 um]: baseline plus the corrugation
+        state (or its post-grinding amplitudes) in energy."""
+        if corrugation is None:
+            return self.baseline_db
+        amp = corrugation.post_grinding_m if post_grinding else corrugation.amplitude_m
+        wl = np.asarray(corrugation.wavelength_m, float)
+        if not len(wl):
+            return self.baseline_db
+        octaves = np.abs(np.log2(self.grid[:, None] / wl[None, :]))
+        nearest = np.argmin(octaves, axis=1)
+        inside = octaves[np.arange(len(self.grid)), nearest] <= 1.0 / 6.0
+        extra = np.where(inside, (np.asarray(amp, float)[nearest] / 1e-6) ** 2, 0.0)
+        return level(power(self.baseline_db) + extra)
+
+    def predict(self, passes: PassTable, model: str | None = None,
+                corrugation: Corrugation | None = None) -> dict[str, Any]:
+        """RollingNoise fields per pass (arrays over passes; bands last), vectorised.
+
+        ``passes`` must be valid for the site with class defaults filled. model: one of MODELS
+        (default: the site's ``noise.model``).
+        """
+        model = model or self.cfg["model"]
+        if model not in MODELS:
+            raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
+        n = len(passes)
+        current = self.rail_roughness_db(corrugation)
+        rails = [current] if corrugation is None else [current, self.rail_roughness_db(corrugation, True)]
+        per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
+        out: dict[str, Any] = {}
+        results = []
+        for rail in rails:
+            roughness = np.empty((n, len(self.band)))
+            components: dict[str, np.ndarray] = {}
+            for name in set(passes.vehicle_class.tolist()):
+                rows = passes.vehicle_class == name
+                terms = self.classes[name]
+                lr, transfers = self._roughness(rail, terms, passes.speed_mps[rows], model)
+                roughness[rows] = lr
+                for comp, lh in transfers.items():
+                    components.setdefault(comp, np.full((n, len(self.band)), -np.inf))[rows] = lr + lh + per_metre[rows]
+            lw = level(sum(power(c) for c in components.values()))
+            pb = pass_by(lw, self.band, passes.train_length_m, passes.speed_mps, self.receiver, self.vertical_db)
+            results.append(pb)
+            if not out:
+                comp_names = list(components)
+                out = {
+                    "model": model, "band_centre_hz": self.band_hz, "speed_mps": passes.speed_mps,
+                    "lp_db": pb.lp_db, "lw_db": lw, "roughness_db": roughness,
+                    "pass_by_time_s": pb.pass_by_time_s, "lpaeq_tp_dba": pb.lpaeq_tp_dba,
+                    "lpafmax_dba": pb.lpafmax_dba, "tel_dba": pb.tel_dba,
+                    "component_names": comp_names,
+                    "component_lpaeq_dba": np.stack([
+                        pass_by(components[c], self.band, passes.train_length_m, passes.speed_mps, self.receiver,
+                                self.vertical_db).lpaeq_tp_dba for c in comp_names], axis=-1),
+                }
+        out["roughness_growth_increase_db"] = (results[0].lpaeq_tp_dba - results[1].lpaeq_tp_dba
+                                               if len(results) > 1 else np.zeros(n))
+        return out
+
+    def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray,
+                   model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
+        rule = self.cfg["interpolation"]
+        if model == "cnossos":
+            lr = cn.total_roughness(rail_db, terms.wheel_db, terms.a3_db, self.impact_db)
+            return cn.at_band_frequencies(lr, speed, self.band_hz, rule), terms.cnossos
+        combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
+        filt = wrn.contact_filter_power(speed, self.band, terms.semi_length_m, self.cfg["band_points"])
+        lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + level(filt)
+        return lr, terms.mechanics
+
+
+def overall_dba(level_db: np.ndarray, band: np.ndarray) -> np.ndarray:
+    """A-weighted total [dB(A)] of band levels (bands last)."""
+    return a_weighted_total(level_db, band)

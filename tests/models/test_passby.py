@@ -1,0 +1,96 @@
+"""Bands, level arithmetic and pass-by levels (models.iec61260, models.levels, models.passby)."""
+
+import numpy as np
+import pytest
+from scipy.integrate import quad, solve_ivp
+
+from rail_monitor.models import iec61260, levels, passby
+
+CNOSSOS_NOMINAL = [50, 63, 80, 100, 125, 160, 200, 250, 315, 400, 500, 630, 800, 1000, 1250, 1600, 2000, 2500,
+                   3150, 4000, 5000, 6300, 8000, 10000]
+
+
+def test_band_numbers_round_trip_the_nominal_centres_of_iec_61260_annex_e():
+    x = iec61260.band_index(CNOSSOS_NOMINAL)
+    np.testing.assert_array_equal(x, np.arange(-13, 11))
+    np.testing.assert_array_equal(iec61260.nominal_centre(x), CNOSSOS_NOMINAL)
+    # Exact centres are within 2 % of the labels (Annex E) and 1/3 octave (base ten) apart.
+    np.testing.assert_allclose(iec61260.exact_centre(x), CNOSSOS_NOMINAL, rtol=0.02)
+    lo, hi = iec61260.band_edges(x)
+    np.testing.assert_allclose(hi / lo, 10 ** 0.1, rtol=1e-12)
+    np.testing.assert_allclose(hi[:-1], lo[1:], rtol=1e-12)
+
+
+def test_energy_sum_and_octaves():
+    assert levels.energy_sum([80.0, 80.0]) == pytest.approx(80.0 + 10 * np.log10(2), abs=1e-12)
+    assert levels.energy_sum([80.0, -np.inf]) == pytest.approx(80.0)
+    x = np.arange(-13, 11)
+    octaves, lv = levels.octave_levels(np.full(24, 70.0), x)
+    np.testing.assert_array_equal(octaves, np.arange(-12, 10, 3))       # 63 Hz ... 8 kHz octaves
+    np.testing.assert_allclose(lv, 70.0 + 10 * np.log10(3))
+    # A-weighted total of a flat spectrum equals the energy sum of the A-weights.
+    total = levels.a_weighted_total(np.zeros(24), x)
+    assert total == pytest.approx(levels.energy_sum(levels.a_weighted(np.zeros(24), x)))
+
+
+RECEIVER = passby.Receiver(7.5, 1.2, 0.05, 0.0, 1.0)
+
+
+def _g(x, d, r):
+    return (0.01 / (r * r + x * x) + 0.99 * d * d / ((d * d + x * x) * (r * r + x * x))) / (4 * np.pi)
+
+
+@pytest.mark.parametrize("d, r", [(7.5, 7.59), (7.5, 7.5), (3.0, 5.0)])
+def test_kernel_antiderivatives_match_quadrature(d, r):
+    """Closed forms against adaptive quadrature of the point-source kernel (independent method), 1e-9."""
+    for x in (0.5, 7.0, 40.0):
+        val, _ = quad(_g, 0.0, x, args=(d, r), epsabs=1e-14, epsrel=1e-12)
+        assert passby.kernel_antiderivative(x, d, r) == pytest.approx(val, rel=1e-9)
+    total, _ = quad(_g, -np.inf, np.inf, args=(d, r), epsabs=1e-14, epsrel=1e-12)
+    assert passby.kernel_total(d, r) == pytest.approx(total, rel=1e-9)
+    length = 60.0
+    mean, _ = quad(lambda s: float(passby.kernel_antiderivative(s, d, r) - passby.kernel_antiderivative(s - length, d, r)),
+                   0.0, length, epsabs=1e-14, epsrel=1e-12)
+    assert passby.kernel_window_mean(length, d, r) == pytest.approx(mean / length, rel=1e-8)
+
+
+def test_a_long_train_approaches_the_infinite_line_and_tel_exceeds_the_window_level():
+    band = np.array([0])                                 # 1 kHz
+    lw = np.array([[90.0]]) - levels.a_weighted(0.0, band)  # so that the A-weighted level is 90 dB
+    short = passby.pass_by(lw, band, [20.0], [20.0], RECEIVER)
+    long_ = passby.pass_by(lw, band, [20000.0], [20.0], RECEIVER)
+    # Infinite incoherent line: p^2 / p0^2 = W' (T_direct + T_image), T in closed form.
+    (r1, _), (r2, _) = RECEIVER.paths()
+    line = 90.0 + 10 * np.log10(passby.kernel_total(7.5, r1) + passby.kernel_total(7.5, r2))
+    assert long_.lpaeq_tp_dba[0] == pytest.approx(line, abs=0.01)
+    assert long_.lpafmax_dba[0] == pytest.approx(line, abs=0.01)
+    assert short.tel_dba[0] == pytest.approx(line, abs=1e-9)       # TEL: exposure over Tp, any length
+    assert short.lpaeq_tp_dba[0] < short.lpafmax_dba[0] < short.tel_dba[0]
+
+
+def test_f_time_weighting_matches_a_time_integration():
+    """LpAFmax against solve_ivp of tau dy/dt = x - y on the same time history (IEC 61672-1 F), 0.05 dB."""
+    d = RECEIVER.distance_m
+    (r1, _), (r2, _) = RECEIVER.paths()
+    length, speed = 12.0, 30.0
+
+    def x(t):
+        s = speed * t
+        g = passby.kernel_antiderivative
+        return float(g(s, d, r1) - g(s - length, d, r1) + g(s, d, r2) - g(s - length, d, r2))
+
+    sol = solve_ivp(lambda t, y: (x(t) - y) / passby.F_TIME_CONSTANT_S, (-10.0, 10.0), [0.0], max_step=0.002,
+                    rtol=1e-9, atol=1e-14)
+    got = passby.pass_by(np.array([[0.0]]), np.array([0]), [length], [speed], RECEIVER).lpafmax_dba[0]
+    assert got == pytest.approx(10 * np.log10(sol.y[0].max()), abs=0.05)
+
+
+def test_free_field_point_limit_and_ground():
+    """A short train far away is a point source: Lp(TEL over Tp) -> L_W - 10 lg(4 pi r^2) + 10 lg(L) per path."""
+    far = passby.Receiver(200.0, 0.0, 0.0, 0.0, 0.0)
+    out = passby.pass_by(np.array([[100.0]]), np.array([0]), [1.0], [10.0], far)
+    expected = 100.0 - 10 * np.log10(4 * np.pi * 200.0**2)            # 1 m of train, broadside
+    assert out.lpaeq_tp_dba[0] == pytest.approx(expected, abs=0.01)
+    hard = passby.pass_by(np.array([[100.0]]), np.array([0]), [1.0], [10.0],
+                          passby.Receiver(200.0, 0.0, 0.0, 0.0, 1.0))
+    assert hard.lpaeq_tp_dba[0] - out.lpaeq_tp_dba[0] == pytest.approx(10 * np.log10(2), abs=0.01)
