@@ -34,8 +34,9 @@ def generate_launch_description() -> LaunchDescription:
         Node(package="rail_monitor", executable="squeal_risk_model", namespace=ns, parameters=[site, common]),
         Node(package="rail_monitor", executable="corrugation_estimator", namespace=ns,
              parameters=[site, common, {"checkpoint_path": LaunchConfiguration("checkpoint")}]),
-        # The replayer starts once the recorder and both models subscribe, so no pass is lost.
+        Node(package="rail_monitor", executable="rolling_noise_predictor", namespace=ns, parameters=[site, common]),
+        # The replayer starts once the recorder and the three models subscribe, so no pass is lost.
         Node(package="rail_monitor", executable="pass_replayer", namespace=ns,
              parameters=[site, {"source": LaunchConfiguration("source"), "rate": LaunchConfiguration("rate"),
-                                "wait_for_subscribers": 3}]),
+                                "wait_for_subscribers": 4}]),
     ])

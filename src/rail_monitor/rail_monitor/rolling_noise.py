@@ -29,7 +29,7 @@ import numpy as np
 from rail_monitor.errors import ConfigError
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import wheel_rail_noise as wrn
-from rail_monitor.models.levels import a_weighted_total, level, power
+from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import Receiver, pass_by
 from rail_monitor.params import ParamSpec, ParamValues, resolve, section
 from rail_monitor.passes import PassTable
@@ -41,7 +41,7 @@ _CLASS_E = cn.rail_roughness("E")
 
 NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("model", "cnossos", "Source model of noise/rolling: CNOSSOS-EU (Directive 2015/996 as amended by "
-              "2021/1226) or the mechanics model.", choices=MODELS),
+              "2021/1226), the mechanics model, or both (one message per model).", choices=(*MODELS, "both")),
     ParamSpec("interpolation", "reference", "Wavelength-to-frequency rule: the European reference module's (dB "
               "linear in wavelength, ends held) or energy against lg frequency.", choices=cn.INTERPOLATION_RULES),
     ParamSpec("rail_roughness", "E", "Baseline rail roughness: class E (EN ISO 3095:2013), class M (CNOSSOS "
@@ -152,6 +152,11 @@ class RollingNoiseModel:
                                      v.wheel_diameter_m, cfg.radiators, cfg["band_points"])
             self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type), a3, float(contact.a), cnossos, mech)
 
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The source models the site's ``noise.model`` selects."""
+        return MODELS if self.cfg["model"] == "both" else (self.cfg["model"],)
+
     def _baseline(self) -> np.ndarray:
         source = self.cfg["rail_roughness"]
         if source != "measured":
@@ -179,9 +184,9 @@ class RollingNoiseModel:
         """RollingNoise fields per pass (arrays over passes; bands last), vectorised.
 
         ``passes`` must be valid for the site with class defaults filled. model: one of MODELS
-        (default: the site's ``noise.model``).
+        (default: the first of the site's ``noise.model``).
         """
-        model = model or self.cfg["model"]
+        model = model or self.models[0]
         if model not in MODELS:
             raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
         n = len(passes)
@@ -231,7 +236,3 @@ class RollingNoiseModel:
         lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + level(filt)
         return lr, terms.mechanics
 
-
-def overall_dba(level_db: np.ndarray, band: np.ndarray) -> np.ndarray:
-    """A-weighted total [dB(A)] of band levels (bands last)."""
-    return a_weighted_total(level_db, band)

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 from builtin_interfaces.msg import Time
 
+from rail_monitor.rolling_noise import Corrugation
 from rail_monitor.timeutil import from_sec_nanosec, to_sec_nanosec
-from rail_msgs.msg import CorrugationState, SpeedAdvisory, SquealPrediction, TrainPass
+from rail_msgs.msg import CorrugationState, RollingNoise, SpeedAdvisory, SquealPrediction, TrainPass
 
 
 def time_msg(ns: int) -> Time:
@@ -100,3 +102,32 @@ def speed_advisory_msg(advice: Any, stamp_ns: int, frame_id: str) -> SpeedAdviso
     for name, value in vars(advice).items():
         setattr(msg, name, value.tolist() if hasattr(value, "tolist") and getattr(value, "ndim", 0) else float(value))
     return msg
+
+
+def rolling_noise_msg(values: dict[str, Any], i: int, source: TrainPass, receiver: Any) -> RollingNoise:
+    """Row i of rail_monitor.rolling_noise.RollingNoiseModel.predict as a RollingNoise for the pass source
+    (receiver: a models.passby.Receiver)."""
+    msg = RollingNoise(header=source.header, train_id=source.train_id, model=values["model"],
+                       receiver_distance_m=float(receiver.distance_m), receiver_height_m=float(receiver.height_m))
+    msg.band_centre_hz = values["band_centre_hz"].tolist()
+    for name in ("lp_db", "lw_db", "roughness_db"):
+        setattr(msg, name, values[name][i].tolist())
+    for name in ("speed_mps", "pass_by_time_s", "lpaeq_tp_dba", "lpafmax_dba", "tel_dba",
+                 "roughness_growth_increase_db"):
+        setattr(msg, name, float(values[name][i]))
+    msg.component_names = list(values["component_names"])
+    msg.component_lpaeq_dba = values["component_lpaeq_dba"][i].tolist()
+    return msg
+
+
+def corrugation_from_msg(msg: CorrugationState) -> Corrugation:
+    """The bands and amplitudes of a CorrugationState (rail_monitor.rolling_noise.Corrugation); ValueError
+    when they are inconsistent. A state without post-grinding amplitudes counts growth from zero."""
+    wl, amp = np.asarray(msg.wavelength_m, float), np.asarray(msg.amplitude_m, float)
+    post = np.asarray(msg.post_grinding_m, float) if len(msg.post_grinding_m) else np.zeros_like(amp)
+    if not (len(wl) == len(amp) == len(post)):
+        raise ValueError("wavelength_m, amplitude_m and post_grinding_m differ in length")
+    if not (np.all(np.isfinite(wl)) and np.all(wl > 0) and np.all(np.isfinite(amp)) and np.all(amp >= 0)
+            and np.all(np.isfinite(post)) and np.all(post >= 0)):
+        raise ValueError("a wavelength is not positive or an amplitude is negative or not finite")
+    return Corrugation(wl, amp, post)
