@@ -121,3 +121,28 @@ def test_noise_parameters_are_checked(site_values):
         noise_config({**site_values, "noise.modle": "cnossos"})
     with pytest.raises(ConfigError, match="noise.model"):
         noise_config({**site_values, "noise.model": "twins"})
+
+
+def test_predict_noise_command(tmp_path, model):
+    import json
+
+    from conftest import run_cmd
+
+    png = tmp_path / "spectra.png"
+    out = run_cmd("rail-monitor", "predict", "noise", "--vehicle-class", "emu", "--speed", "20", "40", "--vehicles",
+                  "4", "--growth-days", "180", "--json", "--plot", str(png))
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    runs = {(r["model"], r["growth_days"]): r["passes"] for r in doc["results"]}
+    assert set(runs) == {("cnossos", 0.0), ("cnossos", 180.0), ("mechanics", 0.0), ("mechanics", 180.0)}
+    # Day 0 is the rail just after grinding: no increase; the CLI's numbers are the library's.
+    assert runs[("cnossos", 0.0)][0]["roughness_growth_increase_db"] == pytest.approx(0.0, abs=1e-12)
+    assert runs[("cnossos", 180.0)][0]["roughness_growth_increase_db"] > 0.5
+    assert len(runs[("mechanics", 0.0)][1]["lp_db"]) == len(doc["band_centre_hz"]) == 24
+    post = 0.5 * band_limits(wavelength_bands(0.01, 1.0))
+    want = model.predict(_passes(model.site, "emu", [20.0, 40.0]), "mechanics", Corrugation(
+        wavelength_bands(0.01, 1.0), post, post))["lpaeq_tp_dba"]
+    np.testing.assert_allclose([p["lpaeq_tp_dba"] for p in runs[("mechanics", 0.0)]], want, rtol=1e-12)
+    assert png.stat().st_size > 10_000
+    out = run_cmd("rail-monitor", "predict", "noise", "--speed", "-3")
+    assert out.returncode == 2 and out.stderr.count("\n") == 1 and "Traceback" not in out.stderr

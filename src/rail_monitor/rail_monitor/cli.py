@@ -323,6 +323,86 @@ def cmd_predict_corrugation(ns: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_predict_noise(ns: argparse.Namespace) -> int:
+    import json
+
+    from rail_monitor.corrugation_state import CorrugationEstimator, corrugation_config
+    from rail_monitor.models import corrugation as cg
+    from rail_monitor.models.levels import a_weighted
+    from rail_monitor.passes import FRICTION_BY_NAME, PassTable, with_class_defaults
+    from rail_monitor.rolling_noise import Corrugation, RollingNoiseModel, noise_config
+    from rail_monitor.site import load_parameter_file, site_from_values
+
+    values = load_parameter_file(_site_file(ns.site))
+    overrides = {"noise.model": ns.noise_model, "noise.rail_roughness": ns.rail_roughness,
+                 "noise.sleeper_type": ns.sleeper_type, "noise.interpolation": ns.interpolation,
+                 "noise.receiver_distance_m": ns.distance, "track.pad_stiffness_npm": ns.pad_stiffness}
+    values.update({k: v for k, v in overrides.items() if v is not None})
+    site = site_from_values(values)
+    model = RollingNoiseModel(site, noise_config(values))
+    cls = site.vehicle(ns.vehicle_class or next(iter(site.vehicles)))
+    speeds = np.asarray(ns.speed or [cls.speed_mean_mps], float)
+    if np.any(~np.isfinite(speeds) | (speeds <= 0) | (speeds > 120)):
+        raise RailMonitorError("--speed values must be in (0, 120] m/s")
+    vehicles = ns.vehicles or round((cls.vehicles_min + cls.vehicles_max) / 2)
+    n = len(speeds)
+    table = with_class_defaults(PassTable(
+        stamp_ns=np.arange(1, n + 1), train_id=[f"speed {v:g}" for v in speeds], vehicle_class=[cls.name] * n,
+        vehicle_count=[vehicles] * n, axle_count=[0] * n, speed_mps=speeds, angle_of_attack_rad=[0.0] * n,
+        wheel_load_n=[0.0] * n, friction_state=[FRICTION_BY_NAME["dry"]] * n, train_length_m=[0.0] * n), site)
+
+    # Roughness growth: the corrugation model's growth at the first speed, for each number of days.
+    est = CorrugationEstimator(site, corrugation_config(values))
+    per_axle = est.growth_at_speeds(speeds[:1], FRICTION_BY_NAME["dry"])[..., 0]
+    axles_per_day = ns.passes_per_day * cls.mean_axles_per_train
+    # Without --growth-days: the baseline rail; with it, day 0 is the rail just after grinding.
+    states = {0.0: Corrugation(est.bands, est.grinding_amplitude, est.grinding_amplitude) if ns.growth_days else None}
+    for days in ns.growth_days or []:
+        amp = cg.band_amplitude(est.log_components + per_axle * axles_per_day * days)
+        states[days] = Corrugation(est.bands, amp, est.grinding_amplitude)
+    results = {(name, days): model.predict(table, name, state)
+               for name in model.models for days, state in states.items()}
+    where = (f"site {site.site_id}, {cls.name} ({cls.brake_type} brakes, {vehicles} vehicles), rail "
+             f"{model.cfg['rail_roughness']}, {model.track_name}, receiver {model.receiver.distance_m:g} m / "
+             f"{model.receiver.height_m:g} m")
+    if ns.json:
+        def row(out: dict, i: int) -> dict:
+            keys = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "pass_by_time_s", "roughness_growth_increase_db")
+            return {"speed_mps": float(speeds[i]), **{k: float(out[k][i]) for k in keys},
+                    "components_lpaeq_dba": dict(zip(out["component_names"], out["component_lpaeq_dba"][i].tolist(),
+                                                     strict=True)),
+                    "lp_db": out["lp_db"][i].tolist(), "lw_db_per_m": out["lw_db"][i].tolist(),
+                    "roughness_db": out["roughness_db"][i].tolist()}
+        print(json.dumps({"where": where, "band_centre_hz": model.band_hz.tolist(), "results": [
+            {"model": name, "growth_days": days, "passes": [row(out, i) for i in range(n)]}
+            for (name, days), out in results.items()]}, indent=1))
+    else:
+        print(f"# {where}")
+        print(f"{'model':>9} {'days':>6} {'v [m/s]':>8} {'LpAeq,Tp':>9} {'LpAFmax':>8} {'TEL':>6} {'growth':>7}  components")
+        for (name, days), out in results.items():
+            for i in range(n):
+                comps = ", ".join(f"{c} {x:.1f}" for c, x in zip(out["component_names"], out["component_lpaeq_dba"][i],
+                                                                 strict=True))
+                print(f"{name:>9} {days:6g} {speeds[i]:8.2f} {out['lpaeq_tp_dba'][i]:9.1f} "
+                      f"{out['lpafmax_dba'][i]:8.1f} {out['tel_dba'][i]:6.1f} "
+                      f"{out['roughness_growth_increase_db'][i]:7.1f}  {comps}")
+    if ns.plot:
+        from rail_monitor.plots import noise_spectra
+
+        name = model.models[0]
+        base = results[(name, 0.0)]
+        def aw(lp: np.ndarray) -> np.ndarray:
+            return a_weighted(lp, model.band)
+        panels = {f"{name}: speeds": {f"{v:g} m/s, {base['lpaeq_tp_dba'][i]:.1f} dB(A)": aw(base["lp_db"][i])
+                                      for i, v in enumerate(speeds)}}
+        if len(states) > 1:
+            panels[f"{name}: after roughness growth at {speeds[0]:g} m/s, {ns.passes_per_day:g} trains/day"] = {
+                f"{days:g} days, {results[(name, days)]['lpaeq_tp_dba'][0]:.1f} dB(A)":
+                    aw(results[(name, days)]["lp_db"][0]) for days in states}
+        print(f"plot: {noise_spectra(model.band_hz, panels, ns.plot, title=where)}", file=sys.stderr)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from rail_monitor.models.squeal import K3_CONVENTIONS
     from rail_monitor.nodes.mcap_recorder import RECORDER_SPECS
@@ -405,6 +485,26 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--plot-receptance", metavar="PNG", help="save the track and wheel receptances to this PNG")
     c.add_argument("--plot-growth", metavar="PNG", help="save growth against wavelength (current and advised)")
     c.set_defaults(func=cmd_predict_corrugation)
+
+    r = models.add_parser("noise", help="rolling noise pass-by levels and spectra (CNOSSOS-EU and mechanics), "
+                          "before and after roughness growth", formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    r.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    r.add_argument("--vehicle-class", help="vehicle class (default: the site's first)")
+    r.add_argument("--speed", type=float, nargs="+", help="train speeds [m/s] (default: the class's mean)")
+    r.add_argument("--vehicles", type=int, help="vehicles in the train (default: the class's mean consist)")
+    r.add_argument("--model", dest="noise_model", choices=("cnossos", "mechanics", "both"),
+                   help="source model (default: the site's noise.model)")
+    r.add_argument("--rail-roughness", choices=("E", "M"), help="baseline rail roughness class")
+    r.add_argument("--sleeper-type", choices=("monoblock", "biblock", "wooden", "direct_fastening"))
+    r.add_argument("--pad-stiffness", type=float, help="rail pad stiffness [N/m] (track.pad_stiffness_npm)")
+    r.add_argument("--interpolation", choices=("reference", "energy_log_frequency"))
+    r.add_argument("--distance", type=float, help="receiver distance from the track centre [m]")
+    r.add_argument("--growth-days", type=float, nargs="+",
+                   help="also predict after this many days of corrugation growth from grinding (at the first speed)")
+    r.add_argument("--passes-per-day", type=float, default=100.0, help="trains per day for --growth-days")
+    r.add_argument("--json", action="store_true", help="print JSON (spectra and single numbers) instead of a table")
+    r.add_argument("--plot", metavar="PNG", help="save A-weighted spectra at the speeds and after growth")
+    r.set_defaults(func=cmd_predict_noise)
 
     for name, helptext in (("monitor", "run the whole graph in one process on a history"),
                            ("demo", "the main job: the bundled sample history through the whole graph")):

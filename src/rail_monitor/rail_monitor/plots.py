@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import matplotlib
@@ -76,4 +77,23 @@ def corrugation_growth(wavelength: np.ndarray, curves: dict[str, np.ndarray], pa
     ax.grid(True, which="both", alpha=0.3)
     if title:
         ax.set_title(title)
+    return _save(fig, path)
+
+
+def noise_spectra(band_hz: np.ndarray, panels: dict[str, dict[str, np.ndarray]], path: str | Path,
+                  title: str = "") -> Path:
+    """A-weighted 1/3-octave Lp [dB(A)] against band centre [Hz], one panel per group of spectra (the
+    shapes of the seed's Figure 3: spectra at several speeds; after roughness growth of various times)."""
+    fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(6.4, 3.2 * len(panels)), constrained_layout=True,
+                             squeeze=False)
+    for ax, (heading, curves) in zip(axes[:, 0], panels.items(), strict=True):
+        for label, lp in curves.items():
+            ax.semilogx(band_hz, lp, "o-", ms=3, label=label)
+        ax.set_ylabel("Lp,A per band [dB(A)]")
+        ax.set_title(heading, fontsize="medium")
+        ax.legend(fontsize="small")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[-1, 0].set_xlabel("1/3-octave band centre [Hz]")
+    if title:
+        fig.suptitle(textwrap.fill(title, 90), fontsize="small")
     return _save(fig, path)
