@@ -206,7 +206,8 @@ class RollingNoiseModel:
                 for comp, lh in transfers.items():
                     components.setdefault(comp, np.full((n, len(self.band)), -np.inf))[rows] = lr + lh + per_metre[rows]
             lw = level(sum(power(c) for c in components.values()))
-            pb = pass_by(lw, self.band, passes.train_length_m, passes.speed_mps, self.receiver, self.vertical_db)
+            pb = pass_by(lw, self.band, passes.train_length_m, passes.speed_mps, self.receiver, self.vertical_db,
+                         time_weighted=not out)
             results.append(pb)
             if not out:
                 comp_names = list(components)
@@ -218,7 +219,7 @@ class RollingNoiseModel:
                     "component_names": comp_names,
                     "component_lpaeq_dba": np.stack([
                         pass_by(components[c], self.band, passes.train_length_m, passes.speed_mps, self.receiver,
-                                self.vertical_db).lpaeq_tp_dba for c in comp_names], axis=-1),
+                                self.vertical_db, time_weighted=False).lpaeq_tp_dba for c in comp_names], axis=-1),
                 }
         out["roughness_growth_increase_db"] = (results[0].lpaeq_tp_dba - results[1].lpaeq_tp_dba
                                                if len(results) > 1 else np.zeros(n))

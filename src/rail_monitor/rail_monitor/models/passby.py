@@ -120,11 +120,12 @@ class PassBy:
 
 
 def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike,
-            receiver: Receiver, direct_correction_db: ArrayLike = 0.0) -> PassBy:
+            receiver: Receiver, direct_correction_db: ArrayLike = 0.0, time_weighted: bool = True) -> PassBy:
     """Pass-by levels of trains with band sound power per metre [dB re 1 pW/m] (passes x bands).
 
     length_m, speed_mps: per pass [m], [m/s]. band: IEC 61260-1 band numbers. direct_correction_db:
     per band, added to the direct path only (CNOSSOS-EU's vertical directivity of source A).
+    time_weighted: compute LpAFmax (the costly part; NaN without it).
     """
     lw = np.atleast_2d(np.asarray(lw_per_metre_db, float))
     length = np.atleast_1d(np.asarray(length_m, float))
@@ -136,27 +137,28 @@ def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, sp
     k1, k2 = kernel_window_mean(length, d, r1)[:, None], kernel_window_mean(length, d, r2)[:, None]
     lp = level(w_direct * k1 + w_image * k2)
     tel_band = level(w_direct * kernel_total(d, r1) + w_image * kernel_total(d, r2))
-    a_direct = np.sum(power(a_weighted(level(w_direct), band)), axis=-1)
-    a_image = np.sum(power(a_weighted(level(w_image), band)), axis=-1)
+    a = power(a_weighted(0.0, band))
+    fmax = level(_f_weighted_peak(np.sum(w_direct * a, axis=-1), np.sum(w_image * a, axis=-1), length, speed,
+                                  d, r1, r2)) if time_weighted else np.full(len(length), np.nan)
     return PassBy(
         lp_db=lp,
-        lpaeq_tp_dba=level(np.sum(power(a_weighted(lp, band)), axis=-1)),
-        tel_dba=level(np.sum(power(a_weighted(tel_band, band)), axis=-1)),
-        lpafmax_dba=level(_f_weighted_peak(a_direct, a_image, length, speed, d, r1, r2)),
+        lpaeq_tp_dba=level(np.sum(power(lp) * a, axis=-1)),
+        tel_dba=level(np.sum(power(tel_band) * a, axis=-1)),
+        lpafmax_dba=fmax,
         pass_by_time_s=length / speed,
     )
 
 
 def _f_weighted_peak(c1: FloatArray, c2: FloatArray, length: FloatArray, speed: FloatArray, d: float,
-                     r1: float, r2: float, steps_per_tau: int = 16) -> FloatArray:
+                     r1: float, r2: float, steps_per_tau: int = 8) -> FloatArray:
     """Peak of the F-time-weighted squared pressure c1 x1(t) + c2 x2(t), x_i(t) = G_i(vt) - G_i(vt - L).
 
-    Exponential averaging (IEC 61672-1 eq. 7, tau = 0.125 s) over 8 tau before to 4 tau after the
+    Exponential averaging (IEC 61672-1 eq. 7, tau = 0.125 s) from 6 tau before to 3 tau after the
     unweighted peak (the train's middle at the perpendicular), started in steady state: the
-    truncated history weighs e^-8.
+    truncated history weighs e^-6 of a level no higher than the peak's.
     """
     tau = F_TIME_CONSTANT_S
-    t = (np.arange(-8 * steps_per_tau, 4 * steps_per_tau + 1) / steps_per_tau) * tau
+    t = (np.arange(-6 * steps_per_tau, 3 * steps_per_tau + 1) / steps_per_tau) * tau
     s = 0.5 * length[:, None] + speed[:, None] * t[None, :]     # front position along the track [m]
     g = kernel_antiderivative
     x = c1[:, None] * (g(s, d, r1) - g(s - length[:, None], d, r1)) \

@@ -1,0 +1,51 @@
+"""Rolling-noise benchmark: per-site set-up, per-pass prediction cost of each model, batch throughput.
+
+Run: ros2_ws/run python bench/noise.py [--passes N]
+Prints figures measured in this run only (compare ratios, not absolute times, across machines).
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import time
+
+import numpy as np
+from corrugation import passes
+from timing import best_of
+
+from rail_monitor.models.corrugation import band_limits, wavelength_bands
+from rail_monitor.rolling_noise import MODELS, Corrugation, RollingNoiseModel, noise_config
+from rail_monitor.site import load_parameter_file, site_from_values
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--passes", type=int, default=100_000, help="passes of the batch run")
+    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
+    ns = ap.parse_args()
+    values = load_parameter_file(ns.site)
+    site, cfg = site_from_values(values), noise_config(values)
+    print(f"# rolling-noise benchmark, {platform.node()}, {platform.processor() or platform.machine()}, "
+          f"numpy {np.__version__}")
+    t = time.perf_counter()
+    model = RollingNoiseModel(site, cfg)
+    print(f"site set-up (tables, per-class transfers of both models): {1e3 * (time.perf_counter() - t):8.2f} ms")
+    bands = wavelength_bands(0.01, 1.0)
+    post = 0.5 * band_limits(bands)
+    state = Corrugation(bands, 3 * post, post)
+    one = passes(site, 1)
+    for name in MODELS:
+        bare = best_of(lambda name=name: model.predict(one, name), 50)
+        grown = best_of(lambda name=name: model.predict(one, name, state), 50)
+        print(f"{name:>9}: per pass {1e3 * bare:6.2f} ms; with a corrugation state (two roughness cases) "
+              f"{1e3 * grown:6.2f} ms")
+    table = passes(site, ns.passes)
+    for name in MODELS:
+        t = best_of(lambda name=name: model.predict(table, name, state), 1)
+        print(f"{name:>9}: batch of {ns.passes} passes with a corrugation state {t:6.2f} s = "
+              f"{ns.passes / t:9.0f} passes/s")
+
+
+if __name__ == "__main__":
+    main()
