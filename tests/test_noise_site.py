@@ -11,6 +11,9 @@ from rail_monitor.models import cnossos as cn
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.rolling_noise import MODELS, Corrugation, RollingNoiseModel, noise_config
+from rail_monitor.site import load_parameter_file, load_site
+
+from conftest import SITE_FILE
 
 
 def _passes(site, vehicle_class: str, speeds, vehicles: int = 4) -> PassTable:
@@ -23,9 +26,7 @@ def _passes(site, vehicle_class: str, speeds, vehicles: int = 4) -> PassTable:
 
 
 @pytest.fixture(scope="module")
-def model(request):
-    from conftest import SITE_FILE
-    from rail_monitor.site import load_parameter_file, load_site
+def model():
     return RollingNoiseModel(load_site(SITE_FILE), noise_config(load_parameter_file(SITE_FILE)))
 
 
@@ -117,9 +118,9 @@ def test_noise_parameters_are_checked(site_values):
     values = {**site_values, "noise.rail_roughness_db": [1.0, 2.0]}
     with pytest.raises(ConfigError, match="same length"):
         noise_config(values)
-    with pytest.raises(ConfigError, match="noise.modle"):
+    with pytest.raises(ConfigError, match=r"noise\.modle"):
         noise_config({**site_values, "noise.modle": "cnossos"})
-    with pytest.raises(ConfigError, match="noise.model"):
+    with pytest.raises(ConfigError, match=r"noise\.model"):
         noise_config({**site_values, "noise.model": "twins"})
 
 

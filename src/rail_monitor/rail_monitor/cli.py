@@ -378,7 +378,8 @@ def cmd_predict_noise(ns: argparse.Namespace) -> int:
             for (name, days), out in results.items()]}, indent=1))
     else:
         print(f"# {where}")
-        print(f"{'model':>9} {'days':>6} {'v [m/s]':>8} {'LpAeq,Tp':>9} {'LpAFmax':>8} {'TEL':>6} {'growth':>7}  components")
+        print(f"{'model':>9} {'days':>6} {'v [m/s]':>8} {'LpAeq,Tp':>9} {'LpAFmax':>8} {'TEL':>6} {'growth':>7}"
+              "  components [dB(A)]")
         for (name, days), out in results.items():
             for i in range(n):
                 comps = ", ".join(f"{c} {x:.1f}" for c, x in zip(out["component_names"], out["component_lpaeq_dba"][i],

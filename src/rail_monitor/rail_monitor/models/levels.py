@@ -51,4 +51,4 @@ def octave_levels(level_db: ArrayLike, band: ArrayLike) -> tuple[NDArray[np.int6
     octaves = [x for x in range(int(band.min()) + 1, int(band.max())) if x % 3 == 0
                and {x - 1, x, x + 1} <= set(band.tolist())]
     cols = [energy_sum(lv[..., np.isin(band, (x - 1, x, x + 1))], axis=-1) for x in octaves]
-    return np.asarray(octaves, np.int64), np.stack(cols, axis=-1) if cols else np.empty(lv.shape[:-1] + (0,))
+    return np.asarray(octaves, np.int64), np.stack(cols, axis=-1) if cols else np.empty((*lv.shape[:-1], 0))
