@@ -6,14 +6,12 @@ Prints figures measured in this run only (compare ratios, not absolute times, ac
 
 from __future__ import annotations
 
-import argparse
-import platform
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
-from timing import best_of
+from timing import best_of, header, parser
 
 from rail_monitor.corrugation_state import CorrugationEstimator, GrowthTables, _rail_receptance, corrugation_config
 from rail_monitor.passes import PassTable, with_class_defaults
@@ -32,14 +30,12 @@ def passes(site, n: int, seed: int = 1, start: int = 0) -> PassTable:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = parser(__doc__)
     ap.add_argument("--passes", type=int, default=200_000, help="passes of the batch run")
-    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
     ns = ap.parse_args()
     values = load_parameter_file(ns.site)
     site, cfg = site_from_values(values), corrugation_config(values)
-    print(f"# corrugation benchmark, {platform.node()}, {platform.processor() or platform.machine()}, "
-          f"numpy {np.__version__}")
+    header("corrugation")
 
     t = time.perf_counter()
     _rail_receptance(site.track)

@@ -6,13 +6,10 @@ Prints figures measured in this run only (compare ratios, not absolute times, ac
 
 from __future__ import annotations
 
-import argparse
-import platform
 import time
 
-import numpy as np
 from corrugation import passes
-from timing import best_of
+from timing import best_of, header, parser
 
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.rolling_noise import MODELS, Corrugation, RollingNoiseModel, noise_config
@@ -20,14 +17,12 @@ from rail_monitor.site import load_parameter_file, site_from_values
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = parser(__doc__)
     ap.add_argument("--passes", type=int, default=100_000, help="passes of the batch run")
-    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
     ns = ap.parse_args()
     values = load_parameter_file(ns.site)
     site, cfg = site_from_values(values), noise_config(values)
-    print(f"# rolling-noise benchmark, {platform.node()}, {platform.processor() or platform.machine()}, "
-          f"numpy {np.__version__}")
+    header("rolling-noise")
     t = time.perf_counter()
     model = RollingNoiseModel(site, cfg)
     print(f"site set-up (tables, per-class transfers of both models): {1e3 * (time.perf_counter() - t):8.2f} ms")

@@ -6,12 +6,10 @@ Prints figures measured in this run only (compare ratios, not absolute times, ac
 
 from __future__ import annotations
 
-import argparse
-import platform
 import time
 
 import numpy as np
-from timing import best_of
+from timing import best_of, header, parser
 
 from rail_monitor import squeal_risk
 from rail_monitor.models import squeal
@@ -20,16 +18,14 @@ from rail_monitor.site import load_parameter_file, site_from_values
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = parser(__doc__)
     ap.add_argument("--ode-cases", type=int, default=5, help="crabbing velocities integrated in time")
-    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
     ns = ap.parse_args()
     case = squeal_risk.rig_case()
     args = (case.speed_mps, case.load_n, case.damping_nspm, case.k1, case.k2, case.k3_n)
     vcs = np.linspace(0.2, 0.5, ns.ode_cases)
 
-    print(f"# squeal benchmark, {platform.node()}, {platform.processor() or platform.machine()}, "
-          f"numpy {np.__version__}")
+    header("squeal")
     one = best_of(lambda: squeal.limit_cycle_amplitude(args[0], 0.39, *args[1:]), 50)
     ode_times, errs = [], []
     for vc in vcs:

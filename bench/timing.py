@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import argparse
+import platform
 import time
 from collections.abc import Callable
+
+import numpy as np
 
 
 def best_of(fn: Callable[[], object], repeat: int = 5) -> float:
@@ -14,3 +18,16 @@ def best_of(fn: Callable[[], object], repeat: int = 5) -> float:
         fn()
         times.append(time.perf_counter() - t)
     return min(times)
+
+
+def parser(doc: str) -> argparse.ArgumentParser:
+    """The command line of a benchmark (its docstring's first paragraph) with --site."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml", help="site parameter file")
+    return ap
+
+
+def header(name: str) -> None:
+    """The first line of a benchmark's output: what ran, where."""
+    print(f"# {name} benchmark, {platform.node()}, {platform.processor() or platform.machine()}, "
+          f"numpy {np.__version__}")
