@@ -30,7 +30,7 @@ from rail_monitor.errors import ConfigError
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
-from rail_monitor.models.passby import Receiver, pass_by
+from rail_monitor.models.passby import PassBy, Receiver, pass_by
 from rail_monitor.params import ParamSpec, ParamValues, resolve, section
 from rail_monitor.passes import PassTable
 from rail_monitor.site import Site
@@ -98,9 +98,9 @@ def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConf
     return NoiseConfig(values)
 
 
-def roughness_level_db(amplitude_m: np.ndarray) -> np.ndarray:
-    """Roughness level [dB re 1 um] of an r.m.s. amplitude [m]."""
-    return level((np.asarray(amplitude_m, float) / 1e-6) ** 2)
+def roughness_power(amplitude_m: np.ndarray) -> np.ndarray:
+    """Squared roughness re (1 um)^2 [-] of an r.m.s. amplitude [m] (10 lg of it: dB re 1 um)."""
+    return (np.asarray(amplitude_m, float) / 1e-6) ** 2
 
 
 @dataclass(frozen=True)
@@ -176,7 +176,7 @@ class RollingNoiseModel:
         octaves = np.abs(np.log2(self.grid[:, None] / wl[None, :]))
         nearest = np.argmin(octaves, axis=1)
         inside = octaves[np.arange(len(self.grid)), nearest] <= 1.0 / 6.0
-        extra = np.where(inside, (np.asarray(amp, float)[nearest] / 1e-6) ** 2, 0.0)
+        extra = np.where(inside, roughness_power(amp)[nearest], 0.0)
         return level(power(self.baseline_db) + extra)
 
     def predict(self, passes: PassTable, model: str | None = None,
@@ -189,41 +189,42 @@ class RollingNoiseModel:
         model = model or self.models[0]
         if model not in MODELS:
             raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
-        n = len(passes)
-        current = self.rail_roughness_db(corrugation)
-        rails = [current] if corrugation is None else [current, self.rail_roughness_db(corrugation, True)]
-        per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
-        out: dict[str, Any] = {}
-        results = []
-        for rail in rails:
-            roughness = np.empty((n, len(self.band)))
-            components: dict[str, np.ndarray] = {}
-            for name in set(passes.vehicle_class.tolist()):
-                rows = passes.vehicle_class == name
-                terms = self.classes[name]
-                lr, transfers = self._roughness(rail, terms, passes.speed_mps[rows], model)
-                roughness[rows] = lr
-                for comp, lh in transfers.items():
-                    components.setdefault(comp, np.full((n, len(self.band)), -np.inf))[rows] = lr + lh + per_metre[rows]
-            lw = level(sum(power(c) for c in components.values()))
-            pb = pass_by(lw, self.band, passes.train_length_m, passes.speed_mps, self.receiver, self.vertical_db,
-                         time_weighted=not out)
-            results.append(pb)
-            if not out:
-                comp_names = list(components)
-                out = {
-                    "model": model, "band_centre_hz": self.band_hz, "speed_mps": passes.speed_mps,
-                    "lp_db": pb.lp_db, "lw_db": lw, "roughness_db": roughness,
-                    "pass_by_time_s": pb.pass_by_time_s, "lpaeq_tp_dba": pb.lpaeq_tp_dba,
-                    "lpafmax_dba": pb.lpafmax_dba, "tel_dba": pb.tel_dba,
-                    "component_names": comp_names,
-                    "component_lpaeq_dba": np.stack([
-                        pass_by(components[c], self.band, passes.train_length_m, passes.speed_mps, self.receiver,
-                                self.vertical_db, time_weighted=False).lpaeq_tp_dba for c in comp_names], axis=-1),
-                }
-        out["roughness_growth_increase_db"] = (results[0].lpaeq_tp_dba - results[1].lpaeq_tp_dba
-                                               if len(results) > 1 else np.zeros(n))
+        roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model)
+        pb = self._pass_by(components, passes)
+        names = list(components)
+        out: dict[str, Any] = {
+            "model": model, "band_centre_hz": self.band_hz, "speed_mps": passes.speed_mps,
+            "lp_db": pb.lp_db, "lw_db": _total(components), "roughness_db": roughness,
+            "pass_by_time_s": pb.pass_by_time_s, "lpaeq_tp_dba": pb.lpaeq_tp_dba, "lpafmax_dba": pb.lpafmax_dba,
+            "tel_dba": pb.tel_dba, "component_names": names,
+            "component_lpaeq_dba": np.stack([self._pass_by({c: components[c]}, passes, False).lpaeq_tp_dba
+                                             for c in names], axis=-1),
+            "roughness_growth_increase_db": np.zeros(len(passes)),
+        }
+        if corrugation is not None:
+            _, ground = self._sources(self.rail_roughness_db(corrugation, post_grinding=True), passes, model)
+            out["roughness_growth_increase_db"] = pb.lpaeq_tp_dba - self._pass_by(ground, passes, False).lpaeq_tp_dba
         return out
+
+    def _sources(self, rail_db: np.ndarray, passes: PassTable,
+                 model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Effective roughness [dB re 1 um] and sound power per metre of train per component
+        [dB re 1 pW/m] (passes x bands) on a rail roughness spectrum."""
+        n, nb = len(passes), len(self.band)
+        per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
+        roughness = np.empty((n, nb))
+        components: dict[str, np.ndarray] = {}
+        for name in set(passes.vehicle_class.tolist()):
+            rows = passes.vehicle_class == name
+            lr, transfers = self._roughness(rail_db, self.classes[name], passes.speed_mps[rows], model)
+            roughness[rows] = lr
+            for comp, lh in transfers.items():
+                components.setdefault(comp, np.full((n, nb), -np.inf))[rows] = lr + lh + per_metre[rows]
+        return roughness, components
+
+    def _pass_by(self, components: dict[str, np.ndarray], passes: PassTable, time_weighted: bool = True) -> PassBy:
+        return pass_by(_total(components), self.band, passes.train_length_m, passes.speed_mps, self.receiver,
+                       self.vertical_db, time_weighted)
 
     def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray,
                    model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -237,3 +238,7 @@ class RollingNoiseModel:
         lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + level(filt)
         return lr, terms.mechanics
 
+
+def _total(components: dict[str, np.ndarray]) -> np.ndarray:
+    """Energy sum of component levels [dB]."""
+    return level(sum(power(c) for c in components.values()))

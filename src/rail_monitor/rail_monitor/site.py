@@ -18,10 +18,9 @@ import yaml
 
 from rail_monitor.errors import ConfigError
 from rail_monitor.models import hertz
+from rail_monitor.models.cnossos import BRAKE_TYPES
 from rail_monitor.models.track import Track
 from rail_monitor.params import ParamSpec, flatten, resolve, section
-
-BRAKE_TYPES = ("cast_iron", "composite", "disc")
 
 SITE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("site_id", "site", "Site identifier, written to header.frame_id of every message."),

@@ -50,7 +50,7 @@ FloatArray = NDArray[np.float64]
 EDITION = "2021"
 INTERPOLATION_RULES = ("reference", "energy_log_frequency")
 RAIL_ROUGHNESS_CLASSES = ("E", "M")
-BRAKE_COLUMNS = {"cast_iron": "cast_iron", "composite": "composite", "disc": "disc"}
+BRAKE_TYPES = ("cast_iron", "composite", "disc")   # Table G-1a columns
 SLEEPER_TYPES = ("monoblock", "biblock", "wooden", "direct_fastening")
 PAD_CLASSES = ("soft", "medium", "hard")
 BRIDGE_TYPES = ("none", "concrete", "steel")
@@ -120,9 +120,9 @@ def rail_roughness(roughness_class: str) -> FloatArray:
 
 def wheel_roughness(brake_type: str) -> FloatArray:
     """Wheel roughness [dB re 1 um] by brake type (cast_iron, composite, disc), Table G-1a."""
-    if brake_type not in BRAKE_COLUMNS:
-        raise ValueError(f"brake type must be one of {tuple(BRAKE_COLUMNS)}")
-    return tables().by_wavelength[f"wheel_roughness_{BRAKE_COLUMNS[brake_type]}_unrounded"]
+    if brake_type not in BRAKE_TYPES:
+        raise ValueError(f"brake type must be one of {BRAKE_TYPES}")
+    return tables().by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
 
 
 def contact_filter(wheel_load_n: float, wheel_diameter_m: float) -> tuple[tuple[float, float], FloatArray]:
