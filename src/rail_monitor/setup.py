@@ -29,6 +29,7 @@ setup(
             "squeal_risk_model = rail_monitor.nodes.squeal_risk_model:main",
             "corrugation_estimator = rail_monitor.nodes.corrugation_estimator:main",
             "rolling_noise_predictor = rail_monitor.nodes.rolling_noise_predictor:main",
+            "alert_manager = rail_monitor.nodes.alert_manager:main",
             "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
             "rail-monitor = rail_monitor.cli:main",
         ],

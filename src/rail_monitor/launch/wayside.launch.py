@@ -35,8 +35,10 @@ def generate_launch_description() -> LaunchDescription:
         Node(package="rail_monitor", executable="corrugation_estimator", namespace=ns,
              parameters=[site, common, {"checkpoint_path": LaunchConfiguration("checkpoint")}]),
         Node(package="rail_monitor", executable="rolling_noise_predictor", namespace=ns, parameters=[site, common]),
-        # The replayer starts once the recorder and the three models subscribe, so no pass is lost.
+        Node(package="rail_monitor", executable="alert_manager", namespace=ns, parameters=[site, common]),
+        # The replayer starts once the recorder, the three models and the alert manager subscribe,
+        # so no pass is lost.
         Node(package="rail_monitor", executable="pass_replayer", namespace=ns,
              parameters=[site, {"source": LaunchConfiguration("source"), "rate": LaunchConfiguration("rate"),
-                                "wait_for_subscribers": 4}]),
+                                "wait_for_subscribers": 5}]),
     ])

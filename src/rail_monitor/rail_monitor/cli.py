@@ -1,4 +1,4 @@
-"""rail-monitor: command-line front end (simulate, replay, record, monitor, demo, info, predict).
+"""rail-monitor: command-line front end (simulate, replay, record, monitor, demo, batch, report, info, predict).
 
 Node options are generated from the same ParamSpecs the nodes declare, so --help shows every
 unit, range and default; they become ``-p name:=value`` ROS arguments. Errors the user can act
@@ -157,13 +157,68 @@ def _monitor(ns: argparse.Namespace, source: str, output: str | None) -> int:
 
 
 def cmd_monitor(ns: argparse.Namespace) -> int:
-    return _monitor(ns, ns.source, ns.output)
+    return _monitor_and_report(ns, ns.source)
 
 
 def cmd_demo(ns: argparse.Namespace) -> int:
     if not ns.source.exists():
         raise RailMonitorError(f"{ns.source} not found: run the demo from the repository's top folder")
-    return _monitor(ns, str(ns.source), ns.output)
+    return _monitor_and_report(ns, str(ns.source))
+
+
+def _monitor_and_report(ns: argparse.Namespace, source: str) -> int:
+    output = ns.output or f"rail_monitor_{Path(source).stem}"
+    rc = _monitor(ns, source, output)
+    if rc == 0 and not getattr(ns, "no_report", False):
+        _report(output, ns.site, ns.report)
+    return rc
+
+
+def _report_dir(bag: str, report: str | None) -> Path:
+    return Path(report) if report else Path(f"{str(bag).rstrip('/')}_report")
+
+
+def _report(bag: str, site: str | None, report: str | None) -> None:
+    """Print the run summary and write the report folder."""
+    from rail_monitor.report import build_report, load_run, summary_lines
+    from rail_monitor.site import load_parameter_file
+
+    values = load_parameter_file(_site_file(site))
+    run = load_run(bag)
+    print("\n".join(summary_lines(run, values)))
+    files = build_report(run, values, _report_dir(bag, report))
+    print(f"report: {files[-1]} ({len(files) - 1} plots)")
+
+
+def cmd_report(ns: argparse.Namespace) -> int:
+    _report(ns.bag, ns.site, ns.out)
+    return 0
+
+
+def cmd_batch(ns: argparse.Namespace) -> int:
+    import time
+
+    from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.batch import run_models, write_bag
+    from rail_monitor.site import load_parameter_file
+
+    t0 = time.monotonic()
+    values = load_parameter_file(_site_file(ns.site))
+    passes = read_passes(ns.source, ns.topic)
+    out = Path(ns.output or f"{Path(ns.source).stem}_batch")
+    if out.exists():
+        if not ns.overwrite:
+            raise RailMonitorError(f"{out} exists; remove it or pass --overwrite")
+        shutil.rmtree(out)
+    result = run_models(passes, values)
+    t_models = time.monotonic() - t0
+    write_bag(result, out, ns.namespace if ns.namespace is not None else str(values.get("site_id", "")))
+    print(f"batch: {len(passes)} passes through the models in {t_models:.2f} s "
+          f"({len(passes) / max(t_models, 1e-9):.0f} passes/s); recorded to {out} in "
+          f"{time.monotonic() - t0 - t_models:.1f} s")
+    if not ns.no_report:
+        _report(str(out), ns.site, ns.report)
+    return 0
 
 
 # predict squeal: option, SquealCase field, unit
@@ -507,6 +562,25 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--plot", metavar="PNG", help="save A-weighted spectra at the speeds and after growth")
     r.set_defaults(func=cmd_predict_noise)
 
+    s = sub.add_parser("batch", help="the graph's models over a whole history without DDS (vectorised), "
+                       "recorded to a bag like the live graph, with the report")
+    s.add_argument("source", help="bag folder, .mcap, .db3 or .csv")
+    s.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    s.add_argument("--topic", help="TrainPass topic of the bag (default: the only one)")
+    s.add_argument("--output", help="bag folder to write (default: <source>_batch)")
+    s.add_argument("--namespace", help="topic namespace in the bag (default: the site_id)")
+    s.add_argument("--report", help="report folder (default: <output>_report)")
+    s.add_argument("--no-report", action="store_true", help="write the bag only")
+    s.add_argument("--overwrite", action="store_true", help="replace an existing output folder")
+    s.set_defaults(func=cmd_batch)
+
+    s = sub.add_parser("report", help="print the summary of a recorded run and write its report folder "
+                       "(PNG plots, index.html)")
+    s.add_argument("bag", help="bag recorded by the graph or by batch")
+    s.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    s.add_argument("--out", help="report folder (default: <bag>_report)")
+    s.set_defaults(func=cmd_report)
+
     for name, helptext in (("monitor", "run the whole graph in one process on a history"),
                            ("demo", "the main job: the bundled sample history through the whole graph")):
         s = sub.add_parser(name, help=helptext)
@@ -518,6 +592,8 @@ def build_parser() -> argparse.ArgumentParser:
             s.add_argument("--output", default="out/demo", help="bag folder to record into")
         s.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
         s.add_argument("--namespace", help="site namespace (default: the site_id)")
+        s.add_argument("--report", help="report folder (default: <output>_report)")
+        s.add_argument("--no-report", action="store_true", help="record only: no summary or report")
         s.add_argument("--overwrite", action="store_true", default=name == "demo",
                        help="replace an existing output folder")
         _add_specs(s, MONITOR_SPECS + PUBLISH_SPECS, skip=("site_id", "wait_for_subscribers", "wait_timeout_s"))

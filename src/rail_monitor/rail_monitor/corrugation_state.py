@@ -66,6 +66,8 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
               0.0, 3650.0),
     ParamSpec("history_days", 28.0, "Passes kept for the forecast (recent speeds, friction, traffic) and for "
               "duplicate detection; older passes are not counted [day].", 0.01, 3650.0),
+    ParamSpec("min_traffic_days", 1.0, "Least span of kept passes from which the traffic rate, and so the "
+              "forecast in days, is estimated (a shorter span is biased by the daily timetable) [day].", 0.0, 3650.0),
     ParamSpec("advice_min_speed_mps", 0.0, "Lowest speed the advice may use [m/s] (0: the slowest class "
               "minimum of the rolling-stock table).", 0.0, MAX_SPEED_MPS),
     ParamSpec("advice_max_speed_mps", 0.0, "Highest speed the advice may use [m/s] (0: the line speed, the "
@@ -90,6 +92,8 @@ def corrugation_config(values: Mapping[str, Any], prefix: str = "corrugation.") 
     out = resolve(CORRUGATION_SPECS, section(values, prefix), where=prefix, strict=True)
     if out["shortest_wavelength_m"] >= out["longest_wavelength_m"]:
         raise ConfigError(f"parameter '{prefix}shortest_wavelength_m' must be below '{prefix}longest_wavelength_m'")
+    if out["min_traffic_days"] > out["history_days"]:
+        raise ConfigError(f"parameter '{prefix}min_traffic_days' exceeds '{prefix}history_days'")
     if out["advice_max_speed_mps"] and out["advice_min_speed_mps"] >= out["advice_max_speed_mps"]:
         raise ConfigError(f"parameter '{prefix}advice_min_speed_mps' must be below '{prefix}advice_max_speed_mps'")
     return CorrugationConfig(out)
@@ -165,6 +169,71 @@ class Forecast:
     grinding_due_ns: int            # 0: never
 
 
+@dataclass(frozen=True)
+class StateSnapshot:
+    """What a CorrugationState carries besides the forecast (units as in the message)."""
+
+    newest_ns: int
+    newest_train_id: str
+    pass_count: int
+    axle_pass_count: int
+    total_pass_count: int
+    last_grinding_ns: int
+    bands: np.ndarray
+    amplitude: np.ndarray
+    threshold: np.ndarray
+    grinding_amplitude: np.ndarray
+    k_b: np.ndarray
+
+
+@dataclass
+class Trajectory:
+    """The state after each counted pass of a history (batch mode): arrays over counted passes.
+
+    index: row of each counted pass in the history given; constants: the snapshot before the
+    history (bands, thresholds, post-grinding amplitudes, K_b, last grinding).
+    """
+
+    index: np.ndarray
+    stamp_ns: np.ndarray
+    train_id: np.ndarray
+    amplitude: np.ndarray          # (M, B) [m]
+    pass_count: np.ndarray
+    axle_pass_count: np.ndarray
+    total_pass_count: np.ndarray
+    forecast: Forecast             # of arrays (M,) and (M, B)
+    constants: StateSnapshot
+
+    def __len__(self) -> int:
+        return len(self.index)
+
+    def state(self, k: int) -> tuple[StateSnapshot, Forecast]:
+        """The snapshot and forecast after counted pass k (for message conversion)."""
+        c, f = self.constants, self.forecast
+        snap = StateSnapshot(int(self.stamp_ns[k]), str(self.train_id[k]), int(self.pass_count[k]),
+                             int(self.axle_pass_count[k]), int(self.total_pass_count[k]), c.last_grinding_ns,
+                             c.bands, self.amplitude[k], c.threshold, c.grinding_amplitude, c.k_b)
+        return snap, Forecast(f.growth_per_axle_pass[k], int(f.worst_band[k]), float(f.passes_to_threshold[k]),
+                              float(f.days_to_threshold[k]), float(f.passes_per_day[k]), bool(f.grinding_due[k]),
+                              int(f.grinding_due_ns[k]))
+
+    @classmethod
+    def from_rows(cls, rows: list[tuple[int, StateSnapshot, Forecast]], last: StateSnapshot) -> Trajectory:
+        """From (history row, snapshot, forecast) per counted pass, taken one by one."""
+        def col(get, dtype=float) -> np.ndarray:
+            return np.array([get(s, f) for _, s, f in rows], dtype=dtype)
+
+        nb = len(last.bands)
+        fc = Forecast(col(lambda s, f: f.growth_per_axle_pass).reshape(-1, nb), col(lambda s, f: f.worst_band, int),
+                      col(lambda s, f: f.passes_to_threshold), col(lambda s, f: f.days_to_threshold),
+                      col(lambda s, f: f.passes_per_day), col(lambda s, f: f.grinding_due, bool),
+                      col(lambda s, f: f.grinding_due_ns, np.int64))
+        return cls(np.array([i for i, _, _ in rows], np.int64), col(lambda s, f: s.newest_ns, np.int64),
+                   col(lambda s, f: s.newest_train_id, object), col(lambda s, f: s.amplitude).reshape(-1, nb),
+                   col(lambda s, f: s.pass_count, np.int64), col(lambda s, f: s.axle_pass_count, np.int64),
+                   col(lambda s, f: s.total_pass_count, np.int64), fc, last)
+
+
 @dataclass
 class Evaluation:
     """A speed distribution's growth against the state (units as in EvaluateSpeedDistribution)."""
@@ -235,6 +304,7 @@ class CorrugationEstimator:
         self.grinding_amplitude = self.post_grinding.copy()             # r.m.s. after the last grinding
         self.pass_count = self.axle_pass_count = self.total_pass_count = 0
         self.last_grinding_ns = self.newest_ns = 0
+        self.newest_train_id = ""                                      # train_id of the newest pass counted
         self.last_survey_ns = 0                                        # last survey or grinding applied
         self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
         self.recent = _Recent()
@@ -250,6 +320,10 @@ class CorrugationEstimator:
         ``passes`` must be valid for the site with class defaults filled. A pass is not counted
         when its (stamp, train_id) was counted already or is older than the kept history.
         """
+        return self._advance(passes)[0]
+
+    def _advance(self, passes: PassTable) -> tuple[np.ndarray, np.ndarray]:
+        """advance(), also returning ln Z after each counted pass (counted, B, P)."""
         n = len(passes)
         counted = np.zeros(n, bool)
         horizon = self.newest_ns - self.history_ns
@@ -261,23 +335,81 @@ class CorrugationEstimator:
             counted[i] = True
             horizon = max(horizon, stamp - self.history_ns)
         if not counted.any():
-            return counted
+            return counted, np.zeros((0, *self.log_components.shape))
         new = passes.take(counted)
         cls = self.tables.class_index(new.vehicle_class)
         growth = self.tables.at(cls, new.friction_state, new.speed_mps) * new.axle_count[:, None, None]
         # Sequential sum (cumsum), so a batch adds as the same passes one by one would.
-        self.log_components = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[-1]
+        steps = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[1:]
+        self.log_components = steps[-1].copy()
         self._growth_sum += growth.sum(axis=0)
         self._axle_sum += int(new.axle_count.sum())
         m = int(counted.sum())
         self.pass_count += m
         self.total_pass_count += m
         self.axle_pass_count += int(new.axle_count.sum())
-        self.newest_ns = max(self.newest_ns, int(new.stamp_ns.max()))
+        i_new = len(new) - 1 - int(np.argmax(new.stamp_ns[::-1]))  # the last of equal stamps, as one by one
+        if int(new.stamp_ns[i_new]) >= self.newest_ns:
+            self.newest_ns, self.newest_train_id = int(new.stamp_ns[i_new]), str(new.train_id[i_new])
         self.recent.extend(stamp_ns=new.stamp_ns, train_id=new.train_id, class_idx=cls,
                            friction=new.friction_state, speed=new.speed_mps, axles=new.axle_count)
         self._prune()
-        return counted
+        return counted, steps
+
+    def advance_history(self, passes: PassTable) -> Trajectory:
+        """advance() over a history, returning the state and forecast after every counted pass,
+        equal to what the live estimator publishes pass by pass (MODELS.md section 2).
+
+        Vectorised when the passes are in time order and none is older than the newest counted:
+        the forecast of pass k then uses the passes within history_days before it, through prefix
+        sums. Otherwise the passes are taken one by one.
+        """
+        stamps = np.asarray(passes.stamp_ns, np.int64)
+        r = self.recent
+        if len(stamps) and (np.any(np.diff(stamps) < 0) or stamps[0] < self.newest_ns):
+            return self._history_one_by_one(passes)
+        kept_growth = self.tables.at(r.class_idx, r.friction, r.speed) * r.axles[:, None, None]
+        kept_stamps, kept_axles = r.stamp_ns.copy(), r.axles.copy()
+        before = self.snapshot()
+        counted, steps = self._advance(passes)
+        new = passes.take(counted)
+        m, k0 = len(new), len(kept_stamps)
+        all_stamps = np.concatenate([kept_stamps, new.stamp_ns])
+        all_axles = np.concatenate([kept_axles, new.axle_count])
+        cls = self.tables.class_index(new.vehicle_class)
+        new_growth = self.tables.at(cls, new.friction_state, new.speed_mps) * new.axle_count[:, None, None]
+        g_prefix = np.concatenate([np.zeros((1, *steps.shape[1:])), np.cumsum(
+            np.concatenate([kept_growth, new_growth]), axis=0)])
+        a_prefix = np.concatenate([[0], np.cumsum(all_axles)])
+        end = k0 + np.arange(1, m + 1)                                   # one past pass k
+        start = np.searchsorted(all_stamps, new.stamp_ns - self.history_ns, side="left")
+        axles = (a_prefix[end] - a_prefix[start]).astype(float)
+        growth = (g_prefix[end] - g_prefix[start]) / axles[:, None, None]
+        span_days = (new.stamp_ns - all_stamps[start]) / NS_PER_DAY
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rate = np.where((span_days > 0) & (span_days >= self.cfg["min_traffic_days"]),
+                            (end - start - 1) / span_days, np.nan)
+        fc = self._forecasts(steps, growth, rate, axles / (end - start), new.stamp_ns)
+        ordinal = np.arange(1, m + 1)
+        return Trajectory(
+            index=np.flatnonzero(counted), stamp_ns=new.stamp_ns.copy(), train_id=new.train_id.copy(),
+            amplitude=cg.band_amplitude(steps), pass_count=before.pass_count + ordinal,
+            axle_pass_count=before.axle_pass_count + np.cumsum(new.axle_count),
+            total_pass_count=before.total_pass_count + ordinal, forecast=fc,
+            constants=before)
+
+    def _history_one_by_one(self, passes: PassTable) -> Trajectory:
+        rows: list[tuple[int, StateSnapshot, Forecast]] = []
+        for i in range(len(passes)):
+            if self.advance(passes.take(np.arange(len(passes)) == i))[0]:
+                rows.append((i, self.snapshot(), self.forecast()))
+        return Trajectory.from_rows(rows, self.snapshot())
+
+    def snapshot(self) -> StateSnapshot:
+        """The state as a CorrugationState carries it (without the forecast)."""
+        return StateSnapshot(self.newest_ns, self.newest_train_id, self.pass_count, self.axle_pass_count,
+                             self.total_pass_count, self.last_grinding_ns, self.bands, self.amplitude,
+                             self.threshold, self.grinding_amplitude.copy(), self.k_b.copy())
 
     def _prune(self) -> None:
         keep = self.recent.stamp_ns >= self.newest_ns - self.history_ns
@@ -309,12 +441,13 @@ class CorrugationEstimator:
         return self._growth_sum / self._axle_sum
 
     def traffic(self) -> tuple[float, float]:
-        """Recent traffic: (train passes per day, axles per train); NaN rate with fewer than 2 passes."""
+        """Recent traffic: (train passes per day, axles per train); NaN rate with fewer than 2 passes or
+        over less than min_traffic_days."""
         r = self.recent
         if len(r.stamp_ns) == 0:
             return float("nan"), float("nan")
         span = (int(r.stamp_ns.max()) - int(r.stamp_ns.min())) / NS_PER_DAY
-        rate = (len(r.stamp_ns) - 1) / span if span > 0 else float("nan")
+        rate = (len(r.stamp_ns) - 1) / span if span > 0 and span >= self.cfg["min_traffic_days"] else float("nan")
         return rate, float(r.axles.mean())
 
     def forecast(self, growth: np.ndarray | None = None, passes_per_day: float | None = None) -> Forecast:
@@ -329,18 +462,32 @@ class CorrugationEstimator:
         rate, axles = self.traffic()
         if passes_per_day:
             rate = passes_per_day
-        if not np.isfinite(axles):
-            axles = float(np.mean([v.mean_axles_per_train for v in self.site.vehicles.values()]))
-        margin = np.log(self.threshold) - self.log_amplitude
-        axle_passes = cg.passes_to_band_level(self.log_components, g, np.log(self.threshold))
-        worst = int(np.argmin(axle_passes)) if np.isfinite(axle_passes).any() else int(np.argmin(margin))
-        passes = float(axle_passes[worst] / axles)
-        days = passes / rate if np.isfinite(rate) and rate > 0 else float("inf")
-        if passes == 0.0:
-            days = 0.0
-        due = bool(margin.min() <= 0 or days <= self.cfg["lead_time_days"])
-        due_ns = self.newest_ns + int(days * NS_PER_DAY) if np.isfinite(days) else 0
-        return Forecast(g.max(axis=1), worst, passes, days, rate, due, due_ns)
+        fc = self._forecasts(self.log_components[None], g[None], np.array([rate]), np.array([axles]),
+                             np.array([self.newest_ns]))
+        return Forecast(fc.growth_per_axle_pass[0], int(fc.worst_band[0]), float(fc.passes_to_threshold[0]),
+                        float(fc.days_to_threshold[0]), float(fc.passes_per_day[0]), bool(fc.grinding_due[0]),
+                        int(fc.grinding_due_ns[0]))
+
+    def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
+                   newest_ns: np.ndarray) -> Forecast:
+        """forecast() for N states at once: ln Z and g (N, B, P), train passes per day and axles
+        per train (N,), newest pass time (N,) [ns]; a Forecast of arrays."""
+        fallback = float(np.mean([v.mean_axles_per_train for v in self.site.vehicles.values()]))
+        axles = np.where(np.isfinite(axles), axles, fallback)
+        log_threshold = np.log(self.threshold)
+        margin = log_threshold - np.log(cg.band_amplitude(log_components))
+        axle_passes = cg.passes_to_band_level(log_components, growth, log_threshold)
+        rows = np.arange(len(rate))
+        worst = np.where(np.isfinite(axle_passes).any(axis=1), np.argmin(axle_passes, axis=1),
+                         np.argmin(margin, axis=1))
+        passes = axle_passes[rows, worst] / axles
+        with np.errstate(divide="ignore", invalid="ignore"):
+            days = np.where(np.isfinite(rate) & (rate > 0), passes / rate, np.inf)
+        days = np.where(passes == 0.0, 0.0, days)
+        due = (margin.min(axis=1) <= 0) | (days <= self.cfg["lead_time_days"])
+        due_ns = np.array([int(t) + int(d * NS_PER_DAY) if np.isfinite(d) else 0
+                           for t, d in zip(newest_ns.tolist(), days.tolist(), strict=True)], np.int64)
+        return Forecast(growth.max(axis=2), worst, passes, days, rate, due, due_ns)
 
     # -- surveys and grinding -------------------------------------------------------------------
     def _match(self, wavelength: np.ndarray, amplitude: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -503,6 +650,7 @@ class CorrugationEstimator:
         meta = {"version": CHECKPOINT_VERSION, "site_id": self.site.site_id, "pass_count": self.pass_count,
                 "axle_pass_count": self.axle_pass_count, "total_pass_count": self.total_pass_count,
                 "last_grinding_ns": self.last_grinding_ns, "newest_ns": self.newest_ns,
+                "newest_train_id": self.newest_train_id,
                 "last_survey_ns": self.last_survey_ns}
         buf = io.BytesIO()
         np.savez(buf, meta=np.array(json.dumps(meta)), bands=self.bands, log_components=self.log_components,
@@ -544,6 +692,7 @@ class CorrugationEstimator:
         for key in ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns",
                     "last_survey_ns"):
             setattr(self, key, int(meta[key]))
+        self.newest_train_id = str(meta.get("newest_train_id", ""))
         self.recent = _Recent(**{n: data[f"recent_{n}"] for n in _RECENT})
         self.recent.train_id = self.recent.train_id.astype(object)
         self._seen = set(zip(self.recent.stamp_ns.tolist(), self.recent.train_id.tolist(), strict=True))

@@ -97,3 +97,103 @@ def noise_spectra(band_hz: np.ndarray, panels: dict[str, dict[str, np.ndarray]],
     if title:
         fig.suptitle(textwrap.fill(title, 90), fontsize="small")
     return _save(fig, path)
+
+
+# -- run report (rail_monitor.report) -----------------------------------------------------------
+def _dates(stamp_ns: np.ndarray) -> np.ndarray:
+    return np.asarray(stamp_ns, np.int64).astype("datetime64[ns]")
+
+
+def corrugation_history(states: dict[str, np.ndarray], path: str | Path, bands_shown: int = 4) -> Path:
+    """r.m.s. roughness of the bands nearest their thresholds against pass time, with the thresholds
+    (dashed), grinding events (vertical lines) and the forecast of the worst band (dotted, to its
+    threshold at the forecast time)."""
+    t = _dates(states["stamp"])
+    amp, thr, lam = states["amplitude_m"], states["threshold_m"], states["wavelength_m"]
+    shown = np.argsort(-(amp[-1] / thr[-1]))[:bands_shown]
+    fig, ax = plt.subplots(figsize=(8.0, 4.6), constrained_layout=True)
+    for j, b in enumerate(shown):
+        colour = f"C{j}"
+        ax.semilogy(t, 1e6 * amp[:, b], color=colour, label=f"{1e3 * lam[b]:.1f} mm")
+        ax.axhline(1e6 * thr[-1, b], color=colour, ls="--", lw=0.9)
+    w = int(states["worst_band"][-1])
+    due = int(states["grinding_due_time"][-1])
+    if due and w in shown:
+        ax.semilogy([t[-1], _dates(np.array([due]))[0]], [1e6 * amp[-1, w], 1e6 * thr[-1, w]], ":", color="k",
+                    label=f"forecast {1e3 * lam[w]:.1f} mm: {str(_dates(np.array([due]))[0])[:10]}")
+    for g in sorted(set(states["last_grinding_time"].tolist()) - {0}):
+        ax.axvline(_dates(np.array([g]))[0], color="grey", lw=1.5, label="grinding")
+    ax.set_ylabel("r.m.s. roughness [um] (dashed: intervention threshold)")
+    ax.set_xlabel("pass time (UTC)")
+    ax.set_title("Corrugation per 1/3-octave wavelength band (the bands nearest their thresholds)")
+    ax.legend(fontsize="small", ncol=2)
+    ax.grid(True, which="both", alpha=0.3)
+    fig.autofmt_xdate()
+    return _save(fig, path)
+
+
+def noise_history(noise: dict[str, dict[str, np.ndarray]], before: dict, after: dict, path: str | Path) -> Path:
+    """LpAeq,Tp per pass against pass time per model, and A-weighted spectra of a reference pass on
+    the post-grinding and the final rail."""
+    from rail_monitor.models.iec61672 import a_weighting_db
+
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8.0, 7.6), constrained_layout=True)
+    for j, (model, nz) in enumerate(noise.items()):
+        ax1.plot(_dates(nz["stamp_ns"]), nz["lpaeq_tp_dba"], ".", ms=2, color=f"C{j}", label=model)
+    ax1.set_ylabel("LpAeq,Tp at the receiver [dB(A)]")
+    ax1.set_xlabel("pass time (UTC)")
+    ax1.legend(markerscale=6)
+    ax1.grid(True, alpha=0.3)
+    for j, model in enumerate(m for m in before if m != "label"):
+        f = before[model]["band_centre_hz"]
+        aw = a_weighting_db(f)
+        ax2.semilogx(f, before[model]["lp_db"][0] + aw, "o--", ms=3, color=f"C{j}", label=f"{model}, post-grinding")
+        ax2.semilogx(f, after[model]["lp_db"][0] + aw, "o-", ms=3, color=f"C{j}", label=f"{model}, final state")
+    ax2.set_xlabel("1/3-octave band centre [Hz]")
+    ax2.set_ylabel("Lp,A per band [dB(A)]")
+    ax2.set_title(f"Spectra before and after roughness growth: {before['label']}", fontsize="medium")
+    ax2.legend(fontsize="small")
+    ax2.grid(True, which="both", alpha=0.3)
+    return _save(fig, path)
+
+
+def squeal_passes(squeal: dict[str, np.ndarray], curves: dict, path: str | Path) -> Path:
+    """Squeal velocity amplitude against crabbing velocity: the model per friction state (lines, for a
+    reference pass) and every pass (points, its own speed, load and class)."""
+    from rail_monitor.passes import FRICTION_NAMES
+
+    fig, ax = plt.subplots(figsize=(8.0, 4.8), constrained_layout=True)
+    for j, (state, name) in enumerate(FRICTION_NAMES.items()):
+        rows = squeal["friction_state"] == state
+        ax.plot(squeal["crabbing_velocity_mps"][rows], squeal["velocity_amplitude_mps"][rows], ".", ms=3,
+                color=f"C{j}", alpha=0.5, label=f"passes, {name}")
+        if name in curves:
+            c = curves[name]
+            ax.plot(c["crabbing_velocity_mps"], c["velocity_amplitude_mps"], "-", color=f"C{j}",
+                    label=f"model, {name} ({curves['label']})")
+    ax.set_xlabel("crabbing velocity Vc [m/s]")
+    ax.set_ylabel("lateral velocity amplitude A w [m/s]")
+    ax.legend(fontsize="small", ncol=2)
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path)
+
+
+def speed_distribution(speeds: np.ndarray, advisory, path: str | Path) -> Path:
+    """The history's pass speeds next to the advised distribution (same mean, least peak growth)."""
+    fig, ax = plt.subplots(figsize=(8.0, 4.2), constrained_layout=True)
+    if advisory is not None and len(advisory.speed_bin_centres_mps):
+        c = np.asarray(advisory.speed_bin_centres_mps)
+        width = float(np.min(np.diff(c))) if len(c) > 1 else 0.5
+        ax.bar(c - width / 4, advisory.current_probability, width / 2, label="recent passes (axle-weighted)")
+        ax.bar(c + width / 4, advisory.recommended_probability, width / 2,
+               label=f"advised (peak growth -{100 * advisory.peak_growth_reduction:.0f} %)")
+        bins = np.append(c - width / 2, c[-1] + width / 2)
+    else:
+        bins = 30
+    hist, edges = np.histogram(speeds, bins=bins)
+    ax.stairs(hist / max(hist.sum(), 1), edges, color="k", label="whole history (passes)")
+    ax.set_xlabel("pass speed [m/s]")
+    ax.set_ylabel("share of traffic [-]")
+    ax.legend(fontsize="small")
+    ax.grid(True, alpha=0.3)
+    return _save(fig, path)

@@ -105,7 +105,10 @@ def roughness_power(amplitude_m: np.ndarray) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Corrugation:
-    """The part of a CorrugationState the noise needs: bands [m] and r.m.s. amplitudes [m]."""
+    """The part of a CorrugationState the noise needs: bands [m] and r.m.s. amplitudes [m].
+
+    amplitude_m and post_grinding_m are (bands,) for one state, or (passes, bands) for a state per
+    pass (batch mode)."""
 
     wavelength_m: np.ndarray
     amplitude_m: np.ndarray
@@ -166,7 +169,7 @@ class RollingNoiseModel:
 
     def rail_roughness_db(self, corrugation: Corrugation | None = None, post_grinding: bool = False) -> np.ndarray:
         """Rail roughness on the CNOSSOS wavelength grid [dB re 1 um]: baseline plus the corrugation
-        state (or its post-grinding amplitudes) in energy."""
+        state (or its post-grinding amplitudes) in energy; (grid,) or, for a state per pass, (passes, grid)."""
         if corrugation is None:
             return self.baseline_db
         amp = corrugation.post_grinding_m if post_grinding else corrugation.amplitude_m
@@ -176,7 +179,7 @@ class RollingNoiseModel:
         octaves = np.abs(np.log2(self.grid[:, None] / wl[None, :]))
         nearest = np.argmin(octaves, axis=1)
         inside = octaves[np.arange(len(self.grid)), nearest] <= 1.0 / 6.0
-        extra = np.where(inside, roughness_power(amp)[nearest], 0.0)
+        extra = np.where(inside, roughness_power(amp)[..., nearest], 0.0)
         return level(power(self.baseline_db) + extra)
 
     def predict(self, passes: PassTable, model: str | None = None,
@@ -216,7 +219,8 @@ class RollingNoiseModel:
         components: dict[str, np.ndarray] = {}
         for name in set(passes.vehicle_class.tolist()):
             rows = passes.vehicle_class == name
-            lr, transfers = self._roughness(rail_db, self.classes[name], passes.speed_mps[rows], model)
+            rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
+            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model)
             roughness[rows] = lr
             for comp, lh in transfers.items():
                 components.setdefault(comp, np.full((n, nb), -np.inf))[rows] = lr + lh + per_metre[rows]

@@ -9,7 +9,15 @@ from builtin_interfaces.msg import Time
 
 from rail_monitor.rolling_noise import Corrugation
 from rail_monitor.timeutil import from_sec_nanosec, to_sec_nanosec
-from rail_msgs.msg import CorrugationState, RollingNoise, SpeedAdvisory, SquealPrediction, TrainPass
+from rail_msgs.msg import (
+    CorrugationState,
+    RollingNoise,
+    SpeedAdvisory,
+    SquealPrediction,
+    TrainPass,
+    WaysideAlert,
+    WaysideAlertArray,
+)
 
 
 def time_msg(ns: int) -> Time:
@@ -19,6 +27,11 @@ def time_msg(ns: int) -> Time:
 
 def time_ns(t: Time) -> int:
     return from_sec_nanosec(t.sec, t.nanosec)
+
+
+def _time_or_never(ns: int) -> Time:
+    """A future time; zero ("never") past 2038, where builtin_interfaces/Time's int32 seconds end."""
+    return time_msg(ns if 0 < ns < 2**31 * 10**9 else 0)
 
 
 def train_pass_msg(row: dict[str, Any], frame_id: str) -> TrainPass:
@@ -70,10 +83,12 @@ def squeal_prediction_msg(values: dict[str, Any], i: int, source: TrainPass) -> 
 
 
 def corrugation_state_msg(est: Any, fc: Any, frame_id: str) -> CorrugationState:
-    """A rail_monitor.corrugation_state.CorrugationEstimator and its Forecast as a CorrugationState."""
+    """A rail_monitor.corrugation_state.CorrugationEstimator (or a StateSnapshot of one) and its
+    Forecast as a CorrugationState."""
     msg = CorrugationState()
     msg.header.stamp = time_msg(est.newest_ns)
     msg.header.frame_id = frame_id
+    msg.last_train_id = est.newest_train_id
     msg.pass_count, msg.axle_pass_count = est.pass_count, est.axle_pass_count
     msg.total_pass_count = est.total_pass_count
     msg.last_grinding_time = time_msg(est.last_grinding_ns)
@@ -88,8 +103,7 @@ def corrugation_state_msg(est: Any, fc: Any, frame_id: str) -> CorrugationState:
     msg.days_to_threshold = float(fc.days_to_threshold)
     msg.passes_per_day = float(fc.passes_per_day)
     msg.grinding_due = fc.grinding_due
-    # builtin_interfaces/Time has an int32 second: a forecast past 2038 is sent as "never" (zero).
-    msg.grinding_due_time = time_msg(fc.grinding_due_ns if fc.grinding_due_ns < 2**31 * 10**9 else 0)
+    msg.grinding_due_time = _time_or_never(fc.grinding_due_ns)
     msg.k_b_by_friction = [float(k) for k in est.k_b]
     return msg
 
@@ -131,3 +145,29 @@ def corrugation_from_msg(msg: CorrugationState) -> Corrugation:
             and np.all(np.isfinite(post)) and np.all(post >= 0)):
         raise ValueError("a wavelength is not positive or an amplitude is negative or not finite")
     return Corrugation(wl, amp, post)
+
+
+def wayside_alert_msg(alert: Any, frame_id: str) -> WaysideAlert:
+    """A rail_monitor.alerts.Alert as a WaysideAlert."""
+    msg = WaysideAlert(kind=alert.kind, key=alert.key, severity=alert.severity, active=alert.active,
+                       summary=alert.summary, value=float(alert.value), threshold=float(alert.threshold),
+                       unit=alert.unit, raised_time=time_msg(alert.raised_ns), due_time=_time_or_never(alert.due_ns))
+    msg.header.stamp = time_msg(alert.stamp_ns)
+    msg.header.frame_id = frame_id
+    return msg
+
+
+def wayside_alert_array_msg(alerts: list[Any], stamp_ns: int, frame_id: str) -> WaysideAlertArray:
+    """The standing alerts (rail_monitor.alerts.Alert) as a WaysideAlertArray snapshot."""
+    msg = WaysideAlertArray(alerts=[wayside_alert_msg(a, frame_id) for a in alerts])
+    msg.header.stamp = time_msg(stamp_ns)
+    msg.header.frame_id = frame_id
+    return msg
+
+
+def alert_from_msg(msg: WaysideAlert) -> Any:
+    """A WaysideAlert back as a rail_monitor.alerts.Alert."""
+    from rail_monitor.alerts import Alert
+
+    return Alert(msg.kind, msg.key, msg.severity, msg.active, msg.summary, msg.value, msg.threshold, msg.unit,
+                 time_ns(msg.header.stamp), time_ns(msg.raised_time), time_ns(msg.due_time))

@@ -18,7 +18,7 @@ from collections import Counter
 from typing import Any
 
 from rail_monitor.corrugation_state import CORRUGATION_SPECS, CorrugationEstimator, corrugation_config
-from rail_monitor.nodes.base import declare, run_node, wall_timer
+from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
 from rail_monitor.nodes.convert import corrugation_state_msg, speed_advisory_msg, time_ns
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS
@@ -45,6 +45,7 @@ class CorrugationEstimatorNode(PassModelNode):
         self.est = CorrugationEstimator(self.site, cfg)
         self.checkpoint = self.params["checkpoint_path"]
         self.counts: Counter[str] = Counter()
+        self.sent = Sent()
         self.surveys_rejected: Counter[str] = Counter()
         if self.checkpoint and os.path.exists(self.checkpoint):
             self.est.load(self.checkpoint)  # a checkpoint it cannot use is a ConfigError: no silent fresh start
@@ -71,7 +72,7 @@ class CorrugationEstimatorNode(PassModelNode):
             self._last_state_t = now
 
     def publish_state(self) -> None:
-        self.state_pub.publish(corrugation_state_msg(self.est, self.est.forecast(), self.site.site_id))
+        self.sent.publish(self.state_pub, corrugation_state_msg(self.est, self.est.forecast(), self.site.site_id))
 
     def publish_advisory(self) -> None:
         if not len(self.est.recent.stamp_ns):
@@ -81,7 +82,7 @@ class CorrugationEstimatorNode(PassModelNode):
         except ValueError as exc:
             self.get_logger().warning(f"no speed advice: {exc}", throttle_duration_sec=60.0)
             return
-        self.advisory_pub.publish(speed_advisory_msg(advice, self.est.newest_ns, self.site.site_id))
+        self.sent.publish(self.advisory_pub, speed_advisory_msg(advice, self.est.newest_ns, self.site.site_id))
 
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         stamp = time_ns(msg.header.stamp)

@@ -38,6 +38,9 @@ class PassModelNode(Node):
         """Handle one accepted pass: a one-row table with class defaults filled, and its message."""
         raise NotImplementedError
 
+    def on_rejected(self, msg: TrainPass, reason: str) -> None:
+        """Handle one rejected pass (after it is counted); nothing by default."""
+
     def _on_train_pass(self, msg: TrainPass) -> None:
         self.taken += 1
         table = PassTable.from_rows([train_pass_row(msg)])
@@ -45,6 +48,7 @@ class PassModelNode(Node):
         if reason:
             self.rejected[reason] += 1
             self.get_logger().warning(f"pass {msg.train_id!r} rejected: {reason}", throttle_duration_sec=5.0)
+            self.on_rejected(msg, reason)
             return
         self.accepted.tick()
         self.last_pass_ns = time_ns(msg.header.stamp)

@@ -1,59 +1,125 @@
 """rolling_noise_predictor: predicted rolling noise at the site's receiver for every accepted train pass.
 
-Subscribes ``train_pass`` and ``corrugation/state`` (latched; the latest state received is the rail's
-corrugation); publishes ``noise/rolling`` (rail_msgs/RollingNoise) per pass, one message per source
-model: ``noise.model`` is cnossos, mechanics or both. Parameters: the site (track, contact, rolling
-stock) and ``noise.*`` (rail_monitor.rolling_noise.NOISE_SPECS: baseline rail roughness, CNOSSOS
-track type, interpolation rule, receiver and ground, mechanics radiators). A corrugation state with
-inconsistent arrays is refused with its reason on /diagnostics and the previous one kept.
+Subscribes ``train_pass`` and ``corrugation/state`` (every state, in order); publishes
+``noise/rolling`` (rail_msgs/RollingNoise) per pass, one message per source model: ``noise.model``
+is cnossos, mechanics or both. Parameters: the site (track, contact, rolling stock), ``noise.*``
+(rail_monitor.rolling_noise.NOISE_SPECS: baseline rail roughness, CNOSSOS track type,
+interpolation rule, receiver and ground, mechanics radiators) and ``state_wait_s``.
+
+Which corrugation a pass is predicted on: the state that includes it. While corrugation/state has
+a publisher, a pass waits (at most ``state_wait_s``) for the state whose stamp and last_train_id
+are its own, or for any later state (the pass was not counted: a duplicate); it then takes the
+latest state not newer than itself. So the result does not depend on how the two topics
+interleave, and equals batch mode. A pass that waits too long takes the latest state (counted on
+/diagnostics). A state with inconsistent arrays is refused with its reason on /diagnostics.
 """
 
 from __future__ import annotations
 
 import sys
-from collections import Counter
+import time
+from collections import Counter, deque
+from dataclasses import dataclass
 from typing import Any
 
-from rail_monitor.nodes.base import declare, run_node
+from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
 from rail_monitor.nodes.convert import corrugation_from_msg, rolling_noise_msg, time_ns
 from rail_monitor.nodes.pass_model import PassModelNode
-from rail_monitor.nodes.qos import LATEST_QOS, STREAM_QOS
+from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
+from rail_monitor.params import ParamSpec
 from rail_monitor.passes import PassTable
 from rail_monitor.rolling_noise import NOISE_SPECS, Corrugation, RollingNoiseModel, noise_config
 from rail_monitor.timeutil import format_iso_ns
 from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
+
+NODE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("state_wait_s", 5.0, "Longest wall time a pass waits for the corrugation state that includes it; "
+              "0: take the latest state at once [s].", 0.0, 3600.0),
+)
+STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass queue is as deep)
+
+
+@dataclass
+class _Pending:
+    table: PassTable
+    msg: TrainPass
+    stamp_ns: int
+    deadline: float   # monotonic [s]; -inf: do not wait
 
 
 class RollingNoisePredictor(PassModelNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("rolling_noise_predictor", **kwargs)
         cfg = noise_config(declare(self, NOISE_SPECS, prefix="noise."), prefix="")
+        self.wait_s = declare(self, NODE_SPECS)["state_wait_s"]
         self.model = RollingNoiseModel(self.site, cfg)
-        self.corrugation: Corrugation | None = None
-        self.corrugation_ns = 0
-        self.published = 0
+        self.states: deque[tuple[int, str, Corrugation]] = deque(maxlen=STATES_KEPT)  # in arrival order
+        self.pending: deque[_Pending] = deque()
+        self.sent = Sent()
+        self.counts: Counter[str] = Counter()
         self.states_rejected: Counter[str] = Counter()
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
-        self.create_subscription(CorrugationState, "corrugation/state", self._on_state, LATEST_QOS)
+        self.create_subscription(CorrugationState, "corrugation/state", self._on_state, STATE_SUB_QOS)
+        wall_timer(self, 0.05, self._flush)
 
     def _on_state(self, msg: CorrugationState) -> None:
         try:
-            self.corrugation = corrugation_from_msg(msg)
+            corrugation = corrugation_from_msg(msg)
         except ValueError as exc:
             self.states_rejected[str(exc)] += 1
             self.get_logger().warning(f"corrugation state refused: {exc}", throttle_duration_sec=5.0)
             return
-        self.corrugation_ns = time_ns(msg.header.stamp)
+        self.states.append((time_ns(msg.header.stamp), msg.last_train_id, corrugation))
+        self._flush()
 
     def on_pass(self, table: PassTable, msg: TrainPass) -> None:
+        wait = self.wait_s > 0 and self.count_publishers("corrugation/state") > 0
+        deadline = time.monotonic() + self.wait_s if wait else float("-inf")
+        self.pending.append(_Pending(table, msg, time_ns(msg.header.stamp), deadline))
+        self._flush()
+
+    def _ready(self, p: _Pending) -> bool:
+        """Whether the state including the pass, or a later one, has come (states come in time order)."""
+        for stamp, last, _ in reversed(self.states):
+            if stamp != p.stamp_ns:
+                return stamp > p.stamp_ns
+            if last == p.msg.train_id:
+                return True
+        return False
+
+    def _state_for(self, p: _Pending) -> Corrugation | None:
+        """The latest state not newer than the pass (its own, when it was counted)."""
+        for stamp, last, corrugation in reversed(self.states):
+            if stamp < p.stamp_ns or (stamp == p.stamp_ns and last == p.msg.train_id):
+                return corrugation
+        same = [c for stamp, _, c in self.states if stamp == p.stamp_ns]  # equal stamps, another train
+        return same[-1] if same else None
+
+    def _flush(self) -> None:
+        """Predict the pending passes, in order, that have their state (or waited long enough)."""
+        now = time.monotonic()
+        while self.pending:
+            p = self.pending[0]
+            if not self._ready(p):
+                if now < p.deadline:
+                    return
+                if p.deadline > float("-inf"):
+                    self.counts["predicted on the latest state (waited too long)"] += 1
+            self.pending.popleft()
+            self._predict(p)
+
+    def _predict(self, p: _Pending) -> None:
+        corrugation = self._state_for(p) if self.states else None
         for name in self.model.models:
-            values = self.model.predict(table, name, self.corrugation)
-            self.pub.publish(rolling_noise_msg(values, 0, msg, self.model.receiver))
-            self.published += 1
+            values = self.model.predict(p.table, name, corrugation)
+            self.sent.publish(self.pub, rolling_noise_msg(values, 0, p.msg, self.model.receiver))
 
     def diagnostic_values(self) -> dict[str, Any]:
-        values = {**super().diagnostic_values(), "published": self.published, "models": ",".join(self.model.models),
-                  "corrugation_state": format_iso_ns(self.corrugation_ns) if self.corrugation_ns else "none"}
+        last = self.states[-1][0] if self.states else 0
+        values = {**super().diagnostic_values(), "published": sum(self.sent.values()),
+                  "models": ",".join(self.model.models),
+                  "pending": len(self.pending), **self.counts,
+                  "corrugation_state": format_iso_ns(last) if last else "none"}
         values.update({f"state refused: {why}": n for why, n in sorted(self.states_rejected.items())})
         return values
 

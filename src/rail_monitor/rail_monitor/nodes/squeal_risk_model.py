@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from typing import Any
 
-from rail_monitor.nodes.base import declare, run_node
+from rail_monitor.nodes.base import Sent, declare, run_node
 from rail_monitor.nodes.convert import squeal_prediction_msg
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import STREAM_QOS
@@ -23,15 +23,14 @@ class SquealRiskModel(PassModelNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("squeal_risk_model", **kwargs)
         self.cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
-        self.published = 0
+        self.sent = Sent()
         self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
 
     def on_pass(self, table: PassTable, msg: TrainPass) -> None:
-        self.pub.publish(squeal_prediction_msg(predict(self.cfg, self.site, table), 0, msg))
-        self.published += 1
+        self.sent.publish(self.pub, squeal_prediction_msg(predict(self.cfg, self.site, table), 0, msg))
 
     def diagnostic_values(self) -> dict[str, Any]:
-        return {**super().diagnostic_values(), "published": self.published}
+        return {**super().diagnostic_values(), "published": sum(self.sent.values())}
 
 
 def main(args: list[str] | None = None) -> int:

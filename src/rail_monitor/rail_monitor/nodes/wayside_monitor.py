@@ -1,7 +1,9 @@
-"""wayside_monitor: the whole graph in one process (multi-threaded executor), like a component
-container. Hosts the pass source (replayer of ``source``, or the simulator when ``source`` is
-empty) and the recorder; the model nodes join as they land. Exits when the history has been
-replayed and every recorded topic has drained; prints a summary.
+"""wayside_monitor: the whole graph in one process (one executor), like a component container:
+the pass source (replayer of ``source``, or the simulator when ``source`` is empty),
+corrugation_estimator, rolling_noise_predictor, squeal_risk_model, alert_manager and mcap_recorder.
+Runs on pass time; exits when the history has been replayed, every model has taken every pass and
+the recorder holds every message the nodes published (then a final speed advisory on the final
+state); prints a summary.
 """
 
 from __future__ import annotations
@@ -9,26 +11,32 @@ from __future__ import annotations
 import sys
 import threading
 import time
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.node import Node
 
 from rail_monitor.errors import RailMonitorError
+from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.base import declare, use_flow_control_profile
+from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
+from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.pass_replayer import REPLAYER_SPECS, PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
+from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
+from rail_monitor.nodes.squeal_risk_model import SquealRiskModel
 from rail_monitor.params import ParamSpec
 
 MONITOR_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("record", True, "Host an mcap_recorder for every output topic."),
     ParamSpec("drain_timeout_s", 60.0, "After the replay, wait at most this for the recorder to catch up [s].",
               0.0, 3600.0),
-    ParamSpec("executor", "multi_threaded", "Executor hosting the nodes: multi_threaded (like a component "
-              "container) or single_threaded (about 8x the pass rate here: rclpy's thread pool costs more than "
-              "it gains under the GIL).", choices=("multi_threaded", "single_threaded")),
+    ParamSpec("executor", "single_threaded", "Executor hosting the nodes: single_threaded, or multi_threaded "
+              "(like a component container; measured 30x slower here on the sample: rclpy's thread pool costs more "
+              "than it gains for Python callbacks under the GIL).", choices=("single_threaded", "multi_threaded")),
     ParamSpec("threads", 4, "Threads of the multi_threaded executor [-].", 1, 64),
 )
 
@@ -39,6 +47,7 @@ class MonitorResult:
     recorded: dict[str, int]
     bag: str | None
     wall_s: float
+    rejected: dict[str, int] = field(default_factory=dict)
 
 
 class _Settings(Node):
@@ -61,28 +70,44 @@ def run_graph(args: list[str] | None = None) -> MonitorResult:
         settings = _Settings()
         nodes.append(settings)
         recorder = McapRecorder() if settings.cfg["record"] else None
-        if recorder is not None:
-            nodes.append(recorder)
-        subscribers = len(nodes) - 1  # every hosted node but the settings takes train_pass
+        models: list[PassModelNode] = [CorrugationEstimatorNode(), RollingNoisePredictor(), SquealRiskModel(),
+                                       AlertManagerNode()]
+        nodes += ([recorder] if recorder is not None else []) + models
         source = PassReplayer() if settings.cfg["source"] else PassSimulator()
         nodes.append(source)
+        estimator, predictor, squeal, alerts = models
+        subscribers = len(models) + (recorder is not None)
         source.cfg["wait_for_subscribers"] = max(source.cfg["wait_for_subscribers"], subscribers)
-        if recorder is not None:
-            topic = source.pub.topic_name
-            source.consumed = lambda: recorder.counts.get(topic, 0)
+        source.consumed = _passes_through(models, recorder, source.pub.topic_name)
         executor = _make_executor(settings.cfg["executor"], settings.cfg["threads"])
         for n in nodes:
             executor.add_node(n)
         spinner = threading.Thread(target=executor.spin, daemon=True)
         spinner.start()
+        if recorder is not None:
+            _wait(lambda: _outputs(models) <= set(recorder.counts), settings.cfg["drain_timeout_s"],
+                  lambda: f"recorder did not subscribe to {sorted(_outputs(models) - set(recorder.counts))}")
         published = source.run()
+        timeout = settings.cfg["drain_timeout_s"]
+        _wait(lambda: all(m.taken >= published for m in models) and not predictor.pending, timeout,
+              lambda: f"models took {[m.taken for m in models]} of {published} passes")
+        _wait(lambda: alerts.inputs["noise/squeal"] >= _total(squeal.sent)
+              and alerts.inputs["noise/rolling"] >= _total(predictor.sent)
+              and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name], timeout,
+              lambda: f"alert_manager took {dict(alerts.inputs)}")
+        estimator.publish_advisory()  # the advice on the final state
         recorded: dict[str, int] = {}
         bag = None
         if recorder is not None:
-            _drain(recorder, source.pub.topic_name, published, settings.cfg["drain_timeout_s"])
+            sent = {source.pub.topic_name: published}
+            for m in models:
+                sent.update(m.sent)
+            _wait(lambda: all(recorder.counts.get(t, 0) >= n for t, n in sent.items()), timeout,
+                  lambda: f"recorder got {dict(recorder.counts)} of {sent}")
             bag = str(recorder.close())
             recorded = dict(recorder.counts)
-        return MonitorResult(published, recorded, bag, time.monotonic() - t0)
+        rejected = {m.get_name(): sum(m.rejected.values()) for m in models}
+        return MonitorResult(published, recorded, bag, time.monotonic() - t0, rejected)
     finally:
         if executor is not None:
             executor.shutdown(timeout_sec=2.0)
@@ -96,19 +121,47 @@ def run_graph(args: list[str] | None = None) -> MonitorResult:
         rclpy.try_shutdown()
 
 
+def _passes_through(models: list[PassModelNode], recorder: McapRecorder | None, topic: str) -> Callable[[], int]:
+    """Passes the slowest hosted consumer has taken, downstream queues included: the pass source
+    keeps its backlog below their depth, so no queue overflows (model outputs per pass: one squeal
+    prediction, one rolling-noise message per source model)."""
+    _, predictor, squeal, alerts = models
+    per_pass = len(predictor.model.models)
+    noise, squeal_topic = predictor.pub.topic_name, squeal.pub.topic_name
+
+    def taken() -> int:
+        counts = [m.taken for m in models]
+        counts += [alerts.inputs["noise/squeal"], alerts.inputs["noise/rolling"] // per_pass]
+        if recorder is not None:
+            got = recorder.counts
+            counts += [got.get(topic, 0), got.get(squeal_topic, 0), got.get(noise, 0) // per_pass]
+        return min(counts)
+
+    return taken
+
+
+def _outputs(models: list[PassModelNode]) -> set[str]:
+    """The topics the model nodes publish (resolved), but /diagnostics and /rosout."""
+    return {p.topic_name for m in models for p in m.publishers
+            if not p.topic_name.startswith(("/diagnostics", "/rosout", "/parameter_events"))}
+
+
+def _total(sent: dict[str, int]) -> int:
+    return sum(sent.values())
+
+
+def _wait(done: Callable[[], bool], timeout_s: float, what: Callable[[], str]) -> None:
+    deadline = time.monotonic() + timeout_s
+    while not done():
+        if time.monotonic() > deadline:
+            raise RailMonitorError(f"{what()} within {timeout_s:g} s")
+        time.sleep(0.02)
+
+
 def _make_executor(kind: str, threads: int) -> Executor:
     if kind == "single_threaded":
         return SingleThreadedExecutor()
     return MultiThreadedExecutor(num_threads=threads)
-
-
-def _drain(recorder: McapRecorder, topic: str, expected: int, timeout_s: float) -> None:
-    deadline = time.monotonic() + timeout_s
-    while recorder.counts.get(topic, 0) < expected:
-        if time.monotonic() > deadline:
-            raise RailMonitorError(f"recorder got {recorder.counts.get(topic, 0)} of {expected} messages "
-                                   f"on {topic} within {timeout_s:g} s")
-        time.sleep(0.02)
 
 
 def main(args: list[str] | None = None) -> int:

@@ -1,0 +1,181 @@
+"""Batch mode: the graph's models over a whole pass history without DDS, vectorised.
+
+Gives what the live graph publishes, pass for pass: the squeal prediction of every accepted
+pass; the corrugation state after every counted pass (CorrugationEstimator.advance_history);
+the rolling noise of every accepted pass on the corrugation state that includes it (as
+rolling_noise_predictor waits for it); the alerts of the alert manager; and the speed advice on
+the final state. ``write_bag`` records them under the same topics as mcap_recorder.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.alerts import Alert, AlertManager, alert_config
+from rail_monitor.corrugation_state import Advice, CorrugationEstimator, Trajectory, corrugation_config
+from rail_monitor.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.rolling_noise import Corrugation, RollingNoiseModel, noise_config
+from rail_monitor.site import Site, site_from_values
+from rail_monitor.squeal_risk import predict as predict_squeal
+from rail_monitor.squeal_risk import squeal_config
+
+NOISE_NUMBERS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")
+
+
+@dataclass
+class BatchResult:
+    """Model outputs over a history. Arrays over ``accepted`` rows unless named otherwise."""
+
+    site: Site
+    passes: PassTable                 # the whole history in time order (as the replayer sends it)
+    reasons: np.ndarray               # per pass: '' accepted, else why rejected
+    accepted: PassTable               # accepted passes, class defaults filled
+    squeal: dict[str, np.ndarray]
+    trajectory: Trajectory            # state after each counted pass (index: row of ``accepted``)
+    state_of_pass: np.ndarray         # per accepted pass: trajectory row it was predicted on (-1: none)
+    noise: dict[str, dict[str, Any]]  # per source model
+    alerts: list[Alert]
+    standing: list[Alert]
+    advice: Advice | None
+    estimator: CorrugationEstimator   # the final state
+    receiver: Any
+
+
+def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None
+               ) -> BatchResult:
+    """Every model over ``passes`` for the site of the flat parameter ``values``.
+
+    estimator: a state to continue from (e.g. a checkpoint); default the post-grinding state.
+    """
+    site = site_from_values(values)
+    table = passes.sorted()
+    reasons = rejection_reasons(table, site)
+    ok = reasons == ""
+    accepted = with_class_defaults(table.take(ok), site)
+    est = estimator or CorrugationEstimator(site, corrugation_config(values))
+    squeal = predict_squeal(squeal_config(values), site, accepted)
+    traj = est.advance_history(accepted)
+    # A pass is predicted on the state that includes it, or for a pass not counted the latest before it.
+    state_of_pass = np.searchsorted(traj.index, np.arange(len(accepted)), side="right") - 1
+    model = RollingNoiseModel(site, noise_config(values))
+    noise: dict[str, dict[str, Any]] = {}
+    have = state_of_pass >= 0
+    for name in model.models:
+        out = model.predict(accepted.take(~have), name) if (~have).any() else None
+        with_state = model.predict(accepted.take(have), name, Corrugation(
+            traj.constants.bands, traj.amplitude[state_of_pass[have]], traj.constants.grinding_amplitude))
+        noise[name] = _merge(with_state, out, have)
+    alerts = AlertManager(alert_config(values, est.cfg["lead_time_days"]))
+    events = _feed_alerts(alerts, table, reasons, accepted, squeal, traj, noise)
+    advice = None
+    if len(est.recent.stamp_ns):
+        try:
+            advice = est.advise()
+        except ValueError:
+            advice = None
+    return BatchResult(site, table, reasons, accepted, squeal, traj, state_of_pass, noise, events,
+                       sorted(alerts.standing.values(), key=_alert_key), advice, est, model.receiver)
+
+
+def _merge(with_state: dict[str, Any], without: dict[str, Any] | None, have: np.ndarray) -> dict[str, Any]:
+    """Rows predicted with a state and without one, back in pass order."""
+    if without is None:
+        return with_state
+    out = dict(with_state)
+    for key, value in with_state.items():
+        if isinstance(value, np.ndarray) and value.ndim and len(value) == have.sum() and key != "band_centre_hz":
+            merged = np.empty((len(have), *value.shape[1:]), value.dtype)
+            merged[have], merged[~have] = value, without[key]
+            out[key] = merged
+    return out
+
+
+def _alert_key(a: Alert) -> tuple[int, int, str, bool]:
+    return a.stamp_ns, a.kind, a.key, a.active
+
+
+def _feed_alerts(alerts: AlertManager, table: PassTable, reasons: np.ndarray, accepted: PassTable,
+                 squeal: dict[str, np.ndarray], traj: Trajectory, noise: dict[str, dict[str, Any]]) -> list[Alert]:
+    """The alert manager over each stream in its own order (streams do not interact)."""
+    for stamp, why in zip(table.stamp_ns.tolist(), reasons.tolist(), strict=True):
+        alerts.on_train_pass(stamp, bool(why))
+    for stamp, risk in zip(accepted.stamp_ns.tolist(), squeal["risk"].tolist(), strict=True):
+        alerts.on_squeal(stamp, risk)
+    for name, out in noise.items():
+        cols = {k: np.asarray(out[k]).tolist() for k in NOISE_NUMBERS}
+        for i, stamp in enumerate(accepted.stamp_ns.tolist()):
+            alerts.on_noise(stamp, name, {k: cols[k][i] for k in NOISE_NUMBERS})
+    c, f = traj.constants, traj.forecast
+    for k in range(len(traj)):
+        alerts.on_state(int(traj.stamp_ns[k]), c.bands, traj.amplitude[k], c.threshold,
+                        float(f.days_to_threshold[k]), bool(f.grinding_due[k]), int(f.grinding_due_ns[k]))
+    return sorted(alerts.events, key=_alert_key)
+
+
+# -- recording ----------------------------------------------------------------------------------
+def write_bag(result: BatchResult, folder: str | Path, namespace: str, compression: str = "zstd") -> Path:
+    """Record the batch outputs as mcap_recorder records the live graph (log time = header stamp)."""
+    from rclpy.serialization import serialize_message
+
+    from rail_monitor.bagio.mcap_bag import McapBagWriter
+    from rail_monitor.nodes import convert
+    from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STREAM_QOS, qos_to_dict
+    from rail_msgs.msg import (
+        CorrugationState,
+        RollingNoise,
+        SpeedAdvisory,
+        SquealPrediction,
+        TrainPass,
+        WaysideAlert,
+        WaysideAlertArray,
+    )
+
+    ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
+    frame = result.site.site_id
+    topics = {"train_pass": (TrainPass, STREAM_QOS), "noise/squeal": (SquealPrediction, STREAM_QOS),
+              "corrugation/state": (CorrugationState, LATEST_QOS), "noise/rolling": (RollingNoise, STREAM_QOS),
+              "alerts": (WaysideAlert, ALERT_QOS), "alerts/standing": (WaysideAlertArray, LATEST_QOS),
+              "speed_advisory": (SpeedAdvisory, LATEST_QOS)}
+    with McapBagWriter(Path(folder), compression=compression) as bag:
+        for name, (msg_type, qos) in topics.items():
+            bag.add_topic(f"{ns}/{name}", _typename(msg_type), [qos_to_dict(qos)])
+
+        def put(name: str, msg: Any, stamp_ns: int) -> None:
+            bag.write(f"{ns}/{name}", serialize_message(msg), stamp_ns)
+
+        sent = [convert.train_pass_msg(result.passes.row(i), frame) for i in range(len(result.passes))]
+        by_accepted = [m for m, why in zip(sent, result.reasons, strict=True) if not why]
+        for msg, stamp in zip(sent, result.passes.stamp_ns.tolist(), strict=True):
+            put("train_pass", msg, stamp)
+        for i, msg in enumerate(by_accepted):
+            put("noise/squeal", convert.squeal_prediction_msg(result.squeal, i, msg), int(result.accepted.stamp_ns[i]))
+        for k in range(len(result.trajectory)):
+            snap, fc = result.trajectory.state(k)
+            put("corrugation/state", convert.corrugation_state_msg(snap, fc, frame), snap.newest_ns)
+        for i, msg in enumerate(by_accepted):
+            for out in result.noise.values():
+                put("noise/rolling", convert.rolling_noise_msg(out, i, msg, result.receiver),
+                    int(result.accepted.stamp_ns[i]))
+        standing: dict[tuple[int, str], Alert] = {}
+        for a in result.alerts:
+            put("alerts", convert.wayside_alert_msg(a, frame), a.stamp_ns)
+            if a.active:
+                standing[(a.kind, a.key)] = a
+            else:
+                standing.pop((a.kind, a.key), None)
+            put("alerts/standing", convert.wayside_alert_array_msg(list(standing.values()), a.stamp_ns, frame),
+                a.stamp_ns)
+        if result.advice is not None:
+            stamp = result.estimator.newest_ns
+            put("speed_advisory", convert.speed_advisory_msg(result.advice, stamp, frame), stamp)
+    return Path(folder)
+
+
+def _typename(msg_type: type) -> str:
+    module = msg_type.__module__.split(".")
+    return f"{module[0]}/msg/{msg_type.__name__}"

@@ -1,0 +1,102 @@
+"""alert_manager: raises and clears the site's WaysideAlerts from the model outputs.
+
+Subscribes ``train_pass`` (rejected inputs), ``noise/squeal``, ``noise/rolling`` and
+``corrugation/state`` (every state, in order); publishes each raise and clear on ``alerts``
+(rail_msgs/WaysideAlert; reliable, transient local, depth 1000) and the standing set on
+``alerts/standing`` (rail_msgs/WaysideAlertArray; latched), so a late subscriber sees the
+standing alerts at once. Thresholds and hysteresis: ``alerts.*`` (rail_monitor.alerts.ALERT_SPECS)
+and the corrugation lead time ``corrugation.lead_time_days``.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+from typing import Any
+
+from diagnostic_msgs.msg import DiagnosticStatus
+
+from rail_monitor.alerts import ALERT_SPECS, KIND_NAMES, SEVERITY_CRITICAL, Alert, AlertManager, alert_config, describe
+from rail_monitor.batch import NOISE_NUMBERS
+from rail_monitor.corrugation_state import CORRUGATION_SPECS
+from rail_monitor.nodes.base import Sent, declare, run_node
+from rail_monitor.nodes.convert import time_ns, wayside_alert_array_msg, wayside_alert_msg
+from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
+from rail_monitor.passes import PassTable
+from rail_msgs.msg import CorrugationState, RollingNoise, SquealPrediction, TrainPass, WaysideAlert, WaysideAlertArray
+
+LEAD_TIME = next(s for s in CORRUGATION_SPECS if s.name == "lead_time_days")
+
+
+class AlertManagerNode(PassModelNode):
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("alert_manager", **kwargs)
+        lead = declare(self, (LEAD_TIME,), prefix="corrugation.")["lead_time_days"]
+        self.alerts = AlertManager(alert_config(declare(self, ALERT_SPECS, prefix="alerts."), lead, prefix=""))
+        self.inputs: Counter[str] = Counter()
+        self.sent = Sent()
+        self.pub = self.create_publisher(WaysideAlert, "alerts", ALERT_QOS)
+        self.standing_pub = self.create_publisher(WaysideAlertArray, "alerts/standing", LATEST_QOS)
+        self.create_subscription(SquealPrediction, "noise/squeal", self._on_squeal, STREAM_SUB_QOS)
+        self.create_subscription(RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS)
+        self.create_subscription(CorrugationState, "corrugation/state", self._on_state, STATE_SUB_QOS)
+        self._publish_standing(0)
+
+    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
+        self._emit(self.alerts.on_train_pass(time_ns(msg.header.stamp), False))
+
+    def on_rejected(self, msg: TrainPass, reason: str) -> None:
+        self._emit(self.alerts.on_train_pass(time_ns(msg.header.stamp), True))
+
+    def _on_squeal(self, msg: SquealPrediction) -> None:
+        self.inputs["noise/squeal"] += 1
+        self._emit(self.alerts.on_squeal(time_ns(msg.header.stamp), msg.risk))
+
+    def _on_noise(self, msg: RollingNoise) -> None:
+        self.inputs["noise/rolling"] += 1
+        self._emit(self.alerts.on_noise(time_ns(msg.header.stamp), msg.model,
+                                        {k: getattr(msg, k) for k in NOISE_NUMBERS}))
+
+    def _on_state(self, msg: CorrugationState) -> None:
+        self.inputs["corrugation/state"] += 1
+        if not (len(msg.wavelength_m) == len(msg.amplitude_m) == len(msg.threshold_m)):
+            self.inputs["corrugation/state refused: arrays differ in length"] += 1
+            return
+        self._emit(self.alerts.on_state(time_ns(msg.header.stamp), msg.wavelength_m, msg.amplitude_m,
+                                        msg.threshold_m, msg.days_to_threshold, msg.grinding_due,
+                                        time_ns(msg.grinding_due_time)))
+
+    def _emit(self, events: list[Alert]) -> None:
+        for e in events:
+            self.sent.publish(self.pub, wayside_alert_msg(e, self.site.site_id))
+            self.get_logger().info(describe(e))
+        if events:
+            self._publish_standing(events[-1].stamp_ns)
+
+    def _publish_standing(self, stamp_ns: int) -> None:
+        alerts = sorted(self.alerts.standing.values(), key=lambda a: (a.kind, a.key))
+        self.sent.publish(self.standing_pub, wayside_alert_array_msg(alerts, stamp_ns, self.site.site_id))
+
+    def diagnostic_values(self) -> dict[str, Any]:
+        events = self.alerts.events
+        return {**super().diagnostic_values(), **{f"taken {k}": n for k, n in sorted(self.inputs.items())},
+                "standing": len(self.alerts.standing), "raised": sum(e.active for e in events),
+                "cleared": sum(not e.active for e in events),
+                **{f"standing {KIND_NAMES[k]}": n for k, n in
+                   sorted(Counter(kind for kind, _ in self.alerts.standing).items())}}
+
+    def _level(self) -> tuple[int, str]:
+        if any(a.severity >= SEVERITY_CRITICAL for a in self.alerts.standing.values()):
+            return DiagnosticStatus.ERROR, f"{len(self.alerts.standing)} alert(s) standing, critical among them"
+        if self.alerts.standing:
+            return DiagnosticStatus.WARN, f"{len(self.alerts.standing)} alert(s) standing"
+        return super()._level()
+
+
+def main(args: list[str] | None = None) -> int:
+    return run_node(AlertManagerNode, args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
