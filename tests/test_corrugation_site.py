@@ -111,7 +111,7 @@ def test_seed_like_speed_control_lengthens_the_grinding_interval_as_the_seed_rep
 def test_forecast_agrees_with_stepping_the_passes(site_, tables):
     # Independent method: the forecast number of passes, then advancing pass by pass at the same
     # speed and friction, crosses the threshold within one pass of the forecast.
-    est = _estimator(site_, tables)
+    est = _estimator(site_, tables, min_traffic_days=0.0)  # 50 passes span 8 h
     est.advance(_passes(site_, [19.0] * 50, prefix="A"))
     fc = est.forecast()
     assert 0 < fc.passes_to_threshold < np.inf and not fc.grinding_due
@@ -127,12 +127,23 @@ def test_forecast_agrees_with_stepping_the_passes(site_, tables):
     assert est.forecast().grinding_due and est.forecast().days_to_threshold == 0.0
 
 
-def test_lead_time_makes_grinding_due_before_the_threshold(site_, tables):
+def test_no_forecast_in_days_until_the_passes_span_min_traffic_days(site_, tables):
+    # 50 passes 10 min apart span 8.2 h: the daily timetable would bias a rate from them.
     est = _estimator(site_, tables)
+    est.advance(_passes(site_, [19.0] * 50))
+    fc = est.forecast()
+    assert np.isnan(fc.passes_per_day) and fc.days_to_threshold == np.inf and not fc.grinding_due
+    assert 0 < fc.passes_to_threshold < np.inf   # the forecast in passes does not need the rate
+    est.advance(_passes(site_, [19.0] * 100, start_s=50 * 600.0, prefix="B"))  # now 25 h
+    assert est.forecast().passes_per_day == pytest.approx(149 / (149 * 600 / 86_400))
+
+
+def test_lead_time_makes_grinding_due_before_the_threshold(site_, tables):
+    est = _estimator(site_, tables, min_traffic_days=0.0)
     est.advance(_passes(site_, [19.0] * 50))
     days = est.forecast().days_to_threshold
     assert not est.forecast().grinding_due
-    near = _estimator(site_, None, lead_time_days=float(np.ceil(days)))
+    near = _estimator(site_, None, lead_time_days=float(np.ceil(days)), min_traffic_days=0.0)
     near.advance(_passes(site_, [19.0] * 50))
     fc = near.forecast()
     assert fc.grinding_due and np.all(near.amplitude < near.threshold)

@@ -54,7 +54,9 @@ class Probe:
 
 def test_node_publishes_both_models_rejects_bad_input_and_follows_the_corrugation(ros_context, site_values, site):
     params = [Parameter(k, value=v) for k, v in site_values.items() if not k.startswith("simulator.")]
-    node = RollingNoisePredictor(context=ros_context, namespace="/curve_250", parameter_overrides=params)
+    # state_wait_s 0: each pass takes the latest state at once (the wait is tested in test_graph).
+    node = RollingNoisePredictor(context=ros_context, namespace="/curve_250",
+                                 parameter_overrides=[*params, Parameter("state_wait_s", value=0.0)])
     probe = Probe(ros_context)
     with spinning(ros_context, node, probe.node):
         assert wait_until(lambda: probe.passes.get_subscription_count() >= 1 and probe.node.count_publishers(
@@ -71,7 +73,7 @@ def test_node_publishes_both_models_rejects_bad_input_and_follows_the_corrugatio
         probe.passes.publish(train_pass_msg(_row(3), "curve_250"))
         assert wait_until(lambda: len(probe.noise) >= 4)
         probe.states.publish(_state(6.0))
-        assert wait_until(lambda: node.corrugation is not None)
+        assert wait_until(lambda: len(node.states) > 0)
         probe.passes.publish(train_pass_msg(_row(4), "curve_250"))
         assert wait_until(lambda: len(probe.noise) >= 6)
         assert wait_until(lambda: probe.diag().get("rejected") == "2" and probe.diag().get("published") == "6")
