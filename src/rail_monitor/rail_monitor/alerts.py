@@ -38,7 +38,7 @@ KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_I
 KIND_NAMES = {KIND_GRINDING_DUE: "grinding due", KIND_GRINDING_FORECAST: "grinding forecast",
               KIND_NOISE_LIMIT: "noise limit", KIND_SQUEAL: "squeal", KIND_INPUT_REJECTED: "inputs rejected"}
 SEVERITY_INFO, SEVERITY_WARNING, SEVERITY_CRITICAL = range(3)
-NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")
+NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")  # RollingNoise single numbers
 RISK_NAMES = ("none", "low", "medium", "high")
 
 ALERT_SPECS: tuple[ParamSpec, ...] = (
@@ -166,38 +166,29 @@ class AlertManager:
     def on_state(self, stamp_ns: int, wavelength_m: np.ndarray, amplitude_m: np.ndarray, threshold_m: np.ndarray,
                  days_to_threshold: float, grinding_due: bool, grinding_due_ns: int) -> list[Alert]:
         """A corrugation state (CorrugationState fields)."""
-        out: list[Alert] = []
+        events: list[Alert | None] = []
         amp, thr = np.asarray(amplitude_m, float), np.asarray(threshold_m, float)
-        past = amp >= thr
-        for lam, z, t, over in zip(np.asarray(wavelength_m, float), amp, thr, past, strict=True):
+        for lam, z, t in zip(np.asarray(wavelength_m, float), amp, thr, strict=True):
             key = f"{lam:.4f}m"
-            if over:
-                e = self._set(True, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_CRITICAL,
-                              f"grinding due: {1e3 * lam:.1f} mm band at {1e6 * z:.2f} um r.m.s., threshold "
-                              f"{1e6 * t:.2f} um", z, t, "m")
+            if z >= t:
+                events.append(self._set(True, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_CRITICAL,
+                                        f"grinding due: {1e3 * lam:.1f} mm band at {1e6 * z:.2f} um r.m.s., "
+                                        f"threshold {1e6 * t:.2f} um", z, t, "m"))
             elif z < self.cfg["grinding_clear_fraction"] * t:
-                e = self._set(False, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_INFO,
-                              f"grinding due: {1e3 * lam:.1f} mm band cleared at {1e6 * z:.2f} um r.m.s.", z, t, "m")
-            else:
-                e = None
-            if e:
-                out.append(e)
+                events.append(self._set(False, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_INFO,
+                                        f"grinding due: {1e3 * lam:.1f} mm band cleared at {1e6 * z:.2f} um r.m.s.",
+                                        z, t, "m"))
         lead = self.cfg["lead_time_days"]
-        key = "forecast"
         due_standing = any(kind == KIND_GRINDING_DUE for kind, _ in self.standing)
         if grinding_due and not due_standing:
-            e = self._set(True, KIND_GRINDING_FORECAST, key, stamp_ns, SEVERITY_WARNING,
-                          f"grinding forecast in {days_to_threshold:.1f} days, inside the {lead:g}-day lead time",
-                          days_to_threshold, lead, "day", grinding_due_ns)
+            events.append(self._set(True, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_WARNING,
+                                    f"grinding forecast in {days_to_threshold:.1f} days, inside the {lead:g}-day "
+                                    "lead time", days_to_threshold, lead, "day", grinding_due_ns))
         elif due_standing or days_to_threshold > self.cfg["forecast_clear_factor"] * lead:
             why = "grinding is due" if due_standing else f"forecast {days_to_threshold:.1f} days"
-            e = self._set(False, KIND_GRINDING_FORECAST, key, stamp_ns, SEVERITY_INFO,
-                          f"grinding forecast cleared: {why}", days_to_threshold, lead, "day")
-        else:
-            e = None
-        if e:
-            out.append(e)
-        return out
+            events.append(self._set(False, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_INFO,
+                                    f"grinding forecast cleared: {why}", days_to_threshold, lead, "day"))
+        return [e for e in events if e]
 
     def on_noise(self, stamp_ns: int, model: str, values: Mapping[str, float]) -> list[Alert]:
         """A RollingNoise prediction (values: its single-number fields) of one source model."""
@@ -210,29 +201,27 @@ class AlertManager:
                               self.cfg["noise_clear_count"], f"{model} {metric[:-4]} above {limit:g} dB(A)",
                               f"{w.over} of the last {n} passes, this one {level:.1f} dB(A)", "dB(A)", level, limit)
 
-    def on_squeal(self, stamp_ns: int, risk: int) -> list[Alert]:
-        """A SquealPrediction's risk (RISK_*)."""
-        hit = int(risk) >= self._min_risk
-        w = self._squeal
+    def _share(self, w: _Window, hit: bool, kind: int, key: str, stamp_ns: int, name: str, what: str,
+               full_window: bool) -> list[Alert]:
+        """A share-of-window alert: raised at ``<name>_raise_share`` of the whole window (only once the
+        window is full, with full_window), cleared at or below ``<name>_clear_share`` of what it holds."""
         w.push(hit, hit)
         n = len(w.flags)
-        share = w.over / n
-        full = n == w.flags.maxlen  # a share over a part-filled window would raise on the first pass
-        raise_at = w.flags.maxlen * self.cfg["squeal_raise_share"] if full else float("inf")
-        return self._windowed(w, KIND_SQUEAL, "site", stamp_ns, max(raise_at, 1),
-                              self.cfg["squeal_clear_share"] * n, f"squeal risk {self.cfg['squeal_min_risk']} or "
-                              f"above", f"{share:.0%} of the last {n} passes", "-", share,
-                              self.cfg["squeal_raise_share"])
+        raise_share, share = self.cfg[f"{name}_raise_share"], w.over / n
+        raise_at = w.flags.maxlen * raise_share if n == w.flags.maxlen or not full_window else float("inf")
+        return self._windowed(w, kind, key, stamp_ns, max(raise_at, 1), self.cfg[f"{name}_clear_share"] * n, what,
+                              f"{w.over} of the last {n}, {share:.0%}", "-", share, raise_share)
+
+    def on_squeal(self, stamp_ns: int, risk: int) -> list[Alert]:
+        """A SquealPrediction's risk (RISK_*). The window must be full: a share over the first few
+        passes would raise on the first squeal."""
+        return self._share(self._squeal, int(risk) >= self._min_risk, KIND_SQUEAL, "site", stamp_ns, "squeal",
+                           f"squeal risk {self.cfg['squeal_min_risk']} or above", full_window=True)
 
     def on_train_pass(self, stamp_ns: int, rejected: bool) -> list[Alert]:
         """A TrainPass message, rejected or not."""
-        w = self._rejected
-        w.push(rejected, rejected)
-        n = len(w.flags)
-        return self._windowed(w, KIND_INPUT_REJECTED, "train_pass", stamp_ns,
-                              max(w.flags.maxlen * self.cfg["rejected_raise_share"], 1),
-                              self.cfg["rejected_clear_share"] * n, "train passes rejected",
-                              f"{w.over} of the last {n}", "-", w.over / n, self.cfg["rejected_raise_share"])
+        return self._share(self._rejected, rejected, KIND_INPUT_REJECTED, "train_pass", stamp_ns, "rejected",
+                           "train passes rejected", full_window=False)
 
 
 def describe(alert: Alert) -> str:

@@ -16,15 +16,13 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.alerts import Alert, AlertManager, alert_config
+from rail_monitor.alerts import NOISE_METRICS, Alert, AlertManager, alert_config
 from rail_monitor.corrugation_state import Advice, CorrugationEstimator, Trajectory, corrugation_config
 from rail_monitor.passes import PassTable, rejection_reasons, with_class_defaults
 from rail_monitor.rolling_noise import Corrugation, RollingNoiseModel, noise_config
 from rail_monitor.site import Site, site_from_values
 from rail_monitor.squeal_risk import predict as predict_squeal
 from rail_monitor.squeal_risk import squeal_config
-
-NOISE_NUMBERS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")
 
 
 @dataclass
@@ -107,9 +105,9 @@ def _feed_alerts(alerts: AlertManager, table: PassTable, reasons: np.ndarray, ac
     for stamp, risk in zip(accepted.stamp_ns.tolist(), squeal["risk"].tolist(), strict=True):
         alerts.on_squeal(stamp, risk)
     for name, out in noise.items():
-        cols = {k: np.asarray(out[k]).tolist() for k in NOISE_NUMBERS}
+        cols = {k: np.asarray(out[k]).tolist() for k in NOISE_METRICS}
         for i, stamp in enumerate(accepted.stamp_ns.tolist()):
-            alerts.on_noise(stamp, name, {k: cols[k][i] for k in NOISE_NUMBERS})
+            alerts.on_noise(stamp, name, {k: cols[k][i] for k in NOISE_METRICS})
     c, f = traj.constants, traj.forecast
     for k in range(len(traj)):
         alerts.on_state(int(traj.stamp_ns[k]), c.bands, traj.amplitude[k], c.threshold,

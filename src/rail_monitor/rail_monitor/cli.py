@@ -144,16 +144,22 @@ def cmd_record(ns: argparse.Namespace) -> int:
 def _monitor(ns: argparse.Namespace, source: str, output: str | None) -> int:
     from rail_monitor.nodes.wayside_monitor import main
 
-    if output and Path(output).exists():
-        if not ns.overwrite:
-            raise RailMonitorError(f"{output} exists; remove it or pass --overwrite")
-        shutil.rmtree(output)
+    if output:
+        _fresh_output(Path(output), ns.overwrite)
     site = _site_file(ns.site)
     if not ns.namespace:
         from rail_monitor.site import load_parameter_file
 
         ns.namespace = str(load_parameter_file(site).get("site_id", ""))
     return main(_ros_args(ns, site, {"source": source, "output": output, "use_sim_time": True}))
+
+
+def _fresh_output(path: Path, overwrite: bool) -> None:
+    """Make room for an output folder: remove it with overwrite, else refuse to touch it."""
+    if path.exists():
+        if not overwrite:
+            raise RailMonitorError(f"{path} exists; remove it or pass --overwrite")
+        shutil.rmtree(path)
 
 
 def cmd_monitor(ns: argparse.Namespace) -> int:
@@ -206,10 +212,7 @@ def cmd_batch(ns: argparse.Namespace) -> int:
     values = load_parameter_file(_site_file(ns.site))
     passes = read_passes(ns.source, ns.topic)
     out = Path(ns.output or f"{Path(ns.source).stem}_batch")
-    if out.exists():
-        if not ns.overwrite:
-            raise RailMonitorError(f"{out} exists; remove it or pass --overwrite")
-        shutil.rmtree(out)
+    _fresh_output(out, ns.overwrite)
     result = run_models(passes, values)
     t_models = time.monotonic() - t0
     write_bag(result, out, ns.namespace if ns.namespace is not None else str(values.get("site_id", "")))

@@ -18,15 +18,14 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.alerts import KIND_NAMES, Alert, describe
-from rail_monitor.bagio.reader import _one_line, _open_bag, _row_from_msg
-from rail_monitor.errors import InputError, RailMonitorError
+from rail_monitor.bagio.reader import pass_row, read_messages
+from rail_monitor.corrugation_state import NS_PER_DAY
+from rail_monitor.errors import InputError
 from rail_monitor.passes import FRICTION_NAMES, PassTable, rejection_reasons
 from rail_monitor.site import site_from_values
-from rail_monitor.timeutil import NS_PER_S, format_iso_ns
+from rail_monitor.timeutil import format_iso_ns, from_sec_nanosec
 
-NS_PER_DAY = 86_400 * NS_PER_S
-_TYPES = {f"rail_msgs/msg/{n}": n for n in ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise",
-                                           "WaysideAlert", "SpeedAdvisory")}
+_TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory")
 _STATE = ("amplitude_m", "threshold_m", "post_grinding_m")
 _STATE_NUMBERS = ("days_to_threshold", "passes_per_day", "worst_band", "pass_count", "total_pass_count")
 
@@ -49,36 +48,11 @@ def load_run(bag: str | Path) -> RunData:
     from rail_monitor.nodes.convert import alert_from_msg  # rosbags objects have the same fields
 
     path = Path(bag)
-    reader = _open_bag(path)
-    rows: list[dict[str, Any]] = []
-    sq: list[Any] = []
-    st: list[Any] = []
-    nz: list[Any] = []
-    al: list[Any] = []
-    adv = None
-    try:
-        conns = [c for c in reader.connections if c.msgtype in _TYPES]
-        for c, _, raw in reader.messages(connections=conns):
-            kind = _TYPES[c.msgtype]
-            msg = reader.deserialize(raw, c.msgtype)
-            if kind == "TrainPass":
-                rows.append(_row_from_msg(msg))
-            elif kind == "SquealPrediction":
-                sq.append(msg)
-            elif kind == "CorrugationState":
-                st.append(msg)
-            elif kind == "RollingNoise":
-                nz.append(msg)
-            elif kind == "WaysideAlert":
-                al.append(msg)
-            else:
-                adv = msg
-    except RailMonitorError:
-        raise
-    except Exception as exc:
-        raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
-    finally:
-        reader.close()
+    got = read_messages(path, [f"rail_msgs/msg/{n}" for n in _TYPES])
+    rows = [pass_row(m) for m in got["rail_msgs/msg/TrainPass"]]
+    sq, st, nz, al = (got[f"rail_msgs/msg/{n}"] for n in ("SquealPrediction", "CorrugationState", "RollingNoise",
+                                                           "WaysideAlert"))
+    advisories = got["rail_msgs/msg/SpeedAdvisory"]
     if not rows:
         raise InputError(f"{path}: no rail_msgs/msg/TrainPass messages: nothing to report")
     run = RunData(path, PassTable.from_rows(rows))
@@ -101,12 +75,12 @@ def load_run(bag: str | Path) -> RunData:
         run.noise[model]["lp_db"] = np.array([list(m.lp_db) for m in ms])
         run.noise[model]["band_centre_hz"] = np.array(ms[0].band_centre_hz)
     run.alerts = sorted((alert_from_msg(m) for m in al), key=lambda a: (a.stamp_ns, a.kind, a.key, a.active))
-    run.advisory = adv
+    run.advisory = advisories[-1] if advisories else None
     return run
 
 
 def _ns(t: Any) -> int:
-    return int(t.sec) * NS_PER_S + int(t.nanosec)
+    return from_sec_nanosec(t.sec, t.nanosec)
 
 
 # -- summary ------------------------------------------------------------------------------------

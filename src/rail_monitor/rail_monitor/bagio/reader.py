@@ -6,7 +6,7 @@ file and the cause; front ends print it without a traceback and exit non-zero.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -81,7 +81,7 @@ def bag_info(path: str | Path) -> BagInfo:
         reader.close()
 
 
-def _row_from_msg(msg: Any) -> dict[str, Any]:
+def pass_row(msg: Any) -> dict[str, Any]:
     """A deserialised TrainPass (rosbags object) as a PassTable row."""
     return {
         "stamp_ns": from_sec_nanosec(msg.header.stamp.sec, msg.header.stamp.nanosec),
@@ -114,7 +114,7 @@ def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
         names = sorted({c.topic for c in conns})
         if len(names) > 1:
             raise InputError(f"{path}: several TrainPass topics ({', '.join(names)}); choose one with --topic")
-        rows = [_row_from_msg(reader.deserialize(raw, c.msgtype)) for c, _, raw in reader.messages(connections=conns)]
+        rows = [pass_row(reader.deserialize(raw, c.msgtype)) for c, _, raw in reader.messages(connections=conns)]
     except RailMonitorError:
         raise
     except Exception as exc:
@@ -122,6 +122,22 @@ def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
     finally:
         reader.close()
     return PassTable.from_rows(rows)
+
+
+def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, list[Any]]:
+    """Every message of the given types in a bag (any topic), deserialised, by type, in log-time order."""
+    path = Path(path)
+    reader = _open_bag(path)
+    out: dict[str, list[Any]] = {t: [] for t in typenames}
+    try:
+        conns = [c for c in reader.connections if c.msgtype in out]
+        for c, _, raw in reader.messages(connections=conns):
+            out[c.msgtype].append(reader.deserialize(raw, c.msgtype))
+    except Exception as exc:
+        raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
+    finally:
+        reader.close()
+    return out
 
 
 def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False) -> PassTable:

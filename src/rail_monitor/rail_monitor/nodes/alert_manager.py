@@ -16,8 +16,16 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from rail_monitor.alerts import ALERT_SPECS, KIND_NAMES, SEVERITY_CRITICAL, Alert, AlertManager, alert_config, describe
-from rail_monitor.batch import NOISE_NUMBERS
+from rail_monitor.alerts import (
+    ALERT_SPECS,
+    KIND_NAMES,
+    NOISE_METRICS,
+    SEVERITY_CRITICAL,
+    Alert,
+    AlertManager,
+    alert_config,
+    describe,
+)
 from rail_monitor.corrugation_state import CORRUGATION_SPECS
 from rail_monitor.nodes.base import Sent, declare, run_node
 from rail_monitor.nodes.convert import time_ns, wayside_alert_array_msg, wayside_alert_msg
@@ -56,7 +64,7 @@ class AlertManagerNode(PassModelNode):
     def _on_noise(self, msg: RollingNoise) -> None:
         self.inputs["noise/rolling"] += 1
         self._emit(self.alerts.on_noise(time_ns(msg.header.stamp), msg.model,
-                                        {k: getattr(msg, k) for k in NOISE_NUMBERS}))
+                                        {k: getattr(msg, k) for k in NOISE_METRICS}))
 
     def _on_state(self, msg: CorrugationState) -> None:
         self.inputs["corrugation/state"] += 1

@@ -109,7 +109,7 @@ class RollingNoisePredictor(PassModelNode):
             self._predict(p)
 
     def _predict(self, p: _Pending) -> None:
-        corrugation = self._state_for(p) if self.states else None
+        corrugation = self._state_for(p)
         for name in self.model.models:
             values = self.model.predict(p.table, name, corrugation)
             self.sent.publish(self.pub, rolling_noise_msg(values, 0, p.msg, self.model.receiver))

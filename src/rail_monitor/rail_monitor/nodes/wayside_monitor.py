@@ -91,8 +91,8 @@ def run_graph(args: list[str] | None = None) -> MonitorResult:
         timeout = settings.cfg["drain_timeout_s"]
         _wait(lambda: all(m.taken >= published for m in models) and not predictor.pending, timeout,
               lambda: f"models took {[m.taken for m in models]} of {published} passes")
-        _wait(lambda: alerts.inputs["noise/squeal"] >= _total(squeal.sent)
-              and alerts.inputs["noise/rolling"] >= _total(predictor.sent)
+        _wait(lambda: alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
+              and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
               and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name], timeout,
               lambda: f"alert_manager took {dict(alerts.inputs)}")
         estimator.publish_advisory()  # the advice on the final state
@@ -144,10 +144,6 @@ def _outputs(models: list[PassModelNode]) -> set[str]:
     """The topics the model nodes publish (resolved), but /diagnostics and /rosout."""
     return {p.topic_name for m in models for p in m.publishers
             if not p.topic_name.startswith(("/diagnostics", "/rosout", "/parameter_events"))}
-
-
-def _total(sent: dict[str, int]) -> int:
-    return sum(sent.values())
 
 
 def _wait(done: Callable[[], bool], timeout_s: float, what: Callable[[], str]) -> None:
