@@ -93,3 +93,28 @@ def wait_until(condition, timeout_s: float = 10.0, period_s: float = 0.01) -> bo
     while not condition() and time.monotonic() < deadline:
         time.sleep(period_s)
     return bool(condition())
+
+
+# -- the reliability table (issue 8) ------------------------------------------------------------
+_TALLY: list[dict[str, object]] = []
+TALLY_FILE = TOP / "out" / "reliability.md"
+
+
+@pytest.fixture()
+def tally(request: pytest.FixtureRequest):
+    """Record what a reliability test tried, what held and how many messages were lost; the
+    session writes the rows to out/reliability.md (the README's table comes from there)."""
+
+    def add(area: str, tried: str, held: str, lost: int | str) -> None:
+        _TALLY.append({"area": area, "tried": tried, "held": held, "lost": lost, "test": request.node.name})
+
+    return add
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if not _TALLY:
+        return
+    TALLY_FILE.parent.mkdir(exist_ok=True)
+    lines = ["| area | tried | what holds | messages lost | test |", "|---|---|---|---|---|"]
+    lines += [f"| {r['area']} | {r['tried']} | {r['held']} | {r['lost']} | `{r['test']}` |" for r in _TALLY]
+    TALLY_FILE.write_text("\n".join(lines) + "\n")

@@ -6,7 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rail_monitor.corrugation_state import NS_PER_DAY, CorrugationEstimator, GrowthTables, corrugation_config
+from rail_monitor.corrugation_state import (
+    NS_PER_DAY,
+    CorrugationEstimator,
+    CorruptCheckpoint,
+    GrowthTables,
+    corrugation_config,
+)
 from rail_monitor.errors import ConfigError
 from rail_monitor.passes import FRICTION_DRY, PassTable, rejection_reasons, with_class_defaults
 
@@ -200,11 +206,52 @@ def test_checkpoint_round_trip_and_refusals(site_, tables, tmp_path):
     est.advance(passes)
     np.testing.assert_allclose(again.log_components, est.log_components, rtol=0, atol=1e-12)
     (tmp_path / "bad.npz").write_bytes(b"not a checkpoint")
-    with pytest.raises(ConfigError, match="not a corrugation checkpoint"):
+    with pytest.raises(ConfigError, match="not a readable corrugation checkpoint"):
         again.load(tmp_path / "bad.npz")
     other = _estimator(site_, None, longest_wavelength_m=0.5)
     with pytest.raises(ConfigError, match="bands differ"):
         other.load(path)
+
+
+def test_an_unreadable_checkpoint_falls_back_to_the_previous_one(site_, tables, tmp_path, tally):
+    """Issue 8: a corrupt or truncated newest checkpoint is detected (zip CRCs, missing arrays) and
+    the previous good one is resumed; with neither readable the estimator refuses, never zero."""
+    est = _estimator(site_, tables)
+    passes = _passes(site_, np.linspace(15, 21, 300))
+    path = tmp_path / "corrugation.npz"
+    est.advance(passes.take(slice(0, 100)))
+    est.save(path)
+    at_100 = est.log_components.copy()
+    est.advance(passes.take(slice(100, 200)))
+    est.save(path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["corrugation.npz", "corrugation.npz.prev"]
+    newest = path.read_bytes()
+    faults = {"truncated": newest[: len(newest) // 2], "zero-length": b"",
+              "flipped byte": newest[:200] + bytes([newest[200] ^ 0xFF]) + newest[201:],
+              "not a zip": b"PK\x03\x04" + b"\x00" * 64}
+    for what, data in faults.items():
+        path.write_bytes(data)
+        again = _estimator(site_, tables)
+        used, skipped = again.resume(path)
+        assert used == tmp_path / "corrugation.npz.prev", what
+        assert len(skipped) == 1 and str(path) in skipped[0] and "\n" not in skipped[0], what
+        np.testing.assert_array_equal(again.log_components, at_100)
+        assert again.total_pass_count == 100
+        # replaying the history counts only what the fallback had not seen
+        assert again.advance(passes.take(slice(0, 200))).sum() == 100, what
+        np.testing.assert_array_equal(again.log_components, est.log_components)
+    # a crash between save()'s two renames leaves only the previous file
+    path.unlink()
+    assert _estimator(site_, tables).resume(path)[0] == tmp_path / "corrugation.npz.prev"
+    # both unreadable: refuse (one line), do not start from zero
+    path.write_bytes(b"")
+    (tmp_path / "corrugation.npz.prev").write_bytes(newest[:300])
+    with pytest.raises(CorruptCheckpoint, match="no readable previous checkpoint") as err:
+        _estimator(site_, tables).resume(path)
+    assert "\n" not in str(err.value)
+    assert _estimator(site_, tables).resume(tmp_path / "none.npz") == (None, [])
+    tally("checkpoint", f"{len(faults)} corrupt newest checkpoints, both corrupt, crash between renames",
+          "previous good state resumed; refusal when neither is readable", 0)
 
 
 def test_the_sample_history_gives_a_plausible_forecast(site_, tables, sample):

@@ -4,6 +4,7 @@ processes, against batch mode, across a restart, and the late-subscriber alert c
 from __future__ import annotations
 
 import os
+import random
 import signal
 import subprocess
 import time
@@ -171,30 +172,46 @@ def test_separate_processes_equal_batch(runs, tmp_path, ros_context):
     _assert_equal_runs(run, runs["batch"])
 
 
-def test_restart_mid_replay_ends_in_the_uninterrupted_state(runs, tmp_path):
-    """SIGKILL the one-process graph mid-replay, start it again on the same history: the final
-    state equals batch over the history (passes counted before the kill are not counted twice)."""
+def test_restart_mid_replay_ends_in_the_uninterrupted_state(runs, tmp_path, tally):
+    """SIGKILL the one-process graph at random points of the replay (issue 8), corrupt the newest
+    checkpoint before one restart, then run to the end on the same history: the final state equals
+    batch over the history (passes counted before a kill are not counted twice; the corrupt file is
+    reported and the previous good checkpoint resumed, not zero)."""
     ckpt = tmp_path / "state.npz"
     args = ["wayside_monitor", "--ros-args", "-r", "__ns:=/curve_250",
             *_ros_params(_site_file(tmp_path, ckpt)),
             "-p", f"source:={SAMPLE}", "-p", f"end_offset_s:={DAYS * 86400}", "-p", "progress:=false",
             "-p", "record:=false"]
-    # recorded timing, 3 days in about 6 s, so that the kill lands mid-replay
-    p = subprocess.Popen([*args, "-p", "rate:=43200.0"], cwd=TOP, stdout=subprocess.DEVNULL,
-                         stderr=subprocess.DEVNULL)
-    try:
-        assert wait_until(lambda: ckpt.exists(), timeout_s=60)
-        time.sleep(1.0)
-    finally:
-        p.kill()
-        p.wait(timeout=30)
     site_values = _values()
     from rail_monitor.site import site_from_values
 
     site = site_from_values(site_values)
-    cut = CorrugationEstimator(site, corrugation_config(site_values))
-    cut.load(ckpt)
-    assert 0 < cut.total_pass_count < len(_slice())                # killed mid-replay
+
+    def counted() -> int:
+        est = CorrugationEstimator(site, corrugation_config(site_values))
+        return (est.resume(ckpt)[0] and est.total_pass_count) or 0
+
+    rng = random.Random(20261122)
+    kills = []
+    for k in range(3):
+        if k == 2:  # the newest checkpoint is cut in half while the graph is down
+            ckpt.write_bytes(ckpt.read_bytes()[: ckpt.stat().st_size // 2])
+        before = ckpt.stat().st_mtime_ns if ckpt.exists() else 0
+        log = tmp_path / f"run{k}.log"
+        # recorded timing, 3 days in about 6 s, so that each kill lands mid-replay
+        with open(log, "w") as err:
+            p = subprocess.Popen([*args, "-p", "rate:=43200.0"], cwd=TOP, stdout=subprocess.DEVNULL, stderr=err)
+            try:
+                # counting again (past what earlier runs counted), then a random moment later
+                assert wait_until(lambda b=before: ckpt.exists() and ckpt.stat().st_mtime_ns != b, timeout_s=60)
+                time.sleep(rng.uniform(0.0, 1.5))
+            finally:
+                p.kill()
+                p.wait(timeout=30)
+        kills.append(counted())
+        if k == 2:
+            assert "checkpoint skipped" in log.read_text() and str(ckpt) in log.read_text()
+    assert kills[0] > 0 and kills[-1] < len(_slice()), kills                 # killed mid-replay
     r = run_cmd(*args, timeout=180)
     assert r.returncode == 0, r.stderr[-2000:]
     resumed = CorrugationEstimator(site, corrugation_config(site_values))
@@ -203,6 +220,9 @@ def test_restart_mid_replay_ends_in_the_uninterrupted_state(runs, tmp_path):
     assert resumed.total_pass_count == final.total_pass_count
     assert np.array_equal(resumed.log_components, final.log_components)   # the same sums in the same order
     assert _close(resumed.forecast().days_to_threshold, final.forecast().days_to_threshold) <= REL
+    tally("restart", f"3 SIGKILLs of the graph at random points (state at {', '.join(map(str, kills))} of "
+          f"{len(_slice())} passes), newest checkpoint truncated before the third restart",
+          "final state equals the uninterrupted run exactly; fallback reported", 0)
 
 
 def test_late_subscriber_sees_the_standing_alerts(ros_context, site_values):

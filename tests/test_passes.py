@@ -21,8 +21,13 @@ def test_each_bad_field_has_its_reason(site):
         "train_id": ("   ", "empty train_id"),
         "stamp_ns": (0, "stamp not set"),
         "train_length_m": (float("inf"), "train_length_m not finite"),
+        "vehicle_count": (501, "vehicle_count above 500"),
+        "axle_count": (65535, "axle_count above 2000"),
     }
     rows = [GOOD] + [{**GOOD, k: v} for k, (v, _) in cases.items()]
+    # 400 vehicles of the class's length and no length given: a train far past 5 km, filled in unchecked before
+    rows.append({**GOOD, "vehicle_count": 400, "train_length_m": 0.0})
+    cases["implied length"] = (None, "train length from vehicle_count and the class's vehicle length above 5000 m")
     reasons = rejection_reasons(PassTable.from_rows(rows), site)
     assert reasons[0] == ""
     for got, (_, want) in zip(reasons[1:], cases.values(), strict=True):

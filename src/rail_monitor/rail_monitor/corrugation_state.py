@@ -22,6 +22,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -42,6 +43,16 @@ NS_PER_DAY = 86_400 * 10**9
 SPEED_STEP_MPS = 0.1          # speed grid of the growth tables [m/s]
 CHECKPOINT_VERSION = 2
 READABLE_VERSIONS = (1, 2)  # 1: before grinding_amplitude (read as the post-grinding default)
+
+
+class CorruptCheckpoint(ConfigError):
+    """A checkpoint file that cannot be read (truncated, failed CRC, missing arrays)."""
+
+
+def previous_checkpoint(path: str | Path) -> Path:
+    """Where save() keeps the checkpoint it replaced: the fallback when the newest is unreadable."""
+    path = Path(path)
+    return path.with_name(path.name + ".prev")
 
 # K_b per friction state [-/axle pass]. MODELS.md section 2: K_b of order 1e-5 (1 nm of wear per
 # pass at 75 kN, k_c = 1.3e9 N/m) for dry rail in partial slip. The wear that drives growth scales
@@ -645,7 +656,11 @@ class CorrugationEstimator:
 
     # -- checkpoints ----------------------------------------------------------------------------
     def save(self, path: str | Path) -> None:
-        """Write the state atomically: a temporary file, fsync, rename over path, fsync the folder."""
+        """Write the state atomically: a temporary file, fsync, rename over path, fsync the folder.
+
+        The file it replaces is kept as previous_checkpoint(path). A crash between the two renames
+        leaves only that one, which resume() then takes.
+        """
         path = Path(path)
         meta = {"version": CHECKPOINT_VERSION, "site_id": self.site.site_id, "pass_count": self.pass_count,
                 "axle_pass_count": self.axle_pass_count, "total_pass_count": self.total_pass_count,
@@ -664,6 +679,8 @@ class CorrugationEstimator:
             fh.write(buf.getvalue())
             fh.flush()
             os.fsync(fh.fileno())
+        if path.exists():  # keep the last good one: a later fault on the new file falls back to it
+            os.replace(path, previous_checkpoint(path))
         os.replace(tmp, path)
         dir_fd = os.open(path.parent, os.O_RDONLY)
         try:
@@ -675,10 +692,17 @@ class CorrugationEstimator:
         """Resume from a checkpoint of this site with the same bands (ConfigError otherwise)."""
         try:
             with np.load(path, allow_pickle=False) as z:
-                data = {k: z[k] for k in z.files}
+                data = {k: z[k] for k in z.files}  # zip member CRCs are checked as each is read
             meta = json.loads(str(data["meta"]))
-        except (OSError, ValueError, KeyError) as exc:
-            raise ConfigError(f"{path}: not a corrugation checkpoint: {str(exc).splitlines()[0]}") from None
+            missing = {"bands", "log_components", "k_b", "survey_log_amplitude",
+                       *(f"recent_{n}" for n in _RECENT)} - set(data)
+            if missing:
+                raise KeyError(f"arrays missing: {', '.join(sorted(missing))}")
+        except FileNotFoundError:
+            raise ConfigError(f"{path}: no such checkpoint") from None
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+            raise CorruptCheckpoint(f"{path}: not a readable corrugation checkpoint: "
+                                    f"{(str(exc).splitlines() or [type(exc).__name__])[0]}") from None
         if meta.get("version") not in READABLE_VERSIONS or meta.get("site_id") != self.site.site_id:
             raise ConfigError(f"{path}: checkpoint of site {meta.get('site_id')!r} version {meta.get('version')}, "
                               f"not of site {self.site.site_id!r} version {CHECKPOINT_VERSION}")
@@ -697,3 +721,25 @@ class CorrugationEstimator:
         self.recent.train_id = self.recent.train_id.astype(object)
         self._seen = set(zip(self.recent.stamp_ns.tolist(), self.recent.train_id.tolist(), strict=True))
         self._resum()
+
+    def resume(self, path: str | Path) -> tuple[Path | None, list[str]]:
+        """Load the newest readable checkpoint: path, else previous_checkpoint(path).
+
+        Returns the file loaded (None: neither exists, the state stays as it is) and one line per
+        unreadable file passed over. Both unreadable is CorruptCheckpoint: a restart from zero
+        would silently lose the history. A readable checkpoint of another site or other bands is
+        ConfigError, with no fallback (the configuration is wrong, not the file).
+        """
+        skipped: list[str] = []
+        for candidate in (Path(path), previous_checkpoint(path)):
+            if not candidate.exists():
+                continue
+            try:
+                self.load(candidate)
+            except CorruptCheckpoint as exc:
+                skipped.append(str(exc))
+                continue
+            return candidate, skipped
+        if skipped:
+            raise CorruptCheckpoint("; ".join(skipped) + " (and no readable previous checkpoint)")
+        return None, skipped

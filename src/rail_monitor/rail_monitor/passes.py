@@ -27,9 +27,14 @@ FRICTION_BY_NAME: dict[str, int] = {v: k for k, v in FRICTION_NAMES.items()}
 
 # Plausibility limits that separate a malformed event from an unusual pass.
 MAX_SPEED_MPS = 120.0           # above any line speed at a curve
+MIN_SPEED_MPS = 1.0             # below a walking pace: not a rolling pass (the models divide by the speed)
+MIN_WHEEL_LOAD_N = 5.0e3        # half a tonne per wheel, under any empty vehicle (0 still means nominal)
+MIN_TRAIN_LENGTH_M = 5.0        # shorter than any rail vehicle (0 still means from the class)
 MAX_ANGLE_OF_ATTACK_RAD = 0.1   # 100 mrad: far past flange contact for any bogie
 MAX_WHEEL_LOAD_N = 3.0e5        # 30 t axle load is about 147 kN per wheel
 MAX_TRAIN_LENGTH_M = 5000.0
+MAX_VEHICLE_COUNT = 500         # record heavy-haul trains run about 300 wagons in 3 km
+MAX_AXLE_COUNT = 4 * MAX_VEHICLE_COUNT
 
 
 @dataclass
@@ -122,21 +127,35 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     flag(np.array([len(s) > 64 for s in table.train_id], dtype=bool), "train_id longer than 64 characters")
     flag(~np.isfinite(table.speed_mps), "speed_mps not finite")
     flag(table.speed_mps <= 0.0, "speed_mps not positive")
+    flag(table.speed_mps < MIN_SPEED_MPS, f"speed_mps below {MIN_SPEED_MPS:g} m/s")
     flag(table.speed_mps > MAX_SPEED_MPS, f"speed_mps above {MAX_SPEED_MPS:g} m/s")
     flag(~np.isfinite(table.angle_of_attack_rad), "angle_of_attack_rad not finite")
     flag(np.abs(table.angle_of_attack_rad) > MAX_ANGLE_OF_ATTACK_RAD,
          f"|angle_of_attack_rad| above {MAX_ANGLE_OF_ATTACK_RAD:g} rad")
     flag(~np.isfinite(table.wheel_load_n), "wheel_load_n not finite")
     flag(table.wheel_load_n < 0.0, "wheel_load_n negative")
+    flag((table.wheel_load_n > 0.0) & (table.wheel_load_n < MIN_WHEEL_LOAD_N),
+         f"wheel_load_n below {MIN_WHEEL_LOAD_N:g} N (0: the class's nominal load)")
     flag(table.wheel_load_n > MAX_WHEEL_LOAD_N, f"wheel_load_n above {MAX_WHEEL_LOAD_N:g} N")
     flag(~np.isin(table.friction_state, list(FRICTION_NAMES)), "friction_state unknown")
     flag((table.axle_count == 0) & (table.vehicle_count == 0), "neither axle_count nor vehicle_count set")
+    flag(table.vehicle_count > MAX_VEHICLE_COUNT, f"vehicle_count above {MAX_VEHICLE_COUNT}")
+    flag(table.axle_count > MAX_AXLE_COUNT, f"axle_count above {MAX_AXLE_COUNT}")
     flag(~np.isfinite(table.train_length_m), "train_length_m not finite")
     flag(table.train_length_m < 0.0, "train_length_m negative")
+    flag((table.train_length_m > 0.0) & (table.train_length_m < MIN_TRAIN_LENGTH_M),
+         f"train_length_m below {MIN_TRAIN_LENGTH_M:g} m (0: from the counts and the class)")
     flag(table.train_length_m > MAX_TRAIN_LENGTH_M, f"train_length_m above {MAX_TRAIN_LENGTH_M:g} m")
     if site is not None:
         known = np.array([c in site.vehicles for c in table.vehicle_class], dtype=bool)
         flag(~known, "vehicle_class unknown to the site")
+        # A zero length is filled from the counts and the class: that length must be plausible too.
+        ok = reasons == ""
+        filled = with_class_defaults(table.take(ok), site).train_length_m
+        implied = np.zeros(n)
+        implied[ok] = filled
+        flag(implied > MAX_TRAIN_LENGTH_M,
+             f"train length from vehicle_count and the class's vehicle length above {MAX_TRAIN_LENGTH_M:g} m")
     return reasons
 
 

@@ -11,11 +11,12 @@ passes, after every survey and at shutdown, and a restart resumes from it.
 
 from __future__ import annotations
 
-import os
 import sys
 import time
 from collections import Counter
 from typing import Any
+
+from diagnostic_msgs.msg import DiagnosticStatus
 
 from rail_monitor.corrugation_state import CORRUGATION_SPECS, CorrugationEstimator, corrugation_config
 from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
@@ -47,9 +48,15 @@ class CorrugationEstimatorNode(PassModelNode):
         self.counts: Counter[str] = Counter()
         self.sent = Sent()
         self.surveys_rejected: Counter[str] = Counter()
-        if self.checkpoint and os.path.exists(self.checkpoint):
-            self.est.load(self.checkpoint)  # a checkpoint it cannot use is a ConfigError: no silent fresh start
-            self.get_logger().info(f"resumed from {self.checkpoint}: {self.est.total_pass_count} passes")
+        self.checkpoint_skipped: list[str] = []
+        if self.checkpoint:
+            # An unreadable checkpoint falls back to the previous one; none readable is a ConfigError
+            # (no silent fresh start).
+            used, self.checkpoint_skipped = self.est.resume(self.checkpoint)
+            for why in self.checkpoint_skipped:
+                self.get_logger().error(f"checkpoint skipped: {why}")
+            if used is not None:
+                self.get_logger().info(f"resumed from {used}: {self.est.total_pass_count} passes")
         self._since_checkpoint = 0
         self._last_state_t = float("-inf")
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", LATEST_QOS)
@@ -145,7 +152,14 @@ class CorrugationEstimatorNode(PassModelNode):
                   "state_age_s": f"{(time.time_ns() - self.est.newest_ns) / 1e9:.0f}" if self.est.newest_ns else "",
                   "last_grinding": format_iso_ns(self.est.last_grinding_ns) if self.est.last_grinding_ns else ""}
         values.update({f"survey rejected: {why}": n for why, n in sorted(self.surveys_rejected.items())})
+        values.update({f"checkpoint skipped {i + 1}": why for i, why in enumerate(self.checkpoint_skipped)})
         return values
+
+    def _level(self) -> tuple[int, str]:
+        level, message = super()._level()
+        if self.checkpoint_skipped and level == DiagnosticStatus.OK:
+            return DiagnosticStatus.WARN, "resumed from the previous checkpoint (newest unreadable)"
+        return level, message
 
 
 def main(args: list[str] | None = None) -> int:

@@ -2,7 +2,8 @@
 
 A malformed pass is rejected with its reason (rail_monitor.passes.rejection_reasons), counted
 per reason on /diagnostics, logged (throttled) and never reaches the model, so it leaves any
-state untouched.
+state untouched. A model raising on an accepted pass is a bug: it is counted and logged, the
+node's diagnostics go to ERROR, and the node goes on with the next pass.
 """
 
 from __future__ import annotations
@@ -27,9 +28,10 @@ class PassModelNode(Node):
     def __init__(self, name: str, **kwargs: Any) -> None:
         super().__init__(name, **kwargs)
         self.site = declare_site(self)
-        self.taken = 0  # train_pass messages taken (the pass source's flow control reads it)
+        self.taken = 0  # train_pass messages handled (the pass source's flow control reads it)
         self.accepted = RateMeter()
         self.rejected: Counter[str] = Counter()
+        self.model_errors: Counter[str] = Counter()  # accepted passes a model raised on (a bug: ERROR)
         self.last_pass_ns = 0
         self.create_subscription(TrainPass, "train_pass", self._on_train_pass, STREAM_SUB_QOS)
         Diagnostics(self, self.diagnostic_values, level=self._level)
@@ -42,7 +44,12 @@ class PassModelNode(Node):
         """Handle one rejected pass (after it is counted); nothing by default."""
 
     def _on_train_pass(self, msg: TrainPass) -> None:
-        self.taken += 1
+        try:
+            self._handle(msg)
+        finally:
+            self.taken += 1  # after handling: a reader of ``taken`` sees the pass's effects
+
+    def _handle(self, msg: TrainPass) -> None:
         table = PassTable.from_rows([train_pass_row(msg)])
         reason = rejection_reasons(table, self.site)[0]
         if reason:
@@ -52,7 +59,12 @@ class PassModelNode(Node):
             return
         self.accepted.tick()
         self.last_pass_ns = time_ns(msg.header.stamp)
-        self.on_pass(with_class_defaults(table, self.site), msg)
+        try:
+            self.on_pass(with_class_defaults(table, self.site), msg)
+        except Exception as exc:  # a model failing on one accepted pass must not stop the node
+            why = f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"
+            self.model_errors[why] += 1
+            self.get_logger().error(f"pass {msg.train_id!r}: model error {why}", throttle_duration_sec=5.0)
 
     def diagnostic_values(self) -> dict[str, Any]:
         values: dict[str, Any] = {
@@ -62,9 +74,13 @@ class PassModelNode(Node):
             "last_pass": format_iso_ns(self.last_pass_ns) if self.last_pass_ns else "",
         }
         values.update({f"rejected: {reason}": n for reason, n in sorted(self.rejected.items())})
+        values["model errors"] = sum(self.model_errors.values())
+        values.update({f"model error: {why}": n for why, n in sorted(self.model_errors.items())})
         return values
 
     def _level(self) -> tuple[int, str]:
+        if self.model_errors:
+            return DiagnosticStatus.ERROR, f"{sum(self.model_errors.values())} pass(es) failed in a model"
         n = sum(self.rejected.values())
         if n:
             return DiagnosticStatus.WARN, f"{n} pass(es) rejected"
