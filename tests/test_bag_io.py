@@ -136,7 +136,42 @@ def _bad_bags(tmp: Path, sample: Path) -> dict[str, Path]:
     garbage.mkdir()
     (garbage / "metadata.yaml").write_text("rosbag2_bagfile_information: [oops\n")
     bags["bad metadata"] = garbage
+    with McapBagWriter(tmp / "wrong_type") as w:
+        w.add_topic("/train_pass", "diagnostic_msgs/msg/DiagnosticArray")
+    bags["train_pass of the wrong type"] = tmp / "wrong_type"
+    # bare MCAP files written record by record (the bag writer refuses these)
+    bags["unknown message type"] = _raw_mcap(tmp / "unknown.mcap", "/axles", ("acme_msgs/msg/Axle", b"float64 x"))
+    bags["missing schema"] = _raw_mcap(tmp / "schemaless.mcap", "/train_pass", None)
+    bags["TrainPass of another definition"] = _raw_mcap(tmp / "otherdef.mcap", "/train_pass",
+                                                        (TRAIN_PASS, b"float64 x"))
     return bags
+
+
+def _raw_mcap(path: Path, topic: str, schema: tuple[str, bytes] | None) -> Path:
+    from mcap.writer import Writer
+
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="ros2", library="test")
+        sid = w.register_schema(name=schema[0], encoding="ros2msg", data=schema[1]) if schema else 0
+        ch = w.register_channel(topic=topic, message_encoding="cdr", schema_id=sid)
+        w.add_message(channel_id=ch, log_time=1, data=b"\x00\x01\x00\x00" + bytes(40), publish_time=1)
+        w.finish()
+    return path
+
+
+def _bad_csvs(tmp: Path) -> dict[str, Path]:
+    header = "time_utc,train_id,vehicle_class,vehicle_count,speed_mps,angle_of_attack_rad,friction_state\n"
+    row = "2026-09-01T05:00:00Z,T1,emu,3,19.0,0.005,dry\n"
+    files = {"csv in an unknown unit": (header.replace("speed_mps", "speed_mph") + row).encode(),
+             "csv in Latin-1": (header + row.replace("T1", "Zug\xe41")).encode("latin-1"),
+             "csv in UTF-16": (header + row).encode("utf-16"),
+             "csv with a row short": (header + row.replace(",dry", "")).encode()}
+    out = {}
+    for i, (what, data) in enumerate(files.items()):
+        out[what] = tmp / f"bad{i}.csv"
+        out[what].write_bytes(data)
+    return out
 
 
 def test_bad_bags_raise_one_line_input_errors(tmp_path: Path):
@@ -149,20 +184,28 @@ def test_bad_bags_raise_one_line_input_errors(tmp_path: Path):
 def test_wrong_topic_type_is_named(tmp_path: Path):
     with McapBagWriter(tmp_path / "diag") as w:
         w.add_topic("/train_pass", "diagnostic_msgs/msg/DiagnosticArray")
-    with pytest.raises(InputError, match="no a rail_msgs/msg/TrainPass topic in the bag; it has /train_pass"):
+    with pytest.raises(InputError, match="no rail_msgs/msg/TrainPass topic in the bag; it has /train_pass"):
         read_bag_passes(tmp_path / "diag")
     with pytest.raises(InputError, match="is diagnostic_msgs/msg/DiagnosticArray, not rail_msgs/msg/TrainPass"):
         read_bag_passes(tmp_path / "diag", topic="/train_pass")
 
 
-def test_cli_on_bad_bags_one_line_nonzero_no_traceback(tmp_path: Path):
-    for what, path in _bad_bags(tmp_path, SAMPLE).items():
-        for cmd in (["rail-monitor", "info", str(path)], ["pass_replayer", "--ros-args", "-p", f"source:={path}"]):
+def test_cli_on_bad_bags_one_line_nonzero_no_traceback(tmp_path: Path, tally):
+    bad = {**_bad_bags(tmp_path, SAMPLE), **_bad_csvs(tmp_path)}
+    for what, path in bad.items():
+        for cmd in (["rail-monitor", "info", str(path)], ["pass_replayer", "--ros-args", "-p", f"source:={path}"],
+                    ["rail-monitor", "batch", str(path), "--output", str(tmp_path / "b"), "--no-report"]):
             r = run_cmd(*cmd, timeout=60)
-            assert r.returncode != 0, (what, cmd)
             assert "Traceback" not in r.stderr, (what, r.stderr)
+            if cmd[1] == "info" and r.returncode == 0:  # info summarises a readable bag without passes
+                assert "TrainPass" not in r.stdout and what.startswith(("train_pass", "unknown", "missing")), what
+                continue
+            assert r.returncode != 0, (what, cmd)
             errors = [line for line in r.stderr.splitlines() if "error:" in line]
             assert len(errors) == 1 and str(path) in errors[0], (what, r.stderr)
+    tally("bad files", f"{len(bad)} unusable histories ({', '.join(bad)}), each through info, pass_replayer "
+          "and batch", "one-line error naming the file, non-zero exit, no traceback (info lists the topics of "
+          "a readable bag without passes)", "-")
 
 
 def test_salvage_reads_every_complete_chunk_of_a_cut_file(tmp_path: Path, sample_passes):

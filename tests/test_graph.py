@@ -3,11 +3,14 @@ processes, against batch mode, across a restart, and the late-subscriber alert c
 
 from __future__ import annotations
 
+import contextlib
 import os
 import random
+import shutil
 import signal
 import subprocess
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -140,36 +143,94 @@ def test_report_rebuilds_from_the_batch_bag(runs, tmp_path):
     assert (tmp_path / "rep" / "index.html").stat().st_size > 0 and "grinding forecast" in r.stdout
 
 
-def test_separate_processes_equal_batch(runs, tmp_path, ros_context):
-    """One executable per node under the site namespace, talking over DDS."""
-    probe = Node("probe", context=ros_context)
-    # subscribers each output topic must have before the replay starts (the recorder among them)
-    wanted = {"noise/squeal": 2, "noise/rolling": 2, "corrugation/state": 3, "alerts": 1, "train_pass": 4}
+# The output topics whose publishers exist once the model nodes are up: the recorder must have
+# subscribed to each before the replay starts.
+OUTPUTS = ("noise/squeal", "noise/rolling", "corrugation/state", "speed_advisory", "alerts", "alerts/standing")
+
+
+def _graph_in_processes(runs, folder: Path, graph_host: tuple[str, ...] = (), replayer_host: tuple[str, ...] = (),
+                        env: dict | None = None) -> int:
+    """One executable per node under the site namespace, talking over DDS: the recorder and the
+    models prefixed by graph_host, the replayer by replayer_host (e.g. ip netns exec). Returns the
+    passes replayed; the recording is in folder/bag."""
+    env = {**os.environ, **(env or {})}
     ns = ["-r", "__ns:=/curve_250"]
-    procs = [subprocess.Popen([name, "--ros-args", *ns, *_ros_params(runs["site"], extra)], cwd=TOP,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-             for name, extra in (("mcap_recorder", {"output": str(tmp_path / "bag"), "flush_period_s": 0.2}),
-                                 ("corrugation_estimator", {}), ("rolling_noise_predictor", {}),
-                                 ("squeal_risk_model", {}), ("alert_manager", {}))]
+    log = folder / "recorder.log"
+    procs = []
     try:
-        assert wait_until(lambda: all(probe.count_subscribers(f"/curve_250/{t}") >= n for t, n in wanted.items())
-                          and probe.count_publishers("/curve_250/noise/squeal") >= 1, timeout_s=60)
-        time.sleep(1.0)  # the recorder subscribes to a topic once it has seen its publisher
-        r = run_cmd("pass_replayer", "--ros-args", *ns, "-p", f"source:={SAMPLE}", "-p",
-                    f"end_offset_s:={DAYS * 86400}", "-p", "wait_for_subscribers:=5", "-p", "progress:=false",
-                    "-p", "site_id:=curve_250", timeout=180)
-        assert r.returncode == 0, r.stderr[-2000:]
-        n = len(_slice())
-        # the outputs are in when the recorder holds the last noise and alert messages
-        time.sleep(3.0)
+        with open(log, "w") as rec_err:
+            for name, extra in (("mcap_recorder", {"output": str(folder / "bag"), "flush_period_s": 0.2}),
+                                ("corrugation_estimator", {}), ("rolling_noise_predictor", {}),
+                                ("squeal_risk_model", {}), ("alert_manager", {})):
+                procs.append(subprocess.Popen(
+                    [*graph_host, name, "--ros-args", *ns, *_ros_params(runs["site"], extra)], cwd=TOP, env=env,
+                    stdout=subprocess.DEVNULL, stderr=rec_err if name == "mcap_recorder" else subprocess.DEVNULL))
+            assert wait_until(lambda: all(f"recording /curve_250/{t} [" in log.read_text() for t in OUTPUTS),
+                              timeout_s=60), log.read_text()[-2000:]
+            time.sleep(1.0)  # the models' own subscriptions to each other's outputs
+            r = subprocess.run([*replayer_host, "pass_replayer", "--ros-args", *ns, "-p", f"source:={SAMPLE}", "-p",
+                                f"end_offset_s:={DAYS * 86400}", "-p", "wait_for_subscribers:=5", "-p",
+                                "progress:=false", "-p", "site_id:=curve_250"],
+                               cwd=TOP, env=env, capture_output=True, text=True, timeout=180)
+            assert r.returncode == 0, r.stderr[-2000:]
+            # the outputs are in when the recorder holds the last noise and alert messages
+            time.sleep(3.0)
     finally:
         for p in reversed(procs):
             p.send_signal(signal.SIGINT)
         for p in procs:
             p.wait(timeout=30)
+    return len(_slice())
+
+
+def test_separate_processes_equal_batch(runs, tmp_path):
+    n = _graph_in_processes(runs, tmp_path)
     run = load_run(tmp_path / "bag")
     assert len(run.passes) == n
     _assert_equal_runs(run, runs["batch"])
+
+
+@contextlib.contextmanager
+def _two_hosts() -> Iterator[tuple[str, str]]:
+    """Two network namespaces joined by a veth pair (10.77.0.1 and .2/24), each with loopback up
+    and a default route on its end; yields their names. Skips where the machine forbids it."""
+    tag = os.getpid() % 100_000
+    a, b = f"rm_a{tag}", f"rm_b{tag}"
+    steps = [["netns", "add", a], ["netns", "add", b],
+             ["link", "add", f"va{tag}", "type", "veth", "peer", "name", f"vb{tag}"],
+             ["link", "set", f"va{tag}", "netns", a], ["link", "set", f"vb{tag}", "netns", b]]
+    for host, dev, addr in ((a, f"va{tag}", "10.77.0.1/24"), (b, f"vb{tag}", "10.77.0.2/24")):
+        steps += [["-n", host, "addr", "add", addr, "dev", dev], ["-n", host, "link", "set", dev, "up"],
+                  ["-n", host, "link", "set", "lo", "up"], ["-n", host, "route", "add", "default", "dev", dev]]
+    try:
+        if shutil.which("ip") is None:
+            pytest.skip("iproute2's ip is not installed: cannot make network namespaces")
+        for step in steps:
+            r = subprocess.run(["ip", *step], capture_output=True, text=True)
+            if r.returncode:
+                pytest.skip(f"network namespaces are forbidden here (ip {' '.join(step)}: {r.stderr.strip()})")
+        yield a, b
+    finally:
+        for host in (a, b):
+            subprocess.run(["ip", "netns", "del", host], capture_output=True)
+
+
+def test_replayer_and_graph_on_two_hosts_lose_nothing(runs, tmp_path, tally):
+    """Issue 8: the replayer in one network namespace, the models and the recorder in another,
+    joined by a veth pair; DDS over UDP only (shared memory would bypass the link): every pass and
+    every output arrives, equal to batch."""
+    with _two_hosts() as (a, b):
+        n = _graph_in_processes(runs, tmp_path, graph_host=("ip", "netns", "exec", b),
+                                replayer_host=("ip", "netns", "exec", a),
+                                env={"FASTDDS_BUILTIN_TRANSPORTS": "UDPv4"})
+        sent = int(subprocess.run(["ip", "netns", "exec", a, "cat", f"/sys/class/net/va{os.getpid() % 100_000}"
+                                   "/statistics/tx_bytes"], capture_output=True, text=True).stdout)
+    run = load_run(tmp_path / "bag")
+    assert len(run.passes) == n
+    assert sent > 100 * n  # the passes went over the link
+    _assert_equal_runs(run, runs["batch"])
+    tally("two hosts", f"replayer and graph in two network namespaces over a veth pair, UDP only: {n} passes, "
+          f"{sent / 1e3:.0f} kB sent over the link", "every pass and every output recorded; equal to batch", 0)
 
 
 def test_restart_mid_replay_ends_in_the_uninterrupted_state(runs, tmp_path, tally):

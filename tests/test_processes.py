@@ -54,7 +54,7 @@ def test_ament_index_resolves_every_executable():
     assert "default: 0.0 [rate]" in r.stdout and "[s]" in r.stdout and "[0, 1e+09]" in r.stdout
 
 
-def test_two_processes_over_dds_lose_nothing_and_sigint_finalises(tmp_path: Path):
+def test_two_processes_over_dds_lose_nothing_and_sigint_finalises(tmp_path: Path, tally):
     rec = _start_recorder(tmp_path / "two")
     try:
         r = _replay()
@@ -69,9 +69,11 @@ def test_two_processes_over_dds_lose_nothing_and_sigint_finalises(tmp_path: Path
         counts = {c.topic: c.msgcount for c in reader.connections}
     assert counts["/site/train_pass"] == n
     assert read_bag_passes(tmp_path / "two").equals(read_bag_passes(SAMPLE).take(slice(0, n)))
+    tally("recorder SIGINT", f"replayer to recorder over DDS, {n} passes, then SIGINT",
+          "exit 0, indexed bag with metadata, equal to the source", 0)
 
 
-def test_sigterm_finalises_an_indexed_bag(tmp_path: Path):
+def test_sigterm_finalises_an_indexed_bag(tmp_path: Path, tally):
     rec = _start_recorder(tmp_path / "term")
     try:
         assert _replay().returncode == 0
@@ -83,6 +85,7 @@ def test_sigterm_finalises_an_indexed_bag(tmp_path: Path):
     meta = yaml.safe_load((tmp_path / "term" / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
     topics = {t["topic_metadata"]["name"]: t["message_count"] for t in meta["topics_with_message_count"]}
     assert topics["/site/train_pass"] == _expected_slice()
+    tally("recorder SIGTERM", f"{_expected_slice()} passes, then SIGTERM", "exit 0, indexed bag with metadata", 0)
 
 
 def test_sigkill_leaves_every_flushed_chunk_readable(tmp_path: Path):

@@ -102,7 +102,10 @@ def cmd_info(ns: argparse.Namespace) -> int:
     from rail_monitor.timeutil import NS_PER_S, format_iso_ns
 
     path = Path(ns.bag)
-    if not is_csv(path):
+    if ns.salvage:
+        table = read_passes(path, ns.topic, salvage=True)
+        print(table.salvage.line(path))
+    elif not is_csv(path):
         info = bag_info(path)
         span = (info.end_ns - info.start_ns) / NS_PER_S
         print(f"bag:       {info.path} ({info.storage})")
@@ -113,7 +116,9 @@ def cmd_info(ns: argparse.Namespace) -> int:
             print(f"  {t.name:32s} {t.typename:40s} {t.count}")
         if not any(t.typename == "rail_msgs/msg/TrainPass" for t in info.topics):
             return 0
-    table = read_passes(path, ns.topic)
+        table = read_passes(path, ns.topic)
+    else:
+        table = read_passes(path, ns.topic)
     if len(table):
         days = max((table.stamp_ns.max() - table.stamp_ns.min()) / 86400e9, 1e-9)
         print(f"passes:    {len(table)} ({len(table) / days:.1f} per day)")
@@ -210,7 +215,9 @@ def cmd_batch(ns: argparse.Namespace) -> int:
 
     t0 = time.monotonic()
     values = load_parameter_file(_site_file(ns.site))
-    passes = read_passes(ns.source, ns.topic)
+    passes = read_passes(ns.source, ns.topic, salvage=ns.salvage)
+    if ns.salvage:
+        print(passes.salvage.line(ns.source))
     out = Path(ns.output or f"{Path(ns.source).stem}_batch")
     _fresh_output(out, ns.overwrite)
     result = run_models(passes, values)
@@ -223,6 +230,9 @@ def cmd_batch(ns: argparse.Namespace) -> int:
         _report(str(out), ns.site, ns.report)
     return 0
 
+
+_SALVAGE_HELP = ("read every complete chunk of an MCAP file cut off mid-write (a killed recorder, a full disk) "
+                 "and say how many messages it recovered")
 
 # predict squeal: option, SquealCase field, unit
 _SQUEAL_OVERRIDES = {"mass_kg": ("--mass", "kg"), "damping_nspm": ("--damping", "N s/m"),
@@ -486,6 +496,7 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("info", help="summarise a bag or CSV: topics, counts, time span, pass statistics")
     s.add_argument("bag", help="bag folder, .mcap, .db3 or .csv")
     s.add_argument("--topic", help="TrainPass topic to summarise (default: the only one)")
+    s.add_argument("--salvage", action="store_true", help=_SALVAGE_HELP)
     s.set_defaults(func=cmd_info)
 
     s = sub.add_parser("replay", help="run pass_replayer: publish a history on train_pass with /clock")
@@ -575,6 +586,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--report", help="report folder (default: <output>_report)")
     s.add_argument("--no-report", action="store_true", help="write the bag only")
     s.add_argument("--overwrite", action="store_true", help="replace an existing output folder")
+    s.add_argument("--salvage", action="store_true", help=_SALVAGE_HELP)
     s.set_defaults(func=cmd_batch)
 
     s = sub.add_parser("report", help="print the summary of a recorded run and write its report folder "

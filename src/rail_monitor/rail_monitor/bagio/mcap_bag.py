@@ -11,8 +11,10 @@ OS at once, so a killed process leaves every complete chunk readable
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -57,8 +59,16 @@ class _DirectFile:
 
     def write(self, data: bytes | memoryview) -> int:
         view = memoryview(data)
-        while view:
-            view = view[os.write(self._fd, view):]
+        try:
+            while view:
+                view = view[os.write(self._fd, view):]
+        except OSError:
+            # A full disk or a write error: cut off what got out of this write, so the file stays
+            # the records written before it (a salvage reads them all), then report.
+            with contextlib.suppress(OSError):
+                os.ftruncate(self._fd, self._pos)
+                os.lseek(self._fd, self._pos, os.SEEK_SET)
+            raise
         self._pos += len(data)
         return len(data)
 
@@ -129,6 +139,7 @@ class McapBagWriter:
         self._files: list[_File] = []
         self._file: _File | None = None
         self.closed = False
+        self.error = ""  # the first write error (e.g. a full disk); the bag takes no more messages
 
     # -- topics and files -------------------------------------------------------------------
     def add_topic(self, topic: str, typename: str, offered_qos: list[dict[str, Any]] | None = None) -> None:
@@ -171,6 +182,8 @@ class McapBagWriter:
         """Append one serialised message [CDR bytes] at log_time_ns [ns since the epoch]."""
         if self.closed:
             raise RailMonitorError("bag writer is closed")
+        if self.error:
+            raise RailMonitorError(self.error)
         t = self._topics.get(topic)
         if t is None:
             raise RailMonitorError(f"topic {topic} was not added to the bag")
@@ -181,11 +194,12 @@ class McapBagWriter:
         ):
             self._close_file(f)
             f = None
-        if f is None:
-            f = self._file = self._open_file()
-        f.writer.add_message(channel_id=f.channel_ids[topic], log_time=log_time_ns, data=data,
-                             publish_time=log_time_ns if publish_time_ns is None else publish_time_ns,
-                             sequence=t.count)
+        with self._failing_on_os_error():
+            if f is None:
+                f = self._file = self._open_file()
+            f.writer.add_message(channel_id=f.channel_ids[topic], log_time=log_time_ns, data=data,
+                                 publish_time=log_time_ns if publish_time_ns is None else publish_time_ns,
+                                 sequence=t.count)
         if f.first_ns is None:
             f.first_ns = log_time_ns
         f.first_ns = min(f.first_ns, log_time_ns)
@@ -199,13 +213,26 @@ class McapBagWriter:
         by_log = self._flush_ns and log_time_ns - self._last_flush_ns >= self._flush_ns
         by_wall = self._flush_wall and now - self._last_flush_wall >= self._flush_wall
         if by_log or by_wall:
-            self.flush()
+            with self._failing_on_os_error():
+                self.flush()
             self._last_flush_ns, self._last_flush_wall = log_time_ns, now
 
     def flush(self) -> None:
         """Close the open chunk and hand it to the OS (messages so far survive a kill)."""
-        if self._file is not None:
-            self._file.writer.flush()
+        if self._file is not None and not self.error:
+            with self._failing_on_os_error():
+                self._file.writer.flush()
+
+    @contextlib.contextmanager
+    def _failing_on_os_error(self) -> Iterator[None]:
+        """Turn an OSError into RailMonitorError and stop the bag: after a failed write the open
+        chunk is lost and the file ends at the last whole record, which salvage_mcap reads."""
+        try:
+            yield
+        except OSError as exc:
+            where = self._file.path if self._file is not None else self.folder
+            self.error = f"{where}: write failed, recording stopped: {exc.strerror or exc}"
+            raise RailMonitorError(self.error) from None
 
     def sync(self) -> None:
         """flush, then fsync the open file (survives a power loss)."""
@@ -254,17 +281,28 @@ class McapBagWriter:
         }
 
     def close(self) -> Path:
-        """Finish the open file and write metadata.yaml; returns the bag folder."""
+        """Finish the open file and write metadata.yaml; returns the bag folder.
+
+        After a write error (self.error) the file cannot be finished: RailMonitorError, and the
+        file keeps the whole records written before the error (salvage_mcap reads them)."""
         if self.closed:
             return self.folder
-        if self._file is None:  # an empty bag still gets one valid file
-            self._file = self._open_file()
-        self._close_file(self._file)
-        self._file = None
-        tmp = self.folder / "metadata.yaml.tmp"
-        tmp.write_text(_dump({"rosbag2_bagfile_information": self._info()}), encoding="utf-8")
-        os.replace(tmp, self.folder / "metadata.yaml")
-        self.closed = True
+        try:
+            if self.error:
+                raise RailMonitorError(self.error)
+            with self._failing_on_os_error():
+                if self._file is None:  # an empty bag still gets one valid file
+                    self._file = self._open_file()
+                self._close_file(self._file)
+                self._file = None
+                tmp = self.folder / "metadata.yaml.tmp"
+                tmp.write_text(_dump({"rosbag2_bagfile_information": self._info()}), encoding="utf-8")
+                os.replace(tmp, self.folder / "metadata.yaml")
+        finally:
+            self.closed = True
+            if self._file is not None:
+                with contextlib.suppress(OSError):
+                    self._file.stream.close()
         return self.folder
 
     def __enter__(self) -> McapBagWriter:

@@ -106,7 +106,7 @@ def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
         conns = [c for c in reader.connections if (c.topic == topic if topic else c.msgtype == TRAIN_PASS)]
         if not conns:
             have = sorted({f"{c.topic} [{c.msgtype}]" for c in reader.connections}) or ["no topics"]
-            want = f"topic {topic}" if topic else f"a {TRAIN_PASS} topic"
+            want = f"topic {topic}" if topic else f"{TRAIN_PASS} topic"
             raise InputError(f"{path}: no {want} in the bag; it has {', '.join(have)}")
         bad = [c for c in conns if c.msgtype != TRAIN_PASS]
         if bad:
@@ -140,10 +140,14 @@ def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, lis
     return out
 
 
-def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False) -> PassTable:
+def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,
+                salvage: bool = False) -> PassTable:
     """Train passes from a CSV export or a bag, whichever path names (skip_bad_rows: CSV only,
-    see read_csv; the table's ``skipped`` attribute counts what was left out)."""
+    see read_csv; the table's ``skipped`` attribute counts what was left out; salvage: MCAP only,
+    see salvage_bag_passes)."""
     path = Path(path)
+    if salvage:
+        return salvage_bag_passes(path, topic)
     if is_csv(path):
         from rail_monitor.bagio.csv_io import read_csv
 
@@ -186,3 +190,53 @@ def salvage_mcap(path: str | Path) -> Iterator[SalvagedMessage]:
                 ch = channels[rec.channel_id]
                 schema = schemas.get(ch.schema_id)
                 yield SalvagedMessage(ch.topic, schema.name if schema else "", rec.log_time, rec.data)
+
+
+@dataclass(frozen=True)
+class SalvageReport:
+    files: int          # .mcap files read
+    messages: int       # messages in their complete chunks (every topic)
+    passes: int         # TrainPass messages among them (of the chosen topic)
+
+    def line(self, path: str | Path) -> str:
+        return (f"salvaged {self.messages} messages ({self.passes} TrainPass) from the complete chunks of "
+                f"{self.files} MCAP file(s) in {path}")
+
+
+def salvage_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
+    """Every TrainPass in the complete chunks of a bag's MCAP files (a folder or one .mcap file),
+    even files cut off mid-write with no summary or metadata.yaml (a killed recorder, a full disk).
+
+    The table's ``salvage`` attribute (SalvageReport) says what was recovered. Passes are in
+    file, then log-time order. topic: as in read_bag_passes.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise InputError(f"{path}: no such file or folder")
+    files = sorted(path.glob("*.mcap"), key=_split_index) if path.is_dir() else [path]
+    if not files:
+        raise InputError(f"{path}: no .mcap files to salvage")
+    rows, total = [], 0
+    store = typestore()
+    try:
+        for f in files:
+            for m in salvage_mcap(f):
+                total += 1
+                if (m.topic == topic) if topic else (m.typename == TRAIN_PASS):
+                    if m.typename != TRAIN_PASS:
+                        raise InputError(f"{path}: topic {m.topic} is {m.typename}, not {TRAIN_PASS}")
+                    rows.append((m.log_time_ns, pass_row(store.deserialize_cdr(m.data, TRAIN_PASS))))
+    except RailMonitorError:
+        raise
+    except Exception as exc:
+        raise InputError(f"{path}: cannot salvage: {_one_line(exc)}") from None
+    rows.sort(key=lambda r: r[0])
+    table = PassTable.from_rows([r for _, r in rows])
+    table.salvage = SalvageReport(len(files), total, len(rows))  # type: ignore[attr-defined]
+    return table
+
+
+def _split_index(path: Path) -> tuple[int, str]:
+    """rosbag2 names split files <bag>_<k>.mcap: order them by k."""
+    stem = path.stem.rsplit("_", 1)
+    return (int(stem[1]), path.name) if len(stem) == 2 and stem[1].isdigit() else (-1, path.name)

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -13,8 +15,9 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.signals import SignalHandlerOptions
 
 from rail_monitor.errors import ConfigError, RailMonitorError
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
@@ -140,23 +143,41 @@ def use_flow_control_profile() -> None:
 def run_node(make: Callable[[], Node], args: list[str] | None = None) -> int:
     """The Jazzy main() pattern for a single node; returns the process exit code.
 
-    Configuration errors are one line on stderr and exit code 2, not a traceback.
+    SIGINT and SIGTERM stop the spin loop (not rclpy's handler, which would shut the context down
+    at once): a node with a ``drain(executor)`` method then takes what DDS has already delivered
+    (the recorder: nothing published before the signal is lost), and ``close()`` runs.
+    Configuration errors, and errors on closing (a bag that cannot be finished), are one line on
+    stderr and exit code 2, not a traceback.
     """
-    rclpy.init(args=args)
+    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    stop = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: stop.set())
     node = None
+    code = 0
     try:
         node = make()
-        rclpy.spin(node)
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        while not stop.is_set() and rclpy.ok():
+            executor.spin_once(timeout_sec=0.1)
+        drain = getattr(node, "drain", None)
+        if drain is not None and rclpy.ok():
+            drain(executor)
     except RailMonitorError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        return 2
+        code = 2
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
         if node is not None:
             close = getattr(node, "close", None)
-            if close is not None:
-                close()
+            try:
+                if close is not None:
+                    close()
+            except RailMonitorError as exc:
+                print(f"error: {exc}", file=sys.stderr)
+                code = 2
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    return code

@@ -3,18 +3,24 @@
 Records every topic whose type is in rail_msgs, and /diagnostics, or the topics named in
 ``topics``. Messages are taken serialised (no decode). Log time is the message's header stamp
 (pass time; ``log_time:=receive`` uses the node clock at receipt, as rosbag2 does). The bag is
-finalised on SIGINT and SIGTERM; chunks are closed every ``flush_period_s``, so a SIGKILL loses
-at most that much.
+finalised on SIGINT and SIGTERM, after taking what was already delivered (a stop right after a
+burst loses nothing); chunks are closed every ``flush_period_s``, so a SIGKILL loses
+at most that much. A write error (a full disk) stops the recording: /diagnostics goes to ERROR
+with the error and a count of messages not recorded, the file keeps every whole record written
+before it (rail-monitor info --salvage reads them), and the node exits 2 at shutdown.
 """
 
 from __future__ import annotations
 
 import sys
 import threading
+import time
 from datetime import UTC, datetime
 from pathlib import Path
 
+from diagnostic_msgs.msg import DiagnosticStatus
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.executors import Executor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile
 
@@ -66,8 +72,13 @@ class McapRecorder(Node):
         self.meter = RateMeter()
         wall_timer(self, self.cfg["discovery_period_s"], self.discover, callback_group=self._group)
         wall_timer(self, max(self.cfg["flush_period_s"], 0.05), self._flush, callback_group=self._group)
-        Diagnostics(self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
-                                   "topics": len(self._subs), "bag": str(self.writer.folder)})
+        self.dropped = 0  # messages not recorded after a write error
+        self.diagnostics = Diagnostics(
+            self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
+                           "topics": len(self._subs), "bag": str(self.writer.folder),
+                           "not recorded (write failed)": self.dropped, "write error": self.writer.error},
+            level=lambda: (DiagnosticStatus.ERROR, self.writer.error) if self.writer.error
+            else (DiagnosticStatus.OK, "ok"))
         self.discover()
 
     def _want(self, topic: str, types: list[str]) -> bool:
@@ -103,21 +114,47 @@ class McapRecorder(Node):
             if self.writer.closed:
                 return
             stamp = header_stamp_ns(data) if self._stamped[topic] else None
-            self.writer.write(topic, data, stamp if stamp else self.get_clock().now().nanoseconds)
+            try:
+                self.writer.write(topic, data, stamp if stamp else self.get_clock().now().nanoseconds)
+            except RailMonitorError as exc:
+                self._write_failed(exc)
+                return
             self.counts[topic] += 1
         self.meter.tick()
+
+    def _write_failed(self, exc: RailMonitorError) -> None:
+        """A full disk or a write error: the bag stops; what it holds stays readable (salvage)."""
+        self.dropped += 1
+        if self.dropped == 1:
+            self.get_logger().error(str(exc))
+            self.diagnostics.publish()  # at once: an operator must hear of it before the next period
 
     def _flush(self) -> None:
         with self._lock:
             if not self.writer.closed:
-                self.writer.flush()
+                try:
+                    self.writer.flush()
+                except RailMonitorError as exc:
+                    self._write_failed(exc)
+
+    def drain(self, executor: Executor, quiet_s: float = 0.3, timeout_s: float = 10.0) -> None:
+        """After SIGINT or SIGTERM: take what is already queued (a burst just before the signal)
+        until nothing arrives for quiet_s [s], at most timeout_s [s]; then the bag is closed."""
+        deadline = time.monotonic() + timeout_s
+        last, quiet_since = self.meter.count, time.monotonic()
+        while time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.05)
+            if self.meter.count != last:
+                last, quiet_since = self.meter.count, time.monotonic()
+            elif time.monotonic() - quiet_since >= quiet_s:
+                return
 
     def close(self) -> Path:
         """Finalise the bag (metadata.yaml, summary); safe to call twice."""
         with self._lock:
             if self.writer.closed:
                 return self.writer.folder
-            folder = self.writer.close()
+            folder = self.writer.close()  # RailMonitorError after a write error: run_node exits 2
         self.get_logger().info(f"bag {folder}: {self.meter.count} messages")
         return folder
 

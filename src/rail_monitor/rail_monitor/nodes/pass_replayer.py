@@ -19,6 +19,8 @@ REPLAYER_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("source", "", "History to replay: a bag folder, an .mcap or .db3 file, or a .csv export."),
     ParamSpec("source_topic", "", "TrainPass topic in the bag; empty: its only TrainPass topic."),
     ParamSpec("skip_bad_rows", False, "CSV: leave malformed rows out (counted) instead of failing."),
+    ParamSpec("salvage", False, "MCAP: read the passes in every complete chunk of a file cut off mid-write "
+              "(a killed recorder, a full disk) instead of failing."),
 )
 
 
@@ -32,7 +34,10 @@ class PassReplayer(PassSourceNode):
         self._table = self._load()  # read up front: a bad file fails before anything is published
 
     def _load(self) -> PassTable:
-        table = read_passes(self.src["source"], self.src["source_topic"] or None, self.src["skip_bad_rows"])
+        table = read_passes(self.src["source"], self.src["source_topic"] or None, self.src["skip_bad_rows"],
+                            salvage=self.src["salvage"])
+        if self.src["salvage"]:
+            self.get_logger().info(table.salvage.line(self.src["source"]))
         self.skipped = getattr(table, "skipped", 0)
         if self.skipped:
             self.get_logger().warning(f"{self.src['source']}: {self.skipped} malformed row(s) left out")

@@ -8,6 +8,7 @@ state); prints a summary.
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import threading
 import time
@@ -102,8 +103,10 @@ def run_graph(args: list[str] | None = None) -> MonitorResult:
             sent = {source.pub.topic_name: published}
             for m in models:
                 sent.update(m.sent)
-            _wait(lambda: all(recorder.counts.get(t, 0) >= n for t, n in sent.items()), timeout,
-                  lambda: f"recorder got {dict(recorder.counts)} of {sent}")
+            _wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
+                  timeout, lambda: f"recorder got {dict(recorder.counts)} of {sent}")
+            if recorder.writer.error:  # e.g. a full disk: say so now, not after the drain timeout
+                raise RailMonitorError(recorder.writer.error)
             bag = str(recorder.close())
             recorded = dict(recorder.counts)
         rejected = {m.get_name(): sum(m.rejected.values()) for m in models}
@@ -116,7 +119,8 @@ def run_graph(args: list[str] | None = None) -> MonitorResult:
         for n in reversed(nodes):
             close = getattr(n, "close", None)
             if close is not None:
-                close()
+                with contextlib.suppress(RailMonitorError):  # already raised above (a failed bag)
+                    close()
             n.destroy_node()
         rclpy.try_shutdown()
 
