@@ -157,11 +157,6 @@ class _RecorderDiagnostics:
         return {kv.key: kv.value for kv in self.status.values}.get(key, "") if self.status else ""
 
 
-def _salvaged_passes(folder: Path):
-    """The TrainPass messages in the complete chunks of a bag folder, decoded."""
-    return salvage_bag_passes(folder)
-
-
 @pytest.fixture()
 def small_disk(tmp_path: Path):
     disk = tmp_path / "disk"
@@ -199,7 +194,7 @@ def test_a_full_disk_is_an_error_on_diagnostics_and_what_was_written_stays_reada
     assert "Traceback" not in err
     assert len([line for line in err.splitlines() if line.startswith("error:")]) == 1
     assert not (out / "metadata.yaml").exists()
-    got = _salvaged_passes(out)
+    got = salvage_bag_passes(out)
     n = len(sample_passes)
     assert 0 < len(got) <= recorded < n
     assert got.equals(sample_passes.take(slice(0, len(got))))   # a prefix, in order, intact
@@ -226,7 +221,7 @@ def test_sigkill_mid_write_leaves_every_complete_chunk(tmp_path, ros_context, sa
             rep.communicate(timeout=30)
     assert not (out / "metadata.yaml").exists()
     files = sorted(out.glob("*.mcap"))
-    got = _salvaged_passes(out)
+    got = salvage_bag_passes(out)
     assert got.equals(sample_passes.take(slice(0, len(got))))
     # at most the open chunk (4 KiB, some 30 passes) and what came after the last report is lost
     assert len(got) >= reported - 100, (len(got), reported)

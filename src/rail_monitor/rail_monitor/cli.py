@@ -105,19 +105,18 @@ def cmd_info(ns: argparse.Namespace) -> int:
     if ns.salvage:
         table = read_passes(path, ns.topic, salvage=True)
         print(table.salvage.line(path))
-    elif not is_csv(path):
-        info = bag_info(path)
-        span = (info.end_ns - info.start_ns) / NS_PER_S
-        print(f"bag:       {info.path} ({info.storage})")
-        print(f"start:     {format_iso_ns(info.start_ns)}")
-        print(f"duration:  {span:.1f} s ({span / 86400:.2f} days)")
-        print(f"messages:  {info.message_count}")
-        for t in info.topics:
-            print(f"  {t.name:32s} {t.typename:40s} {t.count}")
-        if not any(t.typename == "rail_msgs/msg/TrainPass" for t in info.topics):
-            return 0
-        table = read_passes(path, ns.topic)
     else:
+        if not is_csv(path):
+            info = bag_info(path)
+            span = (info.end_ns - info.start_ns) / NS_PER_S
+            print(f"bag:       {info.path} ({info.storage})")
+            print(f"start:     {format_iso_ns(info.start_ns)}")
+            print(f"duration:  {span:.1f} s ({span / 86400:.2f} days)")
+            print(f"messages:  {info.message_count}")
+            for t in info.topics:
+                print(f"  {t.name:32s} {t.typename:40s} {t.count}")
+            if not any(t.typename == "rail_msgs/msg/TrainPass" for t in info.topics):
+                return 0
         table = read_passes(path, ns.topic)
     if len(table):
         days = max((table.stamp_ns.max() - table.stamp_ns.min()) / 86400e9, 1e-9)

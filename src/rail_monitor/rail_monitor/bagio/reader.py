@@ -208,7 +208,7 @@ def salvage_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
     even files cut off mid-write with no summary or metadata.yaml (a killed recorder, a full disk).
 
     The table's ``salvage`` attribute (SalvageReport) says what was recovered. Passes are in
-    file, then log-time order. topic: as in read_bag_passes.
+    log-time order (stable across split files). topic: as in read_bag_passes.
     """
     path = Path(path)
     if not path.exists():
