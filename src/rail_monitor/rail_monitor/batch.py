@@ -122,26 +122,13 @@ def write_bag(result: BatchResult, folder: str | Path, namespace: str, compressi
 
     from rail_monitor.bagio.mcap_bag import McapBagWriter
     from rail_monitor.nodes import convert
-    from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STREAM_QOS, qos_to_dict
-    from rail_msgs.msg import (
-        CorrugationState,
-        RollingNoise,
-        SpeedAdvisory,
-        SquealPrediction,
-        TrainPass,
-        WaysideAlert,
-        WaysideAlertArray,
-    )
+    from rail_monitor.nodes.qos import qos_to_dict
 
     ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
     frame = result.site.site_id
-    topics = {"train_pass": (TrainPass, STREAM_QOS), "noise/squeal": (SquealPrediction, STREAM_QOS),
-              "corrugation/state": (CorrugationState, LATEST_QOS), "noise/rolling": (RollingNoise, STREAM_QOS),
-              "alerts": (WaysideAlert, ALERT_QOS), "alerts/standing": (WaysideAlertArray, LATEST_QOS),
-              "speed_advisory": (SpeedAdvisory, LATEST_QOS)}
     with McapBagWriter(Path(folder), compression=compression) as bag:
-        for name, (msg_type, qos) in topics.items():
-            bag.add_topic(f"{ns}/{name}", _typename(msg_type), [qos_to_dict(qos)])
+        for name, (msg_type, qos) in convert.GRAPH_TOPICS.items():
+            bag.add_topic(f"{ns}/{name}", convert.typename(msg_type), [qos_to_dict(qos)])
 
         def put(name: str, msg: Any, stamp_ns: int) -> None:
             bag.write(f"{ns}/{name}", serialize_message(msg), stamp_ns)
@@ -173,7 +160,3 @@ def write_bag(result: BatchResult, folder: str | Path, namespace: str, compressi
             put("speed_advisory", convert.speed_advisory_msg(result.advice, stamp, frame), stamp)
     return Path(folder)
 
-
-def _typename(msg_type: type) -> str:
-    module = msg_type.__module__.split(".")
-    return f"{module[0]}/msg/{msg_type.__name__}"

@@ -29,6 +29,10 @@ def _site_file(path: str | None) -> Path:
     return Path(get_package_share_directory("rail_monitor")) / "config" / "curve_250.yaml"
 
 
+def _site_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+
+
 def _add_specs(parser: argparse.ArgumentParser, specs: Sequence[ParamSpec], skip: Sequence[str] = ()) -> None:
     group = parser.add_argument_group("node parameters (ROS 2 parameter in brackets)")
     for s in specs:
@@ -484,7 +488,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("simulate", help="generate a seeded pass history for a site into a bag and/or CSV")
-    s.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    _site_option(s)
     s.add_argument("--out", help="bag folder to create (MCAP)")
     s.add_argument("--csv", help="CSV file to write")
     s.add_argument("--days", type=float, help="override simulator.days [day]")
@@ -516,7 +520,7 @@ def build_parser() -> argparse.ArgumentParser:
     q = models.add_parser("squeal", help="squeal amplitude and level for a crabbing velocity, or a sweep",
                           formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     q.add_argument("--rig", action="store_true", help="the seed's two-disc rig (Figure 5) instead of a site")
-    q.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    _site_option(q)
     q.add_argument("--vehicle-class", help="vehicle class of the site (default: its first)")
     q.add_argument("--friction", default="dry", choices=tuple(FRICTION_BY_NAME))
     q.add_argument("--speed", type=float, help="rolling speed V0 [m/s] (default: the class's mean)")
@@ -537,7 +541,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     c = models.add_parser("corrugation", help="corrugation growth per wavelength band, time to the grinding "
                           "threshold, and speed advice", formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    c.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    _site_option(c)
     g = c.add_mutually_exclusive_group()
     g.add_argument("--history", help="pass history (bag folder, .mcap, .db3 or .csv): state, speeds and traffic "
                    "from it")
@@ -557,7 +561,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = models.add_parser("noise", help="rolling noise pass-by levels and spectra (CNOSSOS-EU and mechanics), "
                           "before and after roughness growth", formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    r.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    _site_option(r)
     r.add_argument("--vehicle-class", help="vehicle class (default: the site's first)")
     r.add_argument("--speed", type=float, nargs="+", help="train speeds [m/s] (default: the class's mean)")
     r.add_argument("--vehicles", type=int, help="vehicles in the train (default: the class's mean consist)")
@@ -578,7 +582,7 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("batch", help="the graph's models over a whole history without DDS (vectorised), "
                        "recorded to a bag like the live graph, with the report")
     s.add_argument("source", help="bag folder, .mcap, .db3 or .csv")
-    s.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    _site_option(s)
     s.add_argument("--topic", help="TrainPass topic of the bag (default: the only one)")
     s.add_argument("--output", help="bag folder to write (default: <source>_batch)")
     s.add_argument("--namespace", help="topic namespace in the bag (default: the site_id)")
@@ -591,7 +595,7 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("report", help="print the summary of a recorded run and write its report folder "
                        "(PNG plots, index.html)")
     s.add_argument("bag", help="bag recorded by the graph or by batch")
-    s.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+    _site_option(s)
     s.add_argument("--out", help="report folder (default: <bag>_report)")
     s.set_defaults(func=cmd_report)
 
@@ -604,7 +608,7 @@ def build_parser() -> argparse.ArgumentParser:
         else:
             s.add_argument("--source", type=Path, default=DEFAULT_SAMPLE, help="history to replay")
             s.add_argument("--output", default="out/demo", help="bag folder to record into")
-        s.add_argument("--site", help="site parameter file (default: the shipped curve_250.yaml)")
+        _site_option(s)
         s.add_argument("--namespace", help="site namespace (default: the site_id)")
         s.add_argument("--report", help="report folder (default: <output>_report)")
         s.add_argument("--no-report", action="store_true", help="record only: no summary or report")
