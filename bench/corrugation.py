@@ -1,6 +1,6 @@
 """Corrugation benchmark: growth tables, per-pass state update, batch throughput, what-if, advice.
 
-Run: ros2_ws/run python bench/corrugation.py [--passes N]
+Run: ros2_ws/run python -m bench.corrugation [--passes N]
 Prints figures measured in this run only (compare ratios, not absolute times, across machines).
 """
 
@@ -11,8 +11,8 @@ import time
 from pathlib import Path
 
 import numpy as np
-from timing import best_of, header, parser
 
+from bench.timing import best_of, header, parser
 from rail_monitor.corrugation_state import CorrugationEstimator, GrowthTables, _rail_receptance, corrugation_config
 from rail_monitor.passes import PassTable, with_class_defaults
 from rail_monitor.site import load_parameter_file, site_from_values
@@ -27,6 +27,25 @@ def passes(site, n: int, seed: int = 1, start: int = 0) -> PassTable:
         vehicle_class=classes[rng.integers(0, len(classes), n)], vehicle_count=rng.integers(3, 7, n),
         axle_count=[0] * n, speed_mps=rng.normal(18.0, 2.0, n).clip(8, 22), angle_of_attack_rad=[0.0] * n,
         wheel_load_n=[0.0] * n, friction_state=rng.integers(1, 5, n), train_length_m=[0.0] * n), site)
+
+
+def costs(site_file: str, n: int = 20_000) -> dict[str, float]:
+    """Per-pass cost [s] of the state update with its forecast (what corrugation_estimator
+    publishes per pass): one pass at a time, and a history of n at once (advance_history)."""
+    values = load_parameter_file(site_file)
+    site, cfg = site_from_values(values), corrugation_config(values)
+    tables = GrowthTables(site, cfg)
+    est = CorrugationEstimator(site, cfg, tables)
+    est.advance(passes(site, 3000, seed=2))
+    rows = passes(site, 500, seed=3, start=3000)
+    t = time.perf_counter()
+    for i in range(len(rows)):
+        est.advance(rows.take(slice(i, i + 1)))
+        est.forecast()
+    single = (time.perf_counter() - t) / len(rows)
+    big = passes(site, n, seed=4)
+    batch = best_of(lambda: CorrugationEstimator(site, cfg, tables).advance_history(big), 2) / n
+    return {"pass_single": single, "pass_batch": batch}
 
 
 def main() -> None:

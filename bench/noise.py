@@ -1,6 +1,6 @@
 """Rolling-noise benchmark: per-site set-up, per-pass prediction cost of each model, batch throughput.
 
-Run: ros2_ws/run python bench/noise.py [--passes N]
+Run: ros2_ws/run python -m bench.noise [--passes N]
 Prints figures measured in this run only (compare ratios, not absolute times, across machines).
 """
 
@@ -8,12 +8,25 @@ from __future__ import annotations
 
 import time
 
-from corrugation import passes
-from timing import best_of, header, parser
-
+from bench.corrugation import passes
+from bench.timing import best_of, header, parser
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.rolling_noise import MODELS, Corrugation, RollingNoiseModel, noise_config
 from rail_monitor.site import load_parameter_file, site_from_values
+
+
+def costs(site_file: str, n: int = 20_000) -> dict[str, dict[str, float]]:
+    """Per-pass cost [s] of each source model with a corrugation state: one pass alone (a node's
+    call on a live pass) and in a batch of n (the node on a backlog, batch mode)."""
+    values = load_parameter_file(site_file)
+    model = RollingNoiseModel(site_from_values(values), noise_config(values))
+    bands = wavelength_bands(0.01, 1.0)
+    post = 0.5 * band_limits(bands)
+    state = Corrugation(bands, 3 * post, post)
+    one, table = passes(model.site, 1), passes(model.site, n)
+    return {name: {"pass_single": best_of(lambda name=name: model.predict(one, name, state), 30),
+                   "pass_batch": best_of(lambda name=name: model.predict(table, name, state), 2) / n}
+            for name in MODELS}
 
 
 def main() -> None:

@@ -1,6 +1,6 @@
 """Squeal benchmark: closed form against time integration, vectorised throughput.
 
-Run: ros2_ws/run python bench/squeal.py [--ode-cases N]
+Run: ros2_ws/run python -m bench.squeal [--ode-cases N]
 Prints figures measured in this run only (compare ratios, not absolute times, across machines).
 """
 
@@ -9,12 +9,40 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from timing import best_of, header, parser
 
+from bench.timing import best_of, header, parser
 from rail_monitor import squeal_risk
 from rail_monitor.models import squeal
 from rail_monitor.passes import PassTable, with_class_defaults
 from rail_monitor.site import load_parameter_file, site_from_values
+
+
+def costs(site_file: str, ode_cases: int = 3) -> dict[str, float]:
+    """Per-case and per-pass costs [s]: closed form, time integration, the site prediction."""
+    case = squeal_risk.rig_case()
+    args = (case.speed_mps, case.load_n, case.damping_nspm, case.k1, case.k2, case.k3_n)
+    one = best_of(lambda: squeal.limit_cycle_amplitude(args[0], 0.39, *args[1:]), 50)
+    t = []
+    for vc in np.linspace(0.2, 0.5, ode_cases):
+        t0 = time.perf_counter()
+        squeal.simulate_limit_cycle(case.speed_mps, float(vc), case.load_n, case.mass_kg, case.damping_nspm,
+                                    case.stiffness_npm, case.k1, case.k2, case.k3_n)
+        t.append(time.perf_counter() - t0)
+    values = load_parameter_file(site_file)
+    site, cfg = site_from_values(values), squeal_risk.squeal_config(values)
+    table = _passes(site, 10**5)
+    batch = best_of(lambda: squeal_risk.predict(cfg, site, table), 3) / len(table)
+    single = best_of(lambda: squeal_risk.predict(cfg, site, table.take(slice(0, 1))), 50)
+    return {"closed_form": one, "ode": float(np.median(t)), "pass_single": single, "pass_batch": batch}
+
+
+def _passes(site, n: int) -> PassTable:
+    rng = np.random.default_rng(2)
+    return with_class_defaults(PassTable(
+        stamp_ns=np.arange(1, n + 1), train_id=["T"] * n, vehicle_class=["emu"] * n, vehicle_count=[4] * n,
+        axle_count=[0] * n, speed_mps=rng.uniform(12, 22, n), angle_of_attack_rad=rng.uniform(0, 0.02, n),
+        wheel_load_n=rng.uniform(55e3, 75e3, n), friction_state=rng.integers(1, 5, n), train_length_m=[0.0] * n),
+        site)
 
 
 def main() -> None:
@@ -48,12 +76,7 @@ def main() -> None:
     values = load_parameter_file(ns.site)
     site, cfg = site_from_values(values), squeal_risk.squeal_config(values)
     n = 10**5
-    rng = np.random.default_rng(2)
-    table = with_class_defaults(PassTable(
-        stamp_ns=np.arange(1, n + 1), train_id=["T"] * n, vehicle_class=["emu"] * n, vehicle_count=[4] * n,
-        axle_count=[0] * n, speed_mps=rng.uniform(12, 22, n), angle_of_attack_rad=rng.uniform(0, 0.02, n),
-        wheel_load_n=rng.uniform(55e3, 75e3, n), friction_state=rng.integers(1, 5, n), train_length_m=[0.0] * n),
-        site)
+    table = _passes(site, n)
     t = best_of(lambda: squeal_risk.predict(cfg, site, table), 3)
     print(f"site prediction (contact, k3, limit cycle, levels, friction-modifier what-if), {n:,} passes: "
           f"{n / t:.3g} passes/s")

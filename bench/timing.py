@@ -31,3 +31,13 @@ def header(name: str) -> None:
     """The first line of a benchmark's output: what ran, where."""
     print(f"# {name} benchmark, {platform.node()}, {platform.processor() or platform.machine()}, "
           f"numpy {np.__version__}")
+
+
+def peak_rss_mb(pid: int | str = "self") -> float:
+    """Peak resident memory of a process [MB] (VmHWM: its own, unlike getrusage's ru_maxrss,
+    which Linux carries over exec from whatever ran before in the process)."""
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024.0
+    raise RuntimeError(f"no VmHWM for process {pid}")

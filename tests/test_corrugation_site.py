@@ -305,3 +305,25 @@ def test_running_forecast_sums_match_a_recount_after_pruning(site_, tables, samp
     running = est.recent_growth().copy()
     est._resum()
     np.testing.assert_allclose(running, est.recent_growth(), rtol=1e-9, atol=1e-18)
+
+
+def test_a_history_at_once_equals_the_states_published_pass_by_pass(site_, tables, sample):
+    # corrugation_estimator takes a backlog at once (advance_history: prefix sums over the kept
+    # passes); one pass at a time it publishes advance() then forecast(). Both must give the same
+    # state and forecast after every pass, across the pruning horizon (history_days) too.
+    warm, part = sample.take(slice(0, 300)), sample.take(slice(300, 1100))
+    at_once, single = _estimator(site_, tables), _estimator(site_, tables)
+    at_once.advance(warm)
+    single.advance(warm)
+    traj = at_once.advance_history(part)
+    assert len(traj) == len(part)
+    for k in range(len(part)):
+        assert single.advance(part.take(slice(k, k + 1)))[0]
+        snap, fc = traj.state(k)
+        one = single.forecast()
+        np.testing.assert_allclose(snap.amplitude, single.amplitude, rtol=1e-12)
+        assert (snap.pass_count, snap.newest_ns, snap.newest_train_id) == (
+            single.pass_count, single.newest_ns, single.newest_train_id)
+        np.testing.assert_allclose(fc.growth_per_axle_pass, one.growth_per_axle_pass, rtol=1e-9, atol=1e-18)
+        assert fc.days_to_threshold == pytest.approx(one.days_to_threshold, rel=1e-9)
+        assert (fc.worst_band, fc.grinding_due) == (one.worst_band, one.grinding_due)

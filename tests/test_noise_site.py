@@ -106,6 +106,23 @@ def test_a_batch_equals_passes_one_by_one(model, name):
             np.testing.assert_allclose(one[key][0], batch[key][i], rtol=1e-12, atol=1e-12)
 
 
+@pytest.mark.parametrize("name", MODELS)
+def test_a_batch_with_a_state_per_pass_equals_passes_one_by_one(model, name):
+    # rolling_noise_predictor predicts a backlog in one call, each pass on its own corrugation
+    # state (amplitudes per pass); alone, a pass is predicted on its state's one row.
+    grown = _grown(model, 12.0)
+    n = 30
+    scale = np.linspace(0.2, 3.0, n)[:, None]
+    states = Corrugation(grown.wavelength_m, grown.amplitude_m[None, :] * scale, grown.post_grinding_m)
+    table = _passes(model.site, "emu", np.linspace(10.0, 28.0, n))
+    batch = model.predict(table, name, states)
+    for i in (0, 11, n - 1):
+        one = model.predict(table.take([i]), name, Corrugation(grown.wavelength_m, states.amplitude_m[i],
+                                                               grown.post_grinding_m))
+        for key in ("lp_db", "roughness_db", "lpaeq_tp_dba", "lpafmax_dba", "roughness_growth_increase_db"):
+            np.testing.assert_allclose(one[key][0], batch[key][i], rtol=1e-12, atol=1e-12)
+
+
 def test_metrics_are_ordered_and_components_add_up(model):
     out = model.predict(_passes(model.site, "freight", [14.0], vehicles=20), "mechanics")
     assert out["lpaeq_tp_dba"][0] < out["lpafmax_dba"][0] < out["tel_dba"][0]

@@ -130,6 +130,7 @@ class AlertManager:
         self._squeal = _Window(cfg["squeal_window_passes"])
         self._rejected = _Window(cfg["rejected_window_passes"])
         self._min_risk = RISK_NAMES.index(cfg["squeal_min_risk"])
+        self._keys: dict[bytes, list[str]] = {}
 
     # -- raise / clear ----------------------------------------------------------------------------
     def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
@@ -167,15 +168,21 @@ class AlertManager:
                  days_to_threshold: float, grinding_due: bool, grinding_due_ns: int) -> list[Alert]:
         """A corrugation state (CorrugationState fields)."""
         events: list[Alert | None] = []
+        wl = np.asarray(wavelength_m, float)
         amp, thr = np.asarray(amplitude_m, float), np.asarray(threshold_m, float)
-        for lam, z, t in zip(np.asarray(wavelength_m, float), amp, thr, strict=True):
-            key = f"{lam:.4f}m"
-            if z >= t:
-                events.append(self._set(True, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_CRITICAL,
+        keys = self._band_keys(wl)
+        standing = np.array([(KIND_GRINDING_DUE, k) in self.standing for k in keys], dtype=bool)
+        over = amp >= thr
+        under = ~over & (amp < self.cfg["grinding_clear_fraction"] * thr)
+        # Only the bands whose alert changes (a raise or clear of a standing one is a no-op).
+        for i in np.flatnonzero((over & ~standing) | (under & standing)).tolist():
+            lam, z, t = float(wl[i]), float(amp[i]), float(thr[i])
+            if over[i]:
+                events.append(self._set(True, KIND_GRINDING_DUE, keys[i], stamp_ns, SEVERITY_CRITICAL,
                                         f"grinding due: {1e3 * lam:.1f} mm band at {1e6 * z:.2f} um r.m.s., "
                                         f"threshold {1e6 * t:.2f} um", z, t, "m"))
-            elif z < self.cfg["grinding_clear_fraction"] * t:
-                events.append(self._set(False, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_INFO,
+            else:
+                events.append(self._set(False, KIND_GRINDING_DUE, keys[i], stamp_ns, SEVERITY_INFO,
                                         f"grinding due: {1e3 * lam:.1f} mm band cleared at {1e6 * z:.2f} um r.m.s.",
                                         z, t, "m"))
         lead = self.cfg["lead_time_days"]
@@ -184,11 +191,22 @@ class AlertManager:
             events.append(self._set(True, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_WARNING,
                                     f"grinding forecast in {days_to_threshold:.1f} days, inside the {lead:g}-day "
                                     "lead time", days_to_threshold, lead, "day", grinding_due_ns))
-        elif due_standing or days_to_threshold > self.cfg["forecast_clear_factor"] * lead:
+        elif (due_standing or days_to_threshold > self.cfg["forecast_clear_factor"] * lead) \
+                and (KIND_GRINDING_FORECAST, "forecast") in self.standing:
             why = "grinding is due" if due_standing else f"forecast {days_to_threshold:.1f} days"
             events.append(self._set(False, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_INFO,
                                     f"grinding forecast cleared: {why}", days_to_threshold, lead, "day"))
         return [e for e in events if e]
+
+    def _band_keys(self, wavelength_m: np.ndarray) -> list[str]:
+        """The alert key of each band (its centre wavelength), formatted once per set of bands."""
+        cache_key = wavelength_m.tobytes()
+        keys = self._keys.get(cache_key)
+        if keys is None:
+            if len(self._keys) >= 16:  # bands change only with the site's configuration
+                self._keys.clear()
+            keys = self._keys[cache_key] = [f"{lam:.4f}m" for lam in wavelength_m.tolist()]
+        return keys
 
     def on_noise(self, stamp_ns: int, model: str, values: Mapping[str, float]) -> list[Alert]:
         """A RollingNoise prediction (values: its single-number fields) of one source model."""

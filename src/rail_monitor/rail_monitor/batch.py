@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.alerts import NOISE_METRICS, Alert, AlertManager, alert_config
-from rail_monitor.corrugation_state import Advice, CorrugationEstimator, Trajectory, corrugation_config
+from rail_monitor.corrugation_state import Advice, CorrugationEstimator, Forecast, Trajectory, corrugation_config
 from rail_monitor.passes import PassTable, rejection_reasons, with_class_defaults
 from rail_monitor.rolling_noise import Corrugation, RollingNoiseModel, noise_config
 from rail_monitor.site import Site, site_from_values
@@ -57,15 +57,15 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     accepted = with_class_defaults(table.take(ok), site)
     est = estimator or CorrugationEstimator(site, corrugation_config(values))
     squeal = predict_squeal(squeal_config(values), site, accepted)
-    traj = est.advance_history(accepted)
+    traj = _history(est, accepted)
     # A pass is predicted on the state that includes it, or for a pass not counted the latest before it.
     state_of_pass = np.searchsorted(traj.index, np.arange(len(accepted)), side="right") - 1
     model = RollingNoiseModel(site, noise_config(values))
     noise: dict[str, dict[str, Any]] = {}
     have = state_of_pass >= 0
     for name in model.models:
-        out = model.predict(accepted.take(~have), name) if (~have).any() else None
-        with_state = model.predict(accepted.take(have), name, Corrugation(
+        out = _predict_noise(model, accepted.take(~have), name) if (~have).any() else None
+        with_state = _predict_noise(model, accepted.take(have), name, Corrugation(
             traj.constants.bands, traj.amplitude[state_of_pass[have]], traj.constants.grinding_amplitude))
         noise[name] = _merge(with_state, out, have)
     alerts = AlertManager(alert_config(values, est.cfg["lead_time_days"]))
@@ -80,13 +80,59 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
                        sorted(alerts.standing.values(), key=_alert_key), advice, est, model.receiver)
 
 
+HISTORY_CHUNK = 50_000  # passes per advance_history call: bounds its (passes x bands x components) arrays
+NOISE_CHUNK = 20_000  # passes per noise prediction: bounds the (passes x time steps) arrays of LpAFmax
+
+
+def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:
+    """est.advance_history in chunks of passes (the estimator carries the kept passes from one to
+    the next, so the states are those of one call), joined."""
+    if len(passes) <= HISTORY_CHUNK:
+        return est.advance_history(passes)
+    parts = [(i, est.advance_history(passes.take(slice(i, i + HISTORY_CHUNK))))
+             for i in range(0, len(passes), HISTORY_CHUNK)]
+    first = parts[0][1]
+
+    def join(get: Any) -> np.ndarray:
+        return np.concatenate([get(t) for _, t in parts])
+
+    f = Forecast(**{k: join(lambda t, k=k: getattr(t.forecast, k)) for k in vars(first.forecast)})
+    return Trajectory(index=np.concatenate([t.index + i for i, t in parts]), stamp_ns=join(lambda t: t.stamp_ns),
+                      train_id=join(lambda t: t.train_id), amplitude=join(lambda t: t.amplitude),
+                      pass_count=join(lambda t: t.pass_count), axle_pass_count=join(lambda t: t.axle_pass_count),
+                      total_pass_count=join(lambda t: t.total_pass_count), forecast=f, constants=first.constants)
+
+
+def _predict_noise(model: RollingNoiseModel, passes: PassTable, name: str,
+                   corrugation: Corrugation | None = None) -> dict[str, Any]:
+    """model.predict in chunks of passes (each pass is independent), joined in order."""
+    if len(passes) <= NOISE_CHUNK:
+        return model.predict(passes, name, corrugation)
+    parts = []
+    for i in range(0, len(passes), NOISE_CHUNK):
+        rows = slice(i, i + NOISE_CHUNK)
+        state = corrugation if corrugation is None or corrugation.amplitude_m.ndim == 1 else Corrugation(
+            corrugation.wavelength_m, corrugation.amplitude_m[rows], corrugation.post_grinding_m)
+        parts.append(model.predict(passes.take(rows), name, state))
+    out = dict(parts[0])
+    for key, value in out.items():
+        if _per_pass(key, value, len(parts[0]["speed_mps"])):
+            out[key] = np.concatenate([p[key] for p in parts])
+    return out
+
+
+def _per_pass(key: str, value: Any, n: int) -> bool:
+    """Whether a prediction's field is an array over passes (not the band centres)."""
+    return isinstance(value, np.ndarray) and value.ndim > 0 and len(value) == n and key != "band_centre_hz"
+
+
 def _merge(with_state: dict[str, Any], without: dict[str, Any] | None, have: np.ndarray) -> dict[str, Any]:
     """Rows predicted with a state and without one, back in pass order."""
     if without is None:
         return with_state
     out = dict(with_state)
     for key, value in with_state.items():
-        if isinstance(value, np.ndarray) and value.ndim and len(value) == have.sum() and key != "band_centre_hz":
+        if _per_pass(key, value, int(have.sum())):
             merged = np.empty((len(have), *value.shape[1:]), value.dtype)
             merged[have], merged[~have] = value, without[key]
             out[key] = merged

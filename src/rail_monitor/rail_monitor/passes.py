@@ -85,6 +85,11 @@ class PassTable:
         rows = list(rows)
         return cls(**{name: [r[name] for r in rows] for name in cls.columns()})
 
+    @classmethod
+    def concat(cls, tables: Sequence[PassTable]) -> PassTable:
+        """The rows of the tables, one after the other."""
+        return cls(**{name: np.concatenate([getattr(t, name) for t in tables]) for name in cls.columns()})
+
     def __len__(self) -> int:
         return len(self.stamp_ns)
 

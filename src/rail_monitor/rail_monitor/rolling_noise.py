@@ -216,14 +216,16 @@ class RollingNoiseModel:
         n, nb = len(passes), len(self.band)
         per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
         roughness = np.empty((n, nb))
-        components: dict[str, np.ndarray] = {}
+        # Every component of the model, even with no passes (an empty history gives empty arrays).
+        terms = next(iter(self.classes.values()))
+        components = {c: np.full((n, nb), -np.inf) for c in (terms.cnossos if model == "cnossos" else terms.mechanics)}
         for name in set(passes.vehicle_class.tolist()):
             rows = passes.vehicle_class == name
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
             lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model)
             roughness[rows] = lr
             for comp, lh in transfers.items():
-                components.setdefault(comp, np.full((n, nb), -np.inf))[rows] = lr + lh + per_metre[rows]
+                components[comp][rows] = lr + lh + per_metre[rows]
         return roughness, components
 
     def _pass_by(self, components: dict[str, np.ndarray], passes: PassTable, time_weighted: bool = True) -> PassBy:

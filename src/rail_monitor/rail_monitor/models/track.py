@@ -159,6 +159,9 @@ def sleeper_transmissibility(frequency: ArrayLike, track: Track) -> ComplexArray
     return kp / (kp + lower)
 
 
+_FREQUENCIES_AT_ONCE = 50  # 50 x 121 x 121 complex: 12 MB per array
+
+
 def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", position: ArrayLike = 0.5,
                         supports: int = 121) -> ComplexArray:
     """Rail point receptance [m/N] on discrete supports, the force at ``position`` of a bay.
@@ -169,7 +172,11 @@ def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshe
     """
     if supports < 3 or supports % 2 == 0:
         raise ValueError("supports must be odd and at least 3")
-    f = np.atleast_1d(np.asarray(frequency, float))
+    f = np.atleast_1d(np.asarray(frequency, float)).ravel()
+    if f.size > _FREQUENCIES_AT_ONCE:  # each frequency is independent: bound the (F, N, N) arrays' memory
+        parts = [discrete_receptance(f[i:i + _FREQUENCIES_AT_ONCE], track, beam, position, supports)
+                 for i in range(0, f.size, _FREQUENCIES_AT_ONCE)]
+        return np.concatenate(parts).reshape(np.shape(frequency) + np.shape(position))
     xf = np.atleast_1d(np.asarray(position, float)) * track.sleeper_spacing_m
     w = 2 * np.pi * f
     half = supports // 2

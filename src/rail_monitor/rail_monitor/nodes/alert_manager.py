@@ -27,7 +27,7 @@ from rail_monitor.alerts import (
     describe,
 )
 from rail_monitor.corrugation_state import CORRUGATION_SPECS
-from rail_monitor.nodes.base import Sent, declare, run_node
+from rail_monitor.nodes.base import Sent, declare, run_node, subscribe_batched
 from rail_monitor.nodes.convert import time_ns, wayside_alert_array_msg, wayside_alert_msg
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
@@ -46,9 +46,11 @@ class AlertManagerNode(PassModelNode):
         self.sent = Sent()
         self.pub = self.create_publisher(WaysideAlert, "alerts", ALERT_QOS)
         self.standing_pub = self.create_publisher(WaysideAlertArray, "alerts/standing", LATEST_QOS)
-        self.create_subscription(SquealPrediction, "noise/squeal", self._on_squeal, STREAM_SUB_QOS)
-        self.create_subscription(RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS)
-        self.create_subscription(CorrugationState, "corrugation/state", self._on_state, STATE_SUB_QOS)
+        # Each stream in its own order (streams do not interact): what is queued is taken at once.
+        for msg_type, topic, handle, qos in ((SquealPrediction, "noise/squeal", self._on_squeal, STREAM_SUB_QOS),
+                                             (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS),
+                                             (CorrugationState, "corrugation/state", self._on_state, STATE_SUB_QOS)):
+            subscribe_batched(self, msg_type, topic, lambda msgs, h=handle: [h(m) for m in msgs], qos, self.max_batch)
         self._publish_standing(0)
 
     def on_pass(self, table: PassTable, msg: TrainPass) -> None:

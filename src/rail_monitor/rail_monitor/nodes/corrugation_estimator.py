@@ -65,16 +65,22 @@ class CorrugationEstimatorNode(PassModelNode):
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
         wall_timer(self, self.params["advisory_period_s"], self.publish_advisory)
 
-    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
-        if not self.est.advance(table)[0]:
-            self.counts["not counted (already counted, or older than the history)"] += 1
+    def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
+        # The state and forecast after each counted pass, as advancing one pass at a time gives them.
+        traj = self.est.advance_history(table)
+        if len(traj) < len(msgs):
+            self.counts["not counted (already counted, or older than the history)"] += len(msgs) - len(traj)
+        if not len(traj):
             return
-        self.counts["counted"] += 1
-        self._since_checkpoint += 1
+        self.counts["counted"] += len(traj)
+        self._since_checkpoint += len(traj)
         if self._since_checkpoint >= self.params["checkpoint_every_passes"]:
             self.save()
         now = time.monotonic()
-        if now - self._last_state_t >= self.params["state_period_s"]:
+        if self.params["state_period_s"] == 0.0:
+            for k in range(len(traj)):
+                self.sent.publish(self.state_pub, corrugation_state_msg(*traj.state(k), self.site.site_id))
+        elif now - self._last_state_t >= self.params["state_period_s"]:
             self.publish_state()
             self._last_state_t = now
 

@@ -22,7 +22,9 @@ from collections import Counter, deque
 from dataclasses import dataclass
 from typing import Any
 
-from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
+import numpy as np
+
+from rail_monitor.nodes.base import Sent, declare, run_node, subscribe_batched, wall_timer
 from rail_monitor.nodes.convert import corrugation_from_msg, rolling_noise_msg, time_ns
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
@@ -41,7 +43,8 @@ STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass que
 
 @dataclass
 class _Pending:
-    table: PassTable
+    table: PassTable  # the passes taken with it (class defaults filled)
+    row: int          # its row
     msg: TrainPass
     stamp_ns: int
     deadline: float   # monotonic [s]; -inf: do not wait
@@ -59,23 +62,24 @@ class RollingNoisePredictor(PassModelNode):
         self.counts: Counter[str] = Counter()
         self.states_rejected: Counter[str] = Counter()
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
-        self.create_subscription(CorrugationState, "corrugation/state", self._on_state, STATE_SUB_QOS)
+        subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch)
         wall_timer(self, 0.05, self._flush)
 
-    def _on_state(self, msg: CorrugationState) -> None:
-        try:
-            corrugation = corrugation_from_msg(msg)
-        except ValueError as exc:
-            self.states_rejected[str(exc)] += 1
-            self.get_logger().warning(f"corrugation state refused: {exc}", throttle_duration_sec=5.0)
-            return
-        self.states.append((time_ns(msg.header.stamp), msg.last_train_id, corrugation))
+    def _on_states(self, msgs: list[CorrugationState]) -> None:
+        for msg in msgs:
+            try:
+                corrugation = corrugation_from_msg(msg)
+            except ValueError as exc:
+                self.states_rejected[str(exc)] += 1
+                self.get_logger().warning(f"corrugation state refused: {exc}", throttle_duration_sec=5.0)
+                continue
+            self.states.append((time_ns(msg.header.stamp), msg.last_train_id, corrugation))
         self._flush()
 
-    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
+    def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         wait = self.wait_s > 0 and self.count_publishers("corrugation/state") > 0
         deadline = time.monotonic() + self.wait_s if wait else float("-inf")
-        self.pending.append(_Pending(table, msg, time_ns(msg.header.stamp), deadline))
+        self.pending.extend(_Pending(table, i, msg, time_ns(msg.header.stamp), deadline) for i, msg in enumerate(msgs))
         self._flush()
 
     def _ready(self, p: _Pending) -> bool:
@@ -98,21 +102,46 @@ class RollingNoisePredictor(PassModelNode):
     def _flush(self) -> None:
         """Predict the pending passes, in order, that have their state (or waited long enough)."""
         now = time.monotonic()
+        ready: list[_Pending] = []
         while self.pending:
             p = self.pending[0]
             if not self._ready(p):
                 if now < p.deadline:
-                    return
+                    break
                 if p.deadline > float("-inf"):
                     self.counts["predicted on the latest state (waited too long)"] += 1
-            self.pending.popleft()
-            self._predict(p)
+            ready.append(self.pending.popleft())
+        if ready:
+            self._predict(ready)
 
-    def _predict(self, p: _Pending) -> None:
-        corrugation = self._state_for(p)
-        for name in self.model.models:
-            values = self.model.predict(p.table, name, corrugation)
-            self.sent.publish(self.pub, rolling_noise_msg(values, 0, p.msg, self.model.receiver))
+    def _predict(self, ready: list[_Pending]) -> None:
+        """Both models over the ready passes in one call per run of passes whose states share their
+        bands (each pass on its own state's amplitudes); published pass by pass, models in order."""
+        states = [self._state_for(p) for p in ready]
+        i = 0
+        while i < len(ready):
+            j = i + 1
+            while j < len(ready) and _same_bands(states[i], states[j]):
+                j += 1
+            self._predict_run(ready[i:j], states[i:j])
+            i = j
+
+    def _predict_run(self, ready: list[_Pending], states: list[Corrugation | None]) -> None:
+        first = states[0]
+        corrugation = None if first is None else Corrugation(
+            first.wavelength_m, np.stack([np.asarray(s.amplitude_m) for s in states]), first.post_grinding_m)
+        try:
+            values = [self.model.predict(_rows(ready), name, corrugation) for name in self.model.models]
+        except Exception as exc:  # a bug: find the pass it fails on, the others go through
+            if len(ready) == 1:
+                self.model_error(ready[0].msg, exc)
+                return
+            for k in range(len(ready)):
+                self._predict_run(ready[k:k + 1], states[k:k + 1])
+            return
+        for k, p in enumerate(ready):
+            for v in values:
+                self.sent.publish(self.pub, rolling_noise_msg(v, k, p.msg, self.model.receiver))
 
     def diagnostic_values(self) -> dict[str, Any]:
         last = self.states[-1][0] if self.states else 0
@@ -122,6 +151,27 @@ class RollingNoisePredictor(PassModelNode):
                   "corrugation_state": format_iso_ns(last) if last else "none"}
         values.update({f"state refused: {why}": n for why, n in sorted(self.states_rejected.items())})
         return values
+
+
+def _same_bands(a: Corrugation | None, b: Corrugation | None) -> bool:
+    """Whether two states can be predicted on together (same bands and post-grinding amplitudes)."""
+    if a is None or b is None:
+        return a is b
+    return a is b or (np.array_equal(a.wavelength_m, b.wavelength_m)
+                      and np.array_equal(a.post_grinding_m, b.post_grinding_m))
+
+
+def _rows(pending: list[_Pending]) -> PassTable:
+    """The pending passes as one table, in order."""
+    parts: list[PassTable] = []
+    i = 0
+    while i < len(pending):
+        j = i + 1
+        while j < len(pending) and pending[j].table is pending[i].table:
+            j += 1
+        parts.append(pending[i].table.take(np.array([p.row for p in pending[i:j]])))
+        i = j
+    return parts[0] if len(parts) == 1 else PassTable.concat(parts)
 
 
 def main(args: list[str] | None = None) -> int:

@@ -26,8 +26,10 @@ class SquealRiskModel(PassModelNode):
         self.sent = Sent()
         self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
 
-    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
-        self.sent.publish(self.pub, squeal_prediction_msg(predict(self.cfg, self.site, table), 0, msg))
+    def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
+        values = predict(self.cfg, self.site, table)
+        for i, msg in enumerate(msgs):
+            self.sent.publish(self.pub, squeal_prediction_msg(values, i, msg))
 
     def diagnostic_values(self) -> dict[str, Any]:
         return {**super().diagnostic_values(), "published": sum(self.sent.values())}

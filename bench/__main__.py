@@ -1,0 +1,169 @@
+"""All benchmarks in one run, printed as one table (and written to out/bench.md).
+
+Run: ros2_ws/run python -m bench [--quick]
+
+Figures are measured side by side in this run only: compare ratios within a run, not absolute
+times across machines. Sections: the graph against its rclpy ceiling (the no-op graph of
+bench.bare_graph); batch mode at 1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
+per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import tempfile
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+
+from bench import batch as bb
+from bench import corrugation as bc
+from bench import graph as bg
+from bench import noise as bn
+from bench import recorder as br
+from bench import squeal as bs
+from rail_monitor.bagio.passes_bag import write_passes_bag
+from rail_monitor.bagio.reader import read_passes
+from rail_monitor.batch import run_models, write_bag
+from rail_monitor.site import load_parameter_file
+
+Row = tuple[str, str, str]  # what, figure, note
+
+
+def machine() -> str:
+    mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
+    return (f"{platform.node()}: {os.cpu_count()} cores ({platform.processor() or platform.machine()}), "
+            f"{mem:.0f} GiB, Python {platform.python_version()}, numpy {np.__version__}, "
+            f"{datetime.now(UTC):%Y-%m-%d}")
+
+
+def rate(passes: float, seconds: float) -> str:
+    return f"{passes / seconds:,.0f} passes/s"
+
+
+def graph_rows(source: str, site: str, keep: Path) -> list[Row]:
+    bare1 = bg.in_process("bare", source, site, max_batch=1)
+    bare = bg.in_process("bare", source, site)
+    real = bg.in_process("real", source, site, output=str(keep))
+    r1, rb, rr = (x["passes"] / x["replay_s"] for x in (bare1, bare, real))
+    n = real["passes"]
+    return [
+        (f"no-op graph, one message per callback (rclpy's default), {n} passes", rate(n, bare1["replay_s"]), ""),
+        (f"no-op graph, queued messages taken at once (as the real graph), {n} passes", rate(n, bare["replay_s"]),
+         "the ceiling"),
+        (f"real graph (wayside_monitor), {n} passes", rate(n, real["replay_s"]),
+         f"set-up {real['setup_s']:.1f} s apart"),
+        ("real / ceiling", f"{rr / rb:.2f}", f"against rclpy's default dispatch: {rr / r1:.2f}"),
+    ]
+
+
+def batch_rows(values: dict, sizes: list[int]) -> list[Row]:
+    rows: list[Row] = [("batch set-up (site tables, once per process)", f"{bb.set_up_s(values):.2f} s", "")]
+    for size in sizes:
+        n, t, _ = bb.timed(values, size)
+        rows.append((f"batch, {n:,} simulated passes", rate(n, t),
+                     f"{t:.1f} s; peak RSS so far {bb.peak_rss_mb():,.0f} MB"))
+    return rows
+
+
+def year_rows(values: dict, site: str, passes: int, tmp: Path) -> tuple[list[Row], list[Row]]:
+    """A busy site's year live and in batch; and the graph's peak memory at a tenth of it and all of it."""
+    rows: list[Row] = []
+    memory: list[Row] = []
+    table = bb.busy_history(values, passes)
+    for frac, name in ((0.1, "tenth"), (1.0, "year")):
+        part = table.take(slice(0, int(len(table) * frac)))
+        bag = tmp / f"busy_{name}"
+        write_passes_bag(part, bag, "")
+        live = bg.in_process("real", str(bag), site)
+        memory.append((f"graph peak RSS, {len(part):,} passes", f"{live['peak_rss_mb']:,.0f} MB",
+                       "wayside_monitor, recorder in the process"))
+        rec = bg.recorder_process(str(bag))
+        memory.append((f"recorder peak RSS, {rec['recorded']:,} passes", f"{rec['peak_rss_mb']:,.0f} MB",
+                       "mcap_recorder process fed by pass_replayer over DDS at "
+                       f"{rate(rec['recorded'], rec['replay_s'])}"))
+        if frac == 1.0:
+            t = time.perf_counter()
+            run_models(part, values)
+            t_batch = time.perf_counter() - t
+            rows += [(f"busy year live ({len(part):,} passes)", f"{live['replay_s'] + live['setup_s']:.0f} s",
+                      f"{rate(len(part), live['replay_s'])} after {live['setup_s']:.1f} s set-up"),
+                     (f"busy year in batch ({len(part):,} passes)", f"{t_batch:.1f} s", rate(len(part), t_batch))]
+    return rows, memory
+
+
+def model_rows(site: str) -> list[Row]:
+    sq = bs.costs(site)
+    co = bc.costs(site)
+    no = bn.costs(site)
+    us = 1e6
+    rows = [("squeal, closed form (one case)", f"{sq['closed_form'] * us:.0f} us", ""),
+            ("squeal, time integration (one case)", f"{sq['ode'] * 1e3:.0f} ms",
+             f"{sq['ode'] / sq['closed_form']:,.0f} x the closed form"),
+            ("squeal prediction per pass (contact, k3, limit cycle, levels)", f"{sq['pass_single'] * us:.0f} us",
+             f"{sq['pass_batch'] * us:.1f} us in a batch"),
+            ("corrugation update + forecast per pass", f"{co['pass_single'] * us:.0f} us",
+             f"{co['pass_batch'] * us:.1f} us in a batch")]
+    rows += [(f"rolling noise, {name}, per pass with a corrugation state", f"{c['pass_single'] * us:.0f} us",
+              f"{c['pass_batch'] * us:.1f} us in a batch") for name, c in no.items()]
+    return rows
+
+
+def recorder_rows(values: dict, source: str, tmp: Path) -> list[Row]:
+    bag = tmp / "batch_bag"
+    write_bag(run_models(read_passes(source), values), bag, "curve_250")
+    c = br.compare(bag)
+    return [(f"recorder write ({c['messages']:,} messages, {c['mb']:.0f} MB CDR, zstd)",
+             f"{c['recorder_per_s']:,.0f} messages/s", f"{c['recorder_per_s'] / c['bare_per_s']:.2f} x bare mcap"),
+            ("bare mcap Writer, same messages", f"{c['bare_per_s']:,.0f} messages/s", "")]
+
+
+def table(sections: list[tuple[str, list[Row]]]) -> str:
+    lines = ["| benchmark | figure | note |", "| --- | ---: | --- |"]
+    for name, rows in sections:
+        lines.append(f"| **{name}** | | |")
+        lines += [f"| {a} | {b} | {c} |" for a, b, c in rows]
+    return "\n".join(lines)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
+    ap.add_argument("--source", default="bags/sample", help="history for the graph and recorder comparisons")
+    ap.add_argument("--quick", action="store_true", help="small sizes (a check that the harness runs)")
+    ap.add_argument("--out", default="out/bench.md")
+    ns = ap.parse_args()
+    values = load_parameter_file(ns.site)
+    sizes = [1000, 3000] if ns.quick else [10_000, 100_000, 1_000_000]
+    year = 2000 if ns.quick else bb.BUSY_YEAR
+    sections: list[tuple[str, list[Row]]] = []
+    with tempfile.TemporaryDirectory() as tmp_name:
+        tmp = Path(tmp_name)
+        source = ns.source
+        if ns.quick:
+            source = str(tmp / "short")
+            write_passes_bag(read_passes(ns.source).take(slice(0, 600)), Path(source), "")
+        live_bag = tmp / "live"
+        sections.append(("graph against its rclpy ceiling", graph_rows(source, ns.site, live_bag)))
+        eq = bb.live_equality(str(live_bag), values)
+        sections.append(("batch", [*batch_rows(values, sizes), (
+            "batch against the live graph (same passes)", f"{eq['corrugation_rel']:.1e}",
+            f"largest relative difference of corrugation; levels {max(eq['noise_db'], eq['squeal_db']):.1e} dB; "
+            f"state count {eq['states']:+.0f}, alert count {eq['alerts']:+.0f}")]))
+        year_r, memory = year_rows(values, ns.site, year, tmp)
+        sections.append(("a busy site's year", year_r))
+        sections.append(("models, per pass", model_rows(ns.site)))
+        sections.append(("recorder", recorder_rows(values, source, tmp)))
+        sections.append(("memory against passes", memory))
+    text = f"Machine: {machine()}\n\n{table(sections)}\n"
+    print(text)
+    Path(ns.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(ns.out).write_text(text)
+
+
+if __name__ == "__main__":
+    main()

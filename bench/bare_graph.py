@@ -1,0 +1,123 @@
+"""The no-op graph: wayside_monitor's topology, message types, sizes and QoS, without the physics.
+
+Each stand-in subscribes and publishes what its real node does (train_pass in; per pass one
+corrugation state, one rolling-noise message per source model, one squeal prediction), but its
+callbacks only publish ready-made messages of a real run's sizes. The recorder is the real
+mcap_recorder (discovery, QoS adaptation, raw subscriptions) whose callback only counts. Passed
+to ``wayside_monitor.run_graph``, so the pass source, executor and flow control are the real ones.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from rclpy.node import Node
+
+from rail_monitor.batch import run_models
+from rail_monitor.nodes import convert
+from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
+from rail_monitor.nodes.mcap_recorder import McapRecorder
+from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.passes import PassTable
+from rail_msgs.msg import (
+    CorrugationState,
+    RollingNoise,
+    SquealPrediction,
+    TrainPass,
+    WaysideAlert,
+    WaysideAlertArray,
+)
+
+
+class _StandIn(Node):
+    """Takes train_pass (as the model nodes do: the queued passes with each, up to max_batch) and
+    publishes ``outputs`` (publisher, message) per pass."""
+
+    def __init__(self, name: str, max_batch: int) -> None:
+        super().__init__(name)
+        self.max_batch = max_batch
+        self.taken = 0
+        self.rejected: Counter[str] = Counter()
+        self.sent = Sent()
+        self.outputs: list[tuple[Any, Any]] = []
+        subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, max_batch)
+        Diagnostics(self, lambda: {"taken": self.taken})
+
+    def _on_train_passes(self, msgs: list[TrainPass]) -> None:
+        for _ in msgs:
+            for pub, out in self.outputs:
+                self.sent.publish(pub, out)
+        self.taken += len(msgs)
+
+
+class _Estimator(_StandIn):
+    def __init__(self, state: CorrugationState, max_batch: int) -> None:
+        super().__init__("corrugation_estimator", max_batch)
+        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", LATEST_QOS)
+        self.outputs = [(self.state_pub, state)]
+
+    def publish_advisory(self) -> None:
+        """The real node's final advice is one linear programme: not part of the ceiling."""
+
+
+class _Models:
+    def __init__(self, names: tuple[str, ...]) -> None:
+        self.models = names
+
+
+class _Noise(_StandIn):
+    def __init__(self, noise: list[RollingNoise], max_batch: int) -> None:
+        super().__init__("rolling_noise_predictor", max_batch)
+        self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
+        self.model = _Models(tuple(m.model for m in noise))
+        self.pending: list[Any] = []
+        self.outputs = [(self.pub, m) for m in noise]
+        subscribe_batched(self, CorrugationState, "corrugation/state", lambda _: None, STATE_SUB_QOS, max_batch)
+
+
+class _Squeal(_StandIn):
+    def __init__(self, squeal: SquealPrediction, max_batch: int) -> None:
+        super().__init__("squeal_risk_model", max_batch)
+        self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
+        self.outputs = [(self.pub, squeal)]
+
+
+class _Alerts(_StandIn):
+    def __init__(self, max_batch: int) -> None:
+        super().__init__("alert_manager", max_batch)
+        self.inputs: Counter[str] = Counter()
+        self.pub = self.create_publisher(WaysideAlert, "alerts", ALERT_QOS)
+        self.standing_pub = self.create_publisher(WaysideAlertArray, "alerts/standing", LATEST_QOS)
+        for msg_type, topic, qos in ((SquealPrediction, "noise/squeal", STREAM_SUB_QOS),
+                                     (RollingNoise, "noise/rolling", STREAM_SUB_QOS),
+                                     (CorrugationState, "corrugation/state", STATE_SUB_QOS)):
+            subscribe_batched(self, msg_type, topic, lambda msgs, t=topic: self.inputs.update({t: len(msgs)}), qos,
+                              max_batch)
+
+
+class _CountingRecorder(McapRecorder):
+    """mcap_recorder with a callback that counts and writes nothing."""
+
+    def _on_message(self, topic: str, data: bytes) -> None:
+        self.counts[topic] += 1
+        self.meter.tick()
+
+
+def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
+               ) -> tuple[Callable[[], list[Node]], Callable[[], Node]]:
+    """make_models and make_recorder for run_graph. The stand-ins publish the outputs the real
+    models give for the first of ``passes`` (so every message has a real run's size); every
+    callback takes up to max_batch queued messages (1: one per callback, rclpy's default)."""
+    r = run_models(passes.take(slice(0, 50)), values)
+    frame = r.site.site_id
+    first = convert.train_pass_msg(r.accepted.row(0), frame)
+    snap, fc = r.trajectory.state(0)
+    state = convert.corrugation_state_msg(snap, fc, frame)
+    noise = [convert.rolling_noise_msg(out, 0, first, r.receiver) for out in r.noise.values()]
+    squeal = convert.squeal_prediction_msg(r.squeal, 0, first)
+    recorder = type("CountingRecorder", (_CountingRecorder,),
+                    {"take_at_once": McapRecorder.take_at_once if max_batch > 1 else 1})
+    return (lambda: [_Estimator(state, max_batch), _Noise(noise, max_batch), _Squeal(squeal, max_batch),
+                     _Alerts(max_batch)]), recorder

@@ -1,0 +1,90 @@
+"""Batch mode: passes per second at 1e4, 1e5 and 1e6 simulated passes, and equality with the live graph.
+
+Histories come from the simulator at a busy site: the site's daily traffic profile scaled to
+about 100,000 train passes a year, over as many days as the size needs. The site's tables
+(rail receptance, growth and noise transfer tables) are built once per process before timing
+and reported as set-up.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+
+from bench.timing import peak_rss_mb
+from rail_monitor.batch import BatchResult, run_models
+from rail_monitor.passes import PassTable
+from rail_monitor.simulator import simulate, simulator_config
+from rail_monitor.site import site_from_values
+
+BUSY_YEAR = 100_000  # train passes a year at a busy site
+
+
+def busy_values(values: Mapping[str, Any], passes: int) -> dict[str, Any]:
+    """The site's parameters with the simulator set for about ``passes`` at BUSY_YEAR a year."""
+    out = dict(values)
+    profile = np.asarray(values["simulator.trains_per_hour"], float)
+    per_day = BUSY_YEAR / 365.0
+    out["simulator.trains_per_hour"] = (profile * per_day / profile.sum()).tolist()
+    out["simulator.days"] = passes / per_day
+    return out
+
+
+def busy_history(values: Mapping[str, Any], passes: int) -> PassTable:
+    v = busy_values(values, passes)
+    return simulate(site_from_values(v), simulator_config(v))
+
+
+def set_up_s(values: Mapping[str, Any]) -> float:
+    """Wall time of a first, tiny batch run: the site's tables, cached for the process [s]."""
+    t = time.perf_counter()
+    run_models(busy_history(values, 20), values)
+    return time.perf_counter() - t
+
+
+def timed(values: Mapping[str, Any], passes: int) -> tuple[int, float, BatchResult]:
+    table = busy_history(values, passes)
+    t = time.perf_counter()
+    r = run_models(table, values)
+    return len(table), time.perf_counter() - t, r
+
+
+def live_equality(bag: str, values: Mapping[str, Any]) -> dict[str, float]:
+    """Largest differences between a live graph's bag and batch mode on the passes it recorded:
+    relative for corrugation amplitudes, absolute in dB for levels; and alert events live - batch."""
+    from rail_monitor.report import load_run
+
+    run = load_run(bag)
+    r = run_models(run.passes, values)
+    out = {"states": float(len(run.states["amplitude_m"]) - len(r.trajectory))}
+    out["corrugation_rel"] = float(np.max(np.abs(run.states["amplitude_m"] / r.trajectory.amplitude - 1.0)))
+    out["noise_db"] = max(float(np.max(np.abs(run.noise[m]["lpaeq_tp_dba"] - r.noise[m]["lpaeq_tp_dba"])))
+                          for m in r.noise)
+    live, offline = run.squeal["level_dba"], r.squeal["level_dba"]  # NaN: no squeal
+    out["squeal_db"] = float(np.max(np.abs(np.nan_to_num(live) - np.nan_to_num(offline)), initial=0.0)
+                             if np.array_equal(np.isnan(live), np.isnan(offline)) else np.inf)
+    out["alerts"] = float(len(run.alerts) - len(r.alerts))
+    return out
+
+
+def main() -> None:
+    import argparse
+
+    from rail_monitor.site import load_parameter_file
+
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
+    ap.add_argument("--sizes", default="1e4,1e5,1e6")
+    ns = ap.parse_args()
+    values = load_parameter_file(ns.site)
+    print(f"set-up (site tables, once per process): {set_up_s(values):.2f} s")
+    for size in (int(float(x)) for x in ns.sizes.split(",")):
+        n, t, _ = timed(values, size)
+        print(f"{n:>9,} passes: {t:8.2f} s = {n / t:9.0f} passes/s (peak RSS so far {peak_rss_mb():.0f} MB)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,59 @@
+"""The benchmark harness stays runnable, and batch mode takes any history, an empty one too."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+import numpy as np
+
+from rail_monitor.batch import run_models
+from rail_monitor.passes import PassTable
+
+from conftest import TOP
+
+
+def test_the_benchmark_harness_runs_and_batch_equals_the_live_graph(tmp_path):
+    out = tmp_path / "bench.md"
+    done = subprocess.run([sys.executable, "-m", "bench", "--quick", "--out", str(out)], cwd=TOP,
+                          capture_output=True, text=True, timeout=600, check=False)
+    assert done.returncode == 0, done.stderr[-3000:]
+    text = out.read_text()
+    for section in ("graph against its rclpy ceiling", "batch", "a busy site's year", "models, per pass",
+                    "recorder", "memory against passes"):
+        assert f"| **{section}** |" in text
+    ratio = re.search(r"\| real / ceiling \| ([0-9.]+) \|", text)
+    assert ratio and 0.0 < float(ratio.group(1)) < 10.0
+    # The live graph's bag against batch mode on the same passes (test_graph checks the full sample).
+    row = re.search(r"\| batch against the live graph \(same passes\) \| ([0-9.e+-]+) \| .*levels ([0-9.e+-]+) dB; "
+                    r"state count \+0, alert count \+0 \|", text)
+    assert row, text
+    assert float(row.group(1)) < 1e-9 and float(row.group(2)) < 1e-9
+
+
+def test_batch_of_an_empty_history_gives_empty_outputs(site_values):
+    r = run_models(PassTable.empty(), site_values)
+    assert len(r.accepted) == len(r.trajectory) == 0 and r.alerts == [] and r.advice is None
+    for out in r.noise.values():
+        assert out["lpaeq_tp_dba"].shape == (0,) and out["lp_db"].shape == (0, len(out["band_centre_hz"]))
+    assert all(np.size(v) == 0 for v in r.squeal.values())
+
+
+def test_batch_in_chunks_equals_one_call(site_values, sample_passes, monkeypatch):
+    # Batch mode bounds its memory by advancing the corrugation state and predicting the noise in
+    # chunks of passes; the state carries over, so the chunks give the one call's numbers.
+    import rail_monitor.batch as batch
+
+    whole = run_models(sample_passes, site_values)
+    monkeypatch.setattr(batch, "HISTORY_CHUNK", 700)
+    monkeypatch.setattr(batch, "NOISE_CHUNK", 900)
+    chunked = run_models(sample_passes, site_values)
+    a, b = whole.trajectory, chunked.trajectory
+    assert np.array_equal(a.index, b.index) and np.array_equal(a.total_pass_count, b.total_pass_count)
+    np.testing.assert_allclose(b.amplitude, a.amplitude, rtol=1e-12)
+    np.testing.assert_allclose(b.forecast.days_to_threshold, a.forecast.days_to_threshold, rtol=1e-9)
+    for name, out in whole.noise.items():
+        np.testing.assert_allclose(chunked.noise[name]["lp_db"], out["lp_db"], rtol=1e-12)
+        np.testing.assert_allclose(chunked.noise[name]["lpafmax_dba"], out["lpafmax_dba"], rtol=1e-12)
+    assert chunked.alerts == whole.alerts
