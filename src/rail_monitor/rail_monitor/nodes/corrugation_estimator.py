@@ -31,7 +31,8 @@ from rail_msgs.srv import EvaluateSpeedDistribution
 
 NODE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("checkpoint_path", "", "File the state is checkpointed to and resumed from ('' : none)."),
-    ParamSpec("checkpoint_every_passes", 100, "Counted passes between checkpoints [-].", 1, 10**9),
+    ParamSpec("checkpoint_every_passes", 100, "Counted passes between checkpoints (checked after each "
+              "callback's passes: a backlog taken at once is checkpointed at its end) [-].", 1, 10**9),
     ParamSpec("state_period_s", 0.0, "Least wall time between corrugation/state messages [s] (0: every pass).",
               0.0, 86_400.0),
     ParamSpec("advisory_period_s", 60.0, "Wall time between speed advisories [s].", 0.01, 86_400.0),
