@@ -19,7 +19,7 @@ from rail_monitor.batch import run_models
 from rail_monitor.nodes import convert
 from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
 from rail_monitor.nodes.mcap_recorder import McapRecorder
-from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
 from rail_monitor.passes import PassTable
 from rail_msgs.msg import (
     CorrugationState,
@@ -55,7 +55,7 @@ class _StandIn(Node):
 class _Estimator(_StandIn):
     def __init__(self, state: CorrugationState, max_batch: int) -> None:
         super().__init__("corrugation_estimator", max_batch)
-        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", LATEST_QOS)
+        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.outputs = [(self.state_pub, state)]
 
     def publish_advisory(self) -> None:

@@ -10,7 +10,7 @@ from rclpy.parameter import Parameter
 
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.nodes.convert import time_msg, train_pass_msg
-from rail_monitor.nodes.qos import LATEST_QOS, STREAM_QOS
+from rail_monitor.nodes.qos import STATE_QOS, STREAM_QOS
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
 from rail_monitor.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.rolling_noise import RollingNoiseModel, noise_config
@@ -42,7 +42,7 @@ class Probe:
         self.node.create_subscription(RollingNoise, "noise/rolling", self.noise.append, STREAM_QOS)
         self.node.create_subscription(DiagnosticArray, "/diagnostics", self.diags.append, 10)
         self.passes = self.node.create_publisher(TrainPass, "train_pass", STREAM_QOS)
-        self.states = self.node.create_publisher(CorrugationState, "corrugation/state", LATEST_QOS)
+        self.states = self.node.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
 
     def diag(self) -> dict[str, str]:
         for d in reversed(self.diags):

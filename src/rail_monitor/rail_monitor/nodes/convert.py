@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from builtin_interfaces.msg import Time
 
-from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STREAM_QOS
+from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_QOS, STREAM_QOS
 from rail_monitor.rolling_noise import Corrugation
 from rail_monitor.timeutil import from_sec_nanosec, to_sec_nanosec
 from rail_msgs.msg import (
@@ -23,7 +23,7 @@ from rail_msgs.msg import (
 # The graph's recorded topics (relative to the site namespace): message type and publisher QoS.
 GRAPH_TOPICS: dict[str, tuple[type, Any]] = {
     "train_pass": (TrainPass, STREAM_QOS), "noise/squeal": (SquealPrediction, STREAM_QOS),
-    "corrugation/state": (CorrugationState, LATEST_QOS), "noise/rolling": (RollingNoise, STREAM_QOS),
+    "corrugation/state": (CorrugationState, STATE_QOS), "noise/rolling": (RollingNoise, STREAM_QOS),
     "alerts": (WaysideAlert, ALERT_QOS), "alerts/standing": (WaysideAlertArray, LATEST_QOS),
     "speed_advisory": (SpeedAdvisory, LATEST_QOS)}
 

@@ -22,7 +22,7 @@ from rail_monitor.corrugation_state import CORRUGATION_SPECS, CorrugationEstimat
 from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
 from rail_monitor.nodes.convert import corrugation_state_msg, speed_advisory_msg, time_ns
 from rail_monitor.nodes.pass_model import PassModelNode
-from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS
+from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS
 from rail_monitor.params import ParamSpec
 from rail_monitor.passes import PassTable
 from rail_monitor.timeutil import format_iso_ns
@@ -60,7 +60,7 @@ class CorrugationEstimatorNode(PassModelNode):
                 self.get_logger().info(f"resumed from {used}: {self.est.total_pass_count} passes")
         self._since_checkpoint = 0
         self._last_state_t = float("-inf")
-        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", LATEST_QOS)
+        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
         self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)

@@ -21,6 +21,13 @@ DIAGNOSTICS_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
 # subscriber (a dashboard started later) gets the current one at once.
 LATEST_QOS = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# The corrugation state: every state matters to the noise predictor, the alert manager and the
+# recorder (each takes them all, in order), and the estimator publishes a backlog's states in one
+# burst. A reliable KEEP_LAST writer overwrites samples not yet delivered once its history is full,
+# so at depth 1 a burst over UDP lost states (5 of 304 at the recorder, one at the noise predictor).
+# Latched too: a late subscriber gets the recent states; one with depth 1 keeps the current one.
+STATE_QOS = QoSProfile(depth=1000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
+                       durability=DurabilityPolicy.TRANSIENT_LOCAL)
 # A subscriber that must see every state in order (not just the latest): latched, deep queue.
 STATE_SUB_QOS = QoSProfile(depth=10000, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE,
                            durability=DurabilityPolicy.TRANSIENT_LOCAL)
