@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -78,3 +80,68 @@ def test_grinding_due_per_band_and_forecast_superseded_then_cleared_by_grinding(
 def test_config_without_hysteresis_or_out_of_range_is_refused(over):
     with pytest.raises(ConfigError):
         _manager(**over)
+
+
+def _streams(rng: np.random.Generator, n: int, bands: int) -> dict:
+    """Random inputs near every threshold of _manager(**SMALL), so that each alert toggles often."""
+    thr = np.full(bands, 10e-6)
+    slow = np.repeat(rng.random(n // 20 + 1), 20)[:n]  # spells of more and fewer hits
+    days = rng.choice([0.0, 10.0, 50.0, 65.0, 80.0, 500.0], n)
+    return {
+        "stamp": np.cumsum(rng.integers(1, 10**9, n)),
+        "rejected": rng.random(n) < 0.3 * slow,
+        "risk": np.where(rng.random(n) < slow, rng.integers(2, 4, n), rng.integers(0, 2, n)),
+        "level": 80.0 + 12.0 * rng.random(n) * (0.5 + slow),
+        "thr": thr,
+        "amp": thr * (0.5 + 0.65 * rng.random((n, bands)) * (0.6 + 0.6 * slow[:, None])),
+        "days": days, "due": (days <= 60.0) | (rng.random(n) < 0.05),
+        "due_ns": rng.choice([0, 7 * DAY, 9 * DAY, 11 * DAY], n),
+    }
+
+
+SMALL = dict(noise_window_passes=5, noise_raise_count=2, noise_clear_count=0, noise_hysteresis_db=3.0,
+             squeal_window_passes=7, squeal_raise_share=0.4, squeal_clear_share=0.15,
+             rejected_window_passes=6, rejected_raise_share=0.3, rejected_clear_share=0.1)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_series_inputs_give_the_events_and_state_of_one_message_at_a_time(seed):
+    """Batch mode's series form of each input against the node's one-message form (the reference):
+    the same events (every field, in order) and the same standing alerts and windows afterwards,
+    with the series cut into random chunks (the windows carry over) after a shared prefix."""
+    rng = np.random.default_rng(seed)
+    n, lam = 600, np.array([0.04, 0.05, 0.063, 0.08])
+    s = _streams(rng, n, len(lam))
+    one, many = _manager(**SMALL), _manager(**SMALL)
+
+    def by_message(m, k):
+        t = int(s["stamp"][k])
+        return (m.on_train_pass(t, bool(s["rejected"][k])) + m.on_squeal(t, int(s["risk"][k]))
+                + m.on_noise(t, "cnossos", {"lpafmax_dba": float(s["level"][k])})
+                + m.on_state(t, lam, s["amp"][k], s["thr"], float(s["days"][k]), bool(s["due"][k]),
+                             int(s["due_ns"][k])))
+
+    prefix = 50
+    for k in range(prefix):
+        by_message(one, k)
+        by_message(many, k)
+    ref = {kind: [] for kind in range(1, 6)}
+    for k in range(prefix, n):
+        for e in by_message(one, k):
+            ref[e.kind].append(e)
+    got = {kind: [] for kind in range(1, 6)}
+    cuts = np.unique(np.concatenate([[prefix, n], rng.integers(prefix, n, 12)]))
+    for a, b in itertools.pairwise(cuts):
+        t = s["stamp"][a:b]
+        for e in (many.on_train_pass_series(t, s["rejected"][a:b]) + many.on_squeal_series(t, s["risk"][a:b])
+                  + many.on_noise_series(t, "cnossos", {"lpafmax_dba": s["level"][a:b]})
+                  + many.on_states(t, lam, s["amp"][a:b], s["thr"], s["days"][a:b], s["due"][a:b],
+                                   s["due_ns"][a:b])):
+            got[e.kind].append(e)
+    for kind in ref:  # streams do not interact: each kind's events in their own order
+        assert got[kind] == ref[kind], kind
+        assert len(ref[kind]) >= 4, kind  # the streams do exercise every alert
+    assert many.standing == one.standing
+    for w1, w2 in ((one._squeal, many._squeal), (one._rejected, many._rejected),
+                   (one._noise["cnossos"], many._noise["cnossos"])):
+        assert (list(w1.flags), w1.over, w1.near) == (list(w2.flags), w2.over, w2.near)

@@ -118,6 +118,40 @@ class _Window:
         self.over += over
         self.near += near
 
+    def push_many(self, over: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """push() each pair in order; returns the over and near counts and the window's length after
+        each push (cumulative sums over the kept flags and the new ones)."""
+        n, m = self.flags.maxlen or 0, len(over)
+        kept = np.array(self.flags, dtype=np.int64).reshape(-1, 2)
+        o = np.concatenate([kept[:, 0], np.asarray(over, bool)]).astype(np.int64)
+        r = np.concatenate([kept[:, 1], np.asarray(near, bool)]).astype(np.int64)
+        end = np.arange(len(kept) + 1, len(o) + 1)
+        start = np.maximum(end - n, 0)
+        co, cr = np.concatenate([[0], np.cumsum(o)]), np.concatenate([[0], np.cumsum(r)])
+        over_counts, near_counts = co[end] - co[start], cr[end] - cr[start]
+        if m:
+            self.flags = deque(zip(o[-n:].astype(bool).tolist(), r[-n:].astype(bool).tolist(), strict=True),
+                               maxlen=n)
+            self.over, self.near = int(over_counts[-1]), int(near_counts[-1])
+        return over_counts, near_counts, end - start
+
+
+def hysteresis_changes(standing: bool, can_raise: np.ndarray, can_clear: np.ndarray) -> list[tuple[int, bool]]:
+    """Where a hysteresis alert changes, in order: (index, active). From ``standing``, it is raised
+    at the first can_raise while down and cleared at the first can_clear (a later index) while up."""
+    ups, downs = np.flatnonzero(can_raise), np.flatnonzero(can_clear)
+    out: list[tuple[int, bool]] = []
+    i = 0
+    while True:
+        idx = downs if standing else ups
+        k = int(np.searchsorted(idx, i))
+        if k == len(idx):
+            return out
+        i = int(idx[k])
+        standing = not standing
+        out.append((i, standing))
+        i += 1
+
 
 class AlertManager:
     """The standing alerts of one site and the raise/clear events that change them."""
@@ -151,19 +185,54 @@ class AlertManager:
         self.events.append(event)
         return event
 
-    def _windowed(self, window: _Window, kind: int, key: str, stamp_ns: int, raise_at: float, clear_at: float,
-                  what: str, threshold_text: str, unit: str, value: float, threshold: float) -> list[Alert]:
+    def _windowed_change(self, active: bool, kind: int, key: str, stamp_ns: int, what: str, threshold_text: str,
+                         unit: str, value: float, threshold: float) -> Alert | None:
+        if active:
+            return self._set(True, kind, key, stamp_ns, SEVERITY_WARNING, f"{what} ({threshold_text})", value,
+                             threshold, unit)
+        return self._set(False, kind, key, stamp_ns, SEVERITY_INFO, f"{what}: cleared", value, threshold, unit)
+
+    def _windowed(self, kind: int, key: str, stamp_ns: int, can_raise: bool, can_clear: bool, what: str,
+                  threshold_text: str, unit: str, value: float, threshold: float) -> list[Alert]:
         standing = (kind, key) in self.standing
-        if not standing and window.over >= raise_at:
-            e = self._set(True, kind, key, stamp_ns, SEVERITY_WARNING, f"{what} ({threshold_text})", value,
-                          threshold, unit)
-        elif standing and window.near <= clear_at:
-            e = self._set(False, kind, key, stamp_ns, SEVERITY_INFO, f"{what}: cleared", value, threshold, unit)
-        else:
+        if not (can_clear if standing else can_raise):
             return []
+        e = self._windowed_change(not standing, kind, key, stamp_ns, what, threshold_text, unit, value, threshold)
         return [e] if e else []
 
+    def _windowed_series(self, kind: int, key: str, stamp_ns: np.ndarray, can_raise: np.ndarray,
+                         can_clear: np.ndarray, what: str, threshold_text: Any, unit: str, value: np.ndarray,
+                         threshold: float) -> list[Alert]:
+        """_windowed over a series: only where the alert changes (threshold_text(i): the text at i)."""
+        out = [self._windowed_change(active, kind, key, int(stamp_ns[i]), what, threshold_text(i), unit,
+                                     float(value[i]), threshold)
+               for i, active in hysteresis_changes((kind, key) in self.standing, can_raise, can_clear)]
+        return [e for e in out if e]
+
     # -- inputs -----------------------------------------------------------------------------------
+    # Each input has a one-message form (the node, message by message) and a series form over many
+    # messages of one stream at once (batch mode), which gives the same events and leaves the same
+    # state (tests/test_alerts.py checks one against the other on random streams).
+
+    def _band_change(self, active: bool, key: str, stamp_ns: int, lam: float, z: float, t: float) -> Alert | None:
+        if active:
+            return self._set(True, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_CRITICAL,
+                             f"grinding due: {1e3 * lam:.1f} mm band at {1e6 * z:.2f} um r.m.s., "
+                             f"threshold {1e6 * t:.2f} um", z, t, "m")
+        return self._set(False, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_INFO,
+                         f"grinding due: {1e3 * lam:.1f} mm band cleared at {1e6 * z:.2f} um r.m.s.", z, t, "m")
+
+    def _forecast_change(self, active: bool, stamp_ns: int, days: float, due_standing: bool,
+                         due_ns: int) -> Alert | None:
+        lead = self.cfg["lead_time_days"]
+        if active:
+            return self._set(True, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_WARNING,
+                             f"grinding forecast in {days:.1f} days, inside the {lead:g}-day lead time",
+                             days, lead, "day", due_ns)
+        why = "grinding is due" if due_standing else f"forecast {days:.1f} days"
+        return self._set(False, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_INFO,
+                         f"grinding forecast cleared: {why}", days, lead, "day")
+
     def on_state(self, stamp_ns: int, wavelength_m: np.ndarray, amplitude_m: np.ndarray, threshold_m: np.ndarray,
                  days_to_threshold: float, grinding_due: bool, grinding_due_ns: int) -> list[Alert]:
         """A corrugation state (CorrugationState fields)."""
@@ -176,26 +245,67 @@ class AlertManager:
         under = ~over & (amp < self.cfg["grinding_clear_fraction"] * thr)
         # Only the bands whose alert changes (a raise or clear of a standing one is a no-op).
         for i in np.flatnonzero((over & ~standing) | (under & standing)).tolist():
-            lam, z, t = float(wl[i]), float(amp[i]), float(thr[i])
-            if over[i]:
-                events.append(self._set(True, KIND_GRINDING_DUE, keys[i], stamp_ns, SEVERITY_CRITICAL,
-                                        f"grinding due: {1e3 * lam:.1f} mm band at {1e6 * z:.2f} um r.m.s., "
-                                        f"threshold {1e6 * t:.2f} um", z, t, "m"))
-            else:
-                events.append(self._set(False, KIND_GRINDING_DUE, keys[i], stamp_ns, SEVERITY_INFO,
-                                        f"grinding due: {1e3 * lam:.1f} mm band cleared at {1e6 * z:.2f} um r.m.s.",
-                                        z, t, "m"))
-        lead = self.cfg["lead_time_days"]
+            events.append(self._band_change(bool(over[i]), keys[i], stamp_ns, float(wl[i]), float(amp[i]),
+                                            float(thr[i])))
         due_standing = any(kind == KIND_GRINDING_DUE for kind, _ in self.standing)
+        forecast_standing = (KIND_GRINDING_FORECAST, "forecast") in self.standing
         if grinding_due and not due_standing:
-            events.append(self._set(True, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_WARNING,
-                                    f"grinding forecast in {days_to_threshold:.1f} days, inside the {lead:g}-day "
-                                    "lead time", days_to_threshold, lead, "day", grinding_due_ns))
-        elif (due_standing or days_to_threshold > self.cfg["forecast_clear_factor"] * lead) \
-                and (KIND_GRINDING_FORECAST, "forecast") in self.standing:
-            why = "grinding is due" if due_standing else f"forecast {days_to_threshold:.1f} days"
-            events.append(self._set(False, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_INFO,
-                                    f"grinding forecast cleared: {why}", days_to_threshold, lead, "day"))
+            events.append(self._forecast_change(True, stamp_ns, days_to_threshold, due_standing, grinding_due_ns))
+        elif (due_standing or days_to_threshold > self.cfg["forecast_clear_factor"] * self.cfg["lead_time_days"]) \
+                and forecast_standing:
+            events.append(self._forecast_change(False, stamp_ns, days_to_threshold, due_standing, 0))
+        return [e for e in events if e]
+
+    def on_states(self, stamp_ns: np.ndarray, wavelength_m: np.ndarray, amplitude_m: np.ndarray,
+                  threshold_m: np.ndarray, days_to_threshold: np.ndarray, grinding_due: np.ndarray,
+                  grinding_due_ns: np.ndarray) -> list[Alert]:
+        """on_state over K states of the same bands, in order: amplitude_m (K, B); stamp_ns,
+        days_to_threshold, grinding_due, grinding_due_ns (K,); wavelength_m, threshold_m (B,)."""
+        stamps = np.asarray(stamp_ns, np.int64)
+        wl, thr = np.asarray(wavelength_m, float), np.asarray(threshold_m, float)
+        amp = np.asarray(amplitude_m, float).reshape(len(stamps), len(wl))
+        days, due = np.asarray(days_to_threshold, float), np.asarray(grinding_due, bool)
+        due_ns = np.asarray(grinding_due_ns, np.int64)
+        keys = self._band_keys(wl)
+        if len(set(keys)) < len(keys):  # two bands share a key: their alerts interact, go state by state
+            return [e for k in range(len(stamps)) for e in self.on_state(
+                int(stamps[k]), wl, amp[k], thr, float(days[k]), bool(due[k]), int(due_ns[k]))]
+        over = amp >= thr
+        under = ~over & (amp < self.cfg["grinding_clear_fraction"] * thr)
+        changes: list[tuple[int, int, bool]] = []  # (state, band; len(keys) for the forecast, active)
+        up = np.empty(amp.shape, bool)  # band's alert standing after each state
+        for b, key in enumerate(keys):
+            was = (KIND_GRINDING_DUE, key) in self.standing
+            band = hysteresis_changes(was, over[:, b], under[:, b])
+            flips = np.zeros(len(stamps), np.int64)
+            flips[[i for i, _ in band]] = 1
+            up[:, b] = was ^ (np.cumsum(flips) % 2 == 1)
+            changes += [(i, b, active) for i, active in band]
+        others = any(kind == KIND_GRINDING_DUE and k not in keys for kind, k in self.standing)
+        due_standing = up.any(axis=1) | others
+        fkey = (KIND_GRINDING_FORECAST, "forecast")
+        can_raise = due & ~due_standing
+        beyond = days > self.cfg["forecast_clear_factor"] * self.cfg["lead_time_days"]
+        can_clear = ~can_raise & (due_standing | beyond)
+        forecast = hysteresis_changes(fkey in self.standing, can_raise, can_clear)
+        changes += [(i, len(keys), active) for i, active in forecast]
+        events: list[Alert | None] = []
+        for i, b, active in sorted(changes):
+            if b < len(keys):
+                events.append(self._band_change(active, keys[b], int(stamps[i]), float(wl[b]), float(amp[i, b]),
+                                                float(thr[b])))
+            else:
+                events.append(self._forecast_change(active, int(stamps[i]), float(days[i]), bool(due_standing[i]),
+                                                    int(due_ns[i]) if active else 0))
+        # A standing forecast follows each newer due time (as on_state's raise of a standing one does).
+        if fkey in self.standing:
+            since = forecast[-1][0] + 1 if forecast else 0
+            old = self.standing[fkey]
+            seq = since + np.flatnonzero(can_raise[since:] & (due_ns[since:] != 0))
+            prev = np.concatenate([[old.due_ns], due_ns[seq[:-1]]])
+            moved = seq[due_ns[seq] != prev]
+            if len(moved):
+                self.standing[fkey] = replace(old, due_ns=int(due_ns[moved[-1]]), value=float(days[moved[-1]]))
         return [e for e in events if e]
 
     def _band_keys(self, wavelength_m: np.ndarray) -> list[str]:
@@ -208,6 +318,9 @@ class AlertManager:
             keys = self._keys[cache_key] = [f"{lam:.4f}m" for lam in wavelength_m.tolist()]
         return keys
 
+    def _noise_what(self, model: str) -> str:
+        return f"{model} {self.cfg['noise_metric'][:-4]} above {self.cfg['noise_limit_dba']:g} dB(A)"
+
     def on_noise(self, stamp_ns: int, model: str, values: Mapping[str, float]) -> list[Alert]:
         """A RollingNoise prediction (values: its single-number fields) of one source model."""
         metric, limit = self.cfg["noise_metric"], self.cfg["noise_limit_dba"]
@@ -215,9 +328,21 @@ class AlertManager:
         w = self._noise.setdefault(model, _Window(self.cfg["noise_window_passes"]))
         w.push(level > limit, level > limit - self.cfg["noise_hysteresis_db"])
         n = self.cfg["noise_window_passes"]
-        return self._windowed(w, KIND_NOISE_LIMIT, model, stamp_ns, self.cfg["noise_raise_count"],
-                              self.cfg["noise_clear_count"], f"{model} {metric[:-4]} above {limit:g} dB(A)",
+        return self._windowed(KIND_NOISE_LIMIT, model, stamp_ns, w.over >= self.cfg["noise_raise_count"],
+                              w.near <= self.cfg["noise_clear_count"], self._noise_what(model),
                               f"{w.over} of the last {n} passes, this one {level:.1f} dB(A)", "dB(A)", level, limit)
+
+    def on_noise_series(self, stamp_ns: np.ndarray, model: str, values: Mapping[str, np.ndarray]) -> list[Alert]:
+        """on_noise over one source model's predictions in order (values: arrays of the fields)."""
+        metric, limit = self.cfg["noise_metric"], self.cfg["noise_limit_dba"]
+        level = np.asarray(values[metric], float)
+        w = self._noise.setdefault(model, _Window(self.cfg["noise_window_passes"]))
+        over, near, _ = w.push_many(level > limit, level > limit - self.cfg["noise_hysteresis_db"])
+        n = self.cfg["noise_window_passes"]
+        return self._windowed_series(KIND_NOISE_LIMIT, model, stamp_ns, over >= self.cfg["noise_raise_count"],
+                                     near <= self.cfg["noise_clear_count"], self._noise_what(model),
+                                     lambda i: f"{over[i]} of the last {n} passes, this one {level[i]:.1f} dB(A)",
+                                     "dB(A)", level, limit)
 
     def _share(self, w: _Window, hit: bool, kind: int, key: str, stamp_ns: int, name: str, what: str,
                full_window: bool) -> list[Alert]:
@@ -227,19 +352,44 @@ class AlertManager:
         n = len(w.flags)
         raise_share, share = self.cfg[f"{name}_raise_share"], w.over / n
         raise_at = w.flags.maxlen * raise_share if n == w.flags.maxlen or not full_window else float("inf")
-        return self._windowed(w, kind, key, stamp_ns, max(raise_at, 1), self.cfg[f"{name}_clear_share"] * n, what,
+        return self._windowed(kind, key, stamp_ns, w.over >= max(raise_at, 1),
+                              w.near <= self.cfg[f"{name}_clear_share"] * n, what,
                               f"{w.over} of the last {n}, {share:.0%}", "-", share, raise_share)
+
+    def _share_series(self, w: _Window, hits: np.ndarray, kind: int, key: str, stamp_ns: np.ndarray, name: str,
+                      what: str, full_window: bool) -> list[Alert]:
+        """_share over a series of hits."""
+        over, near, n = w.push_many(hits, hits)
+        raise_share, share = self.cfg[f"{name}_raise_share"], over / n
+        raise_at = np.where((n == w.flags.maxlen) | (not full_window), w.flags.maxlen * raise_share, np.inf)
+        return self._windowed_series(kind, key, stamp_ns, over >= np.maximum(raise_at, 1),
+                                     near <= self.cfg[f"{name}_clear_share"] * n, what,
+                                     lambda i: f"{over[i]} of the last {n[i]}, {share[i]:.0%}", "-", share,
+                                     raise_share)
+
+    def _squeal_what(self) -> str:
+        return f"squeal risk {self.cfg['squeal_min_risk']} or above"
 
     def on_squeal(self, stamp_ns: int, risk: int) -> list[Alert]:
         """A SquealPrediction's risk (RISK_*). The window must be full: a share over the first few
         passes would raise on the first squeal."""
         return self._share(self._squeal, int(risk) >= self._min_risk, KIND_SQUEAL, "site", stamp_ns, "squeal",
-                           f"squeal risk {self.cfg['squeal_min_risk']} or above", full_window=True)
+                           self._squeal_what(), full_window=True)
+
+    def on_squeal_series(self, stamp_ns: np.ndarray, risk: np.ndarray) -> list[Alert]:
+        """on_squeal over SquealPredictions in order."""
+        return self._share_series(self._squeal, np.asarray(risk) >= self._min_risk, KIND_SQUEAL, "site",
+                                  np.asarray(stamp_ns), "squeal", self._squeal_what(), full_window=True)
 
     def on_train_pass(self, stamp_ns: int, rejected: bool) -> list[Alert]:
         """A TrainPass message, rejected or not."""
         return self._share(self._rejected, rejected, KIND_INPUT_REJECTED, "train_pass", stamp_ns, "rejected",
                            "train passes rejected", full_window=False)
+
+    def on_train_pass_series(self, stamp_ns: np.ndarray, rejected: np.ndarray) -> list[Alert]:
+        """on_train_pass over TrainPass messages in order."""
+        return self._share_series(self._rejected, np.asarray(rejected, bool), KIND_INPUT_REJECTED, "train_pass",
+                                  np.asarray(stamp_ns), "rejected", "train passes rejected", full_window=False)
 
 
 def describe(alert: Alert) -> str:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.alerts import NOISE_METRICS, Alert, AlertManager, alert_config
+from rail_monitor.alerts import Alert, AlertManager, alert_config
 from rail_monitor.corrugation_state import Advice, CorrugationEstimator, Forecast, Trajectory, corrugation_config
 from rail_monitor.passes import PassTable, rejection_reasons, with_class_defaults
 from rail_monitor.rolling_noise import Corrugation, RollingNoiseModel, noise_config
@@ -145,19 +145,14 @@ def _alert_key(a: Alert) -> tuple[int, int, str, bool]:
 
 def _feed_alerts(alerts: AlertManager, table: PassTable, reasons: np.ndarray, accepted: PassTable,
                  squeal: dict[str, np.ndarray], traj: Trajectory, noise: dict[str, dict[str, Any]]) -> list[Alert]:
-    """The alert manager over each stream in its own order (streams do not interact)."""
-    for stamp, why in zip(table.stamp_ns.tolist(), reasons.tolist(), strict=True):
-        alerts.on_train_pass(stamp, bool(why))
-    for stamp, risk in zip(accepted.stamp_ns.tolist(), squeal["risk"].tolist(), strict=True):
-        alerts.on_squeal(stamp, risk)
+    """The alert manager over each stream in its own order (streams do not interact), a stream at once."""
+    alerts.on_train_pass_series(table.stamp_ns, reasons != "")
+    alerts.on_squeal_series(accepted.stamp_ns, squeal["risk"])
     for name, out in noise.items():
-        cols = {k: np.asarray(out[k]).tolist() for k in NOISE_METRICS}
-        for i, stamp in enumerate(accepted.stamp_ns.tolist()):
-            alerts.on_noise(stamp, name, {k: cols[k][i] for k in NOISE_METRICS})
+        alerts.on_noise_series(accepted.stamp_ns, name, out)
     c, f = traj.constants, traj.forecast
-    for k in range(len(traj)):
-        alerts.on_state(int(traj.stamp_ns[k]), c.bands, traj.amplitude[k], c.threshold,
-                        float(f.days_to_threshold[k]), bool(f.grinding_due[k]), int(f.grinding_due_ns[k]))
+    alerts.on_states(traj.stamp_ns, c.bands, traj.amplitude, c.threshold, f.days_to_threshold, f.grinding_due,
+                     f.grinding_due_ns)
     return sorted(alerts.events, key=_alert_key)
 
 

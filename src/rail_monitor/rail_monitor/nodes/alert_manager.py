@@ -14,6 +14,7 @@ import sys
 from collections import Counter
 from typing import Any
 
+import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus
 
 from rail_monitor.alerts import (
@@ -46,11 +47,12 @@ class AlertManagerNode(PassModelNode):
         self.sent = Sent()
         self.pub = self.create_publisher(WaysideAlert, "alerts", ALERT_QOS)
         self.standing_pub = self.create_publisher(WaysideAlertArray, "alerts/standing", LATEST_QOS)
-        # Each stream in its own order (streams do not interact): what is queued is taken at once.
+        # Each stream in its own order (streams do not interact): what is queued is taken at once and
+        # fed as one series; alerts/standing (latched, latest only) is published once per series.
         for msg_type, topic, handle, qos in ((SquealPrediction, "noise/squeal", self._on_squeal, STREAM_SUB_QOS),
                                              (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS),
-                                             (CorrugationState, "corrugation/state", self._on_state, STATE_SUB_QOS)):
-            subscribe_batched(self, msg_type, topic, lambda msgs, h=handle: [h(m) for m in msgs], qos, self.max_batch)
+                                             (CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS)):
+            subscribe_batched(self, msg_type, topic, handle, qos, self.max_batch)
         self._publish_standing(0)
 
     def on_pass(self, table: PassTable, msg: TrainPass) -> None:
@@ -59,23 +61,35 @@ class AlertManagerNode(PassModelNode):
     def on_rejected(self, msg: TrainPass, reason: str) -> None:
         self._emit(self.alerts.on_train_pass(time_ns(msg.header.stamp), True))
 
-    def _on_squeal(self, msg: SquealPrediction) -> None:
-        self.inputs["noise/squeal"] += 1
-        self._emit(self.alerts.on_squeal(time_ns(msg.header.stamp), msg.risk))
+    def _on_squeal(self, msgs: list[SquealPrediction]) -> None:
+        self.inputs["noise/squeal"] += len(msgs)
+        self._emit(self.alerts.on_squeal_series(_stamps(msgs), np.array([m.risk for m in msgs])))
 
-    def _on_noise(self, msg: RollingNoise) -> None:
-        self.inputs["noise/rolling"] += 1
-        self._emit(self.alerts.on_noise(time_ns(msg.header.stamp), msg.model,
-                                        {k: getattr(msg, k) for k in NOISE_METRICS}))
+    def _on_noise(self, msgs: list[RollingNoise]) -> None:
+        self.inputs["noise/rolling"] += len(msgs)
+        events: list[Alert] = []
+        for model in dict.fromkeys(m.model for m in msgs):  # each source model's stream in its order
+            mine = [m for m in msgs if m.model == model]
+            events += self.alerts.on_noise_series(_stamps(mine), model, {
+                k: np.array([getattr(m, k) for m in mine]) for k in NOISE_METRICS})
+        self._emit(sorted(events, key=lambda e: e.stamp_ns))
 
-    def _on_state(self, msg: CorrugationState) -> None:
-        self.inputs["corrugation/state"] += 1
-        if not (len(msg.wavelength_m) == len(msg.amplitude_m) == len(msg.threshold_m)):
-            self.inputs["corrugation/state refused: arrays differ in length"] += 1
-            return
-        self._emit(self.alerts.on_state(time_ns(msg.header.stamp), msg.wavelength_m, msg.amplitude_m,
-                                        msg.threshold_m, msg.days_to_threshold, msg.grinding_due,
-                                        time_ns(msg.grinding_due_time)))
+    def _on_states(self, msgs: list[CorrugationState]) -> None:
+        self.inputs["corrugation/state"] += len(msgs)
+        ok = [m for m in msgs if len(m.wavelength_m) == len(m.amplitude_m) == len(m.threshold_m)]
+        if len(ok) < len(msgs):
+            self.inputs["corrugation/state refused: arrays differ in length"] += len(msgs) - len(ok)
+        i = 0
+        while i < len(ok):  # runs of states on the same bands and thresholds, as one series
+            j = i + 1
+            while j < len(ok) and ok[j].wavelength_m == ok[i].wavelength_m and ok[j].threshold_m == ok[i].threshold_m:
+                j += 1
+            run = ok[i:j]
+            self._emit(self.alerts.on_states(
+                _stamps(run), np.asarray(run[0].wavelength_m), np.array([m.amplitude_m for m in run]),
+                np.asarray(run[0].threshold_m), np.array([m.days_to_threshold for m in run]),
+                np.array([m.grinding_due for m in run]), np.array([time_ns(m.grinding_due_time) for m in run])))
+            i = j
 
     def _emit(self, events: list[Alert]) -> None:
         for e in events:
@@ -102,6 +116,11 @@ class AlertManagerNode(PassModelNode):
         if self.alerts.standing:
             return DiagnosticStatus.WARN, f"{len(self.alerts.standing)} alert(s) standing"
         return super()._level()
+
+
+def _stamps(msgs: list[Any]) -> np.ndarray:
+    """The header stamps of messages [ns]."""
+    return np.array([time_ns(m.header.stamp) for m in msgs], np.int64)
 
 
 def main(args: list[str] | None = None) -> int:
