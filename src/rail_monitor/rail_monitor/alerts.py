@@ -210,9 +210,10 @@ class AlertManager:
         return [e for e in out if e]
 
     # -- inputs -----------------------------------------------------------------------------------
-    # Each input has a one-message form (the node, message by message) and a series form over many
-    # messages of one stream at once (batch mode), which gives the same events and leaves the same
-    # state (tests/test_alerts.py checks one against the other on random streams).
+    # Each input has a one-message form (the reference; the node's train_pass path) and a series
+    # form over many messages of one stream at once (batch mode, the node's taken backlogs), which
+    # gives the same events and leaves the same state (tests/test_alerts.py checks one against
+    # the other on random streams).
 
     def _band_change(self, active: bool, key: str, stamp_ns: int, lam: float, z: float, t: float) -> Alert | None:
         if active:

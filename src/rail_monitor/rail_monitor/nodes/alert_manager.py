@@ -28,8 +28,14 @@ from rail_monitor.alerts import (
     describe,
 )
 from rail_monitor.corrugation_state import CORRUGATION_SPECS
-from rail_monitor.nodes.base import Sent, declare, run_node, subscribe_batched
-from rail_monitor.nodes.convert import time_ns, wayside_alert_array_msg, wayside_alert_msg
+from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched
+from rail_monitor.nodes.convert import (
+    corrugation_series,
+    stamps_ns,
+    time_ns,
+    wayside_alert_array_msg,
+    wayside_alert_msg,
+)
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
 from rail_monitor.passes import PassTable
@@ -63,14 +69,14 @@ class AlertManagerNode(PassModelNode):
 
     def _on_squeal(self, msgs: list[SquealPrediction]) -> None:
         self.inputs["noise/squeal"] += len(msgs)
-        self._emit(self.alerts.on_squeal_series(_stamps(msgs), np.array([m.risk for m in msgs])))
+        self._emit(self.alerts.on_squeal_series(stamps_ns(msgs), np.array([m.risk for m in msgs])))
 
     def _on_noise(self, msgs: list[RollingNoise]) -> None:
         self.inputs["noise/rolling"] += len(msgs)
         events: list[Alert] = []
         for model in dict.fromkeys(m.model for m in msgs):  # each source model's stream in its order
             mine = [m for m in msgs if m.model == model]
-            events += self.alerts.on_noise_series(_stamps(mine), model, {
+            events += self.alerts.on_noise_series(stamps_ns(mine), model, {
                 k: np.array([getattr(m, k) for m in mine]) for k in NOISE_METRICS})
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
 
@@ -79,17 +85,8 @@ class AlertManagerNode(PassModelNode):
         ok = [m for m in msgs if len(m.wavelength_m) == len(m.amplitude_m) == len(m.threshold_m)]
         if len(ok) < len(msgs):
             self.inputs["corrugation/state refused: arrays differ in length"] += len(msgs) - len(ok)
-        i = 0
-        while i < len(ok):  # runs of states on the same bands and thresholds, as one series
-            j = i + 1
-            while j < len(ok) and ok[j].wavelength_m == ok[i].wavelength_m and ok[j].threshold_m == ok[i].threshold_m:
-                j += 1
-            run = ok[i:j]
-            self._emit(self.alerts.on_states(
-                _stamps(run), np.asarray(run[0].wavelength_m), np.array([m.amplitude_m for m in run]),
-                np.asarray(run[0].threshold_m), np.array([m.days_to_threshold for m in run]),
-                np.array([m.grinding_due for m in run]), np.array([time_ns(m.grinding_due_time) for m in run])))
-            i = j
+        for run in runs(ok, _same_bands):  # states on the same bands and thresholds, as one series
+            self._emit(self.alerts.on_states(**corrugation_series(ok[run])))
 
     def _emit(self, events: list[Alert]) -> None:
         for e in events:
@@ -118,9 +115,8 @@ class AlertManagerNode(PassModelNode):
         return super()._level()
 
 
-def _stamps(msgs: list[Any]) -> np.ndarray:
-    """The header stamps of messages [ns]."""
-    return np.array([time_ns(m.header.stamp) for m in msgs], np.int64)
+def _same_bands(a: CorrugationState, b: CorrugationState) -> bool:
+    return a.wavelength_m == b.wavelength_m and a.threshold_m == b.threshold_m
 
 
 def main(args: list[str] | None = None) -> int:

@@ -7,7 +7,7 @@ import sys
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 import rclpy
@@ -101,6 +101,17 @@ def subscribe_batched(node: Node, msg_type: Any, topic: str, handle: Callable[[l
 
     subs.append(node.create_subscription(msg_type, topic, callback, qos, **kwargs))
     return subs[0]
+
+
+def runs(items: Sequence[Any], same: Callable[[Any, Any], bool]) -> Iterator[slice]:
+    """The slices of consecutive items that are ``same`` as the first of their run, in order."""
+    i = 0
+    while i < len(items):
+        j = i + 1
+        while j < len(items) and same(items[i], items[j]):
+            j += 1
+        yield slice(i, j)
+        i = j
 
 
 def wall_timer(node: Node, period_s: float, callback: Callable[[], None], **kwargs: Any):

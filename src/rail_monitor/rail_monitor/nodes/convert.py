@@ -160,6 +160,21 @@ def corrugation_from_msg(msg: CorrugationState) -> Corrugation:
     return Corrugation(wl, amp, post)
 
 
+def stamps_ns(msgs: list[Any]) -> np.ndarray:
+    """The header stamps of messages [ns]."""
+    return np.array([time_ns(m.header.stamp) for m in msgs], np.int64)
+
+
+def corrugation_series(msgs: list[CorrugationState]) -> dict[str, np.ndarray]:
+    """States on the same bands as AlertManager.on_states' arguments: stamps [ns], bands [m] and
+    thresholds [m] of the first, amplitudes [m] (states x bands), forecast fields per state."""
+    return {"stamp_ns": stamps_ns(msgs), "wavelength_m": np.asarray(msgs[0].wavelength_m),
+            "amplitude_m": np.array([m.amplitude_m for m in msgs]), "threshold_m": np.asarray(msgs[0].threshold_m),
+            "days_to_threshold": np.array([m.days_to_threshold for m in msgs]),
+            "grinding_due": np.array([m.grinding_due for m in msgs]),
+            "grinding_due_ns": np.array([time_ns(m.grinding_due_time) for m in msgs], np.int64)}
+
+
 def wayside_alert_msg(alert: Any, frame_id: str) -> WaysideAlert:
     """A rail_monitor.alerts.Alert as a WaysideAlert."""
     msg = WaysideAlert(kind=alert.kind, key=alert.key, severity=alert.severity, active=alert.active,

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.nodes.base import Sent, declare, run_node, subscribe_batched, wall_timer
+from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.convert import corrugation_from_msg, rolling_noise_msg, time_ns
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
@@ -118,13 +118,8 @@ class RollingNoisePredictor(PassModelNode):
         """Both models over the ready passes in one call per run of passes whose states share their
         bands (each pass on its own state's amplitudes); published pass by pass, models in order."""
         states = [self._state_for(p) for p in ready]
-        i = 0
-        while i < len(ready):
-            j = i + 1
-            while j < len(ready) and _same_bands(states[i], states[j]):
-                j += 1
-            self._predict_run(ready[i:j], states[i:j])
-            i = j
+        for run in runs(states, _same_bands):
+            self._predict_run(ready[run], states[run])
 
     def _predict_run(self, ready: list[_Pending], states: list[Corrugation | None]) -> None:
         first = states[0]
@@ -163,14 +158,8 @@ def _same_bands(a: Corrugation | None, b: Corrugation | None) -> bool:
 
 def _rows(pending: list[_Pending]) -> PassTable:
     """The pending passes as one table, in order."""
-    parts: list[PassTable] = []
-    i = 0
-    while i < len(pending):
-        j = i + 1
-        while j < len(pending) and pending[j].table is pending[i].table:
-            j += 1
-        parts.append(pending[i].table.take(np.array([p.row for p in pending[i:j]])))
-        i = j
+    parts = [pending[run.start].table.take(np.array([p.row for p in pending[run]]))
+             for run in runs(pending, lambda a, b: a.table is b.table)]
     return parts[0] if len(parts) == 1 else PassTable.concat(parts)
 
 
