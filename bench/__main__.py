@@ -26,10 +26,10 @@ from bench import graph as bg
 from bench import noise as bn
 from bench import recorder as br
 from bench import squeal as bs
+from rail_monitor.app.batch import run_models, write_bag
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_passes
-from rail_monitor.batch import run_models, write_bag
-from rail_monitor.site import load_parameter_file
+from rail_monitor.site_file import load_parameter_file
 
 Row = tuple[str, str, str]  # what, figure, note
 

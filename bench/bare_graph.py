@@ -15,12 +15,13 @@ from typing import Any
 
 from rclpy.node import Node
 
-from rail_monitor.batch import run_models
-from rail_monitor.nodes import convert
+from rail_monitor.app.batch import run_models
+from rail_monitor.bagio import messages as fields
+from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
+from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
-from rail_monitor.passes import PassTable
 from rail_msgs.msg import (
     CorrugationState,
     RollingNoise,
@@ -112,11 +113,12 @@ def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
     callback takes up to max_batch queued messages (1: one per callback, rclpy's default)."""
     r = run_models(passes.take(slice(0, 50)), values)
     frame = r.site.site_id
-    first = convert.train_pass_msg(r.accepted.row(0), frame)
+    first = fields.train_pass_fields(r.accepted.row(0), frame)
     snap, fc = r.trajectory.state(0)
-    state = convert.corrugation_state_msg(snap, fc, frame)
-    noise = [convert.rolling_noise_msg(out, 0, first, r.receiver) for out in r.noise.values()]
-    squeal = convert.squeal_prediction_msg(r.squeal, 0, first)
+    state = to_msg(CorrugationState, fields.corrugation_state_fields(snap, fc, frame))
+    noise = [to_msg(RollingNoise, fields.rolling_noise_fields(out, 0, first["header"], first["train_id"], r.receiver))
+             for out in r.noise.values()]
+    squeal = to_msg(SquealPrediction, fields.squeal_prediction_fields(r.squeal, 0, first["header"], first["train_id"]))
     recorder = type("CountingRecorder", (_CountingRecorder,),
                     {"take_at_once": McapRecorder.take_at_once if max_batch > 1 else 1})
     return (lambda: [_Estimator(state, max_batch), _Noise(noise, max_batch), _Squeal(squeal, max_batch),

@@ -15,10 +15,10 @@ from typing import Any
 import numpy as np
 
 from bench.timing import peak_rss_mb
-from rail_monitor.batch import BatchResult, run_models
-from rail_monitor.passes import PassTable
-from rail_monitor.simulator import simulate, simulator_config
-from rail_monitor.site import site_from_values
+from rail_monitor.app.batch import BatchResult, run_models
+from rail_monitor.app.simulator import simulate, simulator_config
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.site import site_from_values
 
 BUSY_YEAR = 100_000  # train passes a year at a busy site
 
@@ -55,13 +55,13 @@ def timed(values: Mapping[str, Any], passes: int) -> tuple[int, float, BatchResu
 def live_equality(bag: str, values: Mapping[str, Any]) -> dict[str, float]:
     """Largest differences between a live graph's bag and batch mode on the passes it recorded:
     relative for corrugation amplitudes, absolute in dB for levels; and alert events live - batch."""
-    from rail_monitor.report import load_run
+    from rail_monitor.app.report import load_run
 
     run = load_run(bag)
     r = run_models(run.passes, values)
     out = {"states": float(len(run.states["amplitude_m"]) - len(r.trajectory))}
     out["corrugation_rel"] = float(np.max(np.abs(run.states["amplitude_m"] / r.trajectory.amplitude - 1.0)))
-    out["noise_db"] = max(float(np.max(np.abs(run.noise[m]["lpaeq_tp_dba"] - r.noise[m]["lpaeq_tp_dba"])))
+    out["noise_db"] = max(float(np.max(np.abs(run.noise[m]["lpaeq_tp_dba"] - r.noise[m].lpaeq_tp_dba)))
                           for m in r.noise)
     live, offline = run.squeal["level_dba"], r.squeal["level_dba"]  # NaN: no squeal
     out["squeal_db"] = float(np.max(np.abs(np.nan_to_num(live) - np.nan_to_num(offline)), initial=0.0)
@@ -73,7 +73,7 @@ def live_equality(bag: str, values: Mapping[str, Any]) -> dict[str, float]:
 def main() -> None:
     import argparse
 
-    from rail_monitor.site import load_parameter_file
+    from rail_monitor.site_file import load_parameter_file
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")

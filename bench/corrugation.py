@@ -13,9 +13,13 @@ from pathlib import Path
 import numpy as np
 
 from bench.timing import best_of, header, parser
-from rail_monitor.corrugation_state import CorrugationEstimator, GrowthTables, _rail_receptance, corrugation_config
-from rail_monitor.passes import PassTable, with_class_defaults
-from rail_monitor.site import load_parameter_file, site_from_values
+from rail_monitor.core.passes import PassTable, with_class_defaults
+from rail_monitor.core.site import site_from_values
+from rail_monitor.corrugation import advice, checkpoint
+from rail_monitor.corrugation.config import corrugation_config
+from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.growth import GrowthTables, _rail_receptance
+from rail_monitor.site_file import load_parameter_file
 
 
 def passes(site, n: int, seed: int = 1, start: int = 0) -> PassTable:
@@ -77,7 +81,7 @@ def main() -> None:
     per_pass = (time.perf_counter() - t) / len(rows)
     t_fc = best_of(est.forecast, 20)
     print(f"state update, one pass (the node's call):   {per_pass * 1e6:10.0f} us")
-    print(f"forecast ({len(est.recent.stamp_ns)} kept passes):           {t_fc * 1e6:10.0f} us")
+    print(f"forecast ({len(est.kept)} kept passes):           {t_fc * 1e6:10.0f} us")
 
     big = passes(site, ns.passes, seed=4)
 
@@ -90,13 +94,13 @@ def main() -> None:
 
     v = np.linspace(10, 22, 25)
     p = np.exp(-0.5 * ((v - 17) / 2) ** 2)
-    t_ev = best_of(lambda: est.evaluate(v, p), 20)
-    t_adv = best_of(est.advise, 5)
+    t_ev = best_of(lambda: advice.evaluate(est, v, p), 20)
+    t_adv = best_of(lambda: advice.advise(est), 5)
     print(f"what-if evaluation, 25 speed bins:          {t_ev * 1e3:10.2f} ms")
     print(f"speed advice (linear programme):            {t_adv * 1e3:10.2f} ms")
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "state.npz"
-        t_s = best_of(lambda: est.save(path), 5)
+        t_s = best_of(lambda: checkpoint.save(est, path), 5)
         t_l = best_of(lambda: CorrugationEstimator(site, cfg, tables).load(path), 5)
         print(f"checkpoint write (fsync) / read:            {t_s * 1e3:10.2f} / {t_l * 1e3:.2f} ms "
               f"({path.stat().st_size / 1e3:.0f} kB)")

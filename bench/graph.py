@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from bench.timing import peak_rss_mb
-from rail_monitor.site import load_parameter_file
+from rail_monitor.site_file import load_parameter_file
 
 
 def run_one(kind: str, source: str, site: str, output: str, executor: str = "single_threaded",

@@ -10,9 +10,11 @@ import time
 
 from bench.corrugation import passes
 from bench.timing import best_of, header, parser
+from rail_monitor.core.site import site_from_values
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
-from rail_monitor.rolling_noise import MODELS, Corrugation, RollingNoiseModel, noise_config
-from rail_monitor.site import load_parameter_file, site_from_values
+from rail_monitor.noise.config import MODELS, noise_config
+from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.site_file import load_parameter_file
 
 
 def costs(site_file: str, n: int = 20_000) -> dict[str, dict[str, float]]:

@@ -11,15 +11,18 @@ import time
 import numpy as np
 
 from bench.timing import best_of, header, parser
-from rail_monitor import squeal_risk
+from rail_monitor.core.passes import PassTable, with_class_defaults
+from rail_monitor.core.site import site_from_values
 from rail_monitor.models import squeal
-from rail_monitor.passes import PassTable, with_class_defaults
-from rail_monitor.site import load_parameter_file, site_from_values
+from rail_monitor.site_file import load_parameter_file
+from rail_monitor.squeal.config import squeal_config
+from rail_monitor.squeal.predict import predict
+from rail_monitor.squeal.whatif import rig_case
 
 
 def costs(site_file: str, ode_cases: int = 3) -> dict[str, float]:
     """Per-case and per-pass costs [s]: closed form, time integration, the site prediction."""
-    case = squeal_risk.rig_case()
+    case = rig_case()
     args = (case.speed_mps, case.load_n, case.damping_nspm, case.k1, case.k2, case.k3_n)
     one = best_of(lambda: squeal.limit_cycle_amplitude(args[0], 0.39, *args[1:]), 50)
     t = []
@@ -29,10 +32,10 @@ def costs(site_file: str, ode_cases: int = 3) -> dict[str, float]:
                                     case.stiffness_npm, case.k1, case.k2, case.k3_n)
         t.append(time.perf_counter() - t0)
     values = load_parameter_file(site_file)
-    site, cfg = site_from_values(values), squeal_risk.squeal_config(values)
+    site, cfg = site_from_values(values), squeal_config(values)
     table = _passes(site, 10**5)
-    batch = best_of(lambda: squeal_risk.predict(cfg, site, table), 3) / len(table)
-    single = best_of(lambda: squeal_risk.predict(cfg, site, table.take(slice(0, 1))), 50)
+    batch = best_of(lambda: predict(cfg, site, table), 3) / len(table)
+    single = best_of(lambda: predict(cfg, site, table.take(slice(0, 1))), 50)
     return {"closed_form": one, "ode": float(np.median(t)), "pass_single": single, "pass_batch": batch}
 
 
@@ -49,7 +52,7 @@ def main() -> None:
     ap = parser(__doc__)
     ap.add_argument("--ode-cases", type=int, default=5, help="crabbing velocities integrated in time")
     ns = ap.parse_args()
-    case = squeal_risk.rig_case()
+    case = rig_case()
     args = (case.speed_mps, case.load_n, case.damping_nspm, case.k1, case.k2, case.k3_n)
     vcs = np.linspace(0.2, 0.5, ns.ode_cases)
 
@@ -74,14 +77,14 @@ def main() -> None:
         print(f"closed form, {n:>9,} cases:    {n / t:10.3g} cases/s")
 
     values = load_parameter_file(ns.site)
-    site, cfg = site_from_values(values), squeal_risk.squeal_config(values)
+    site, cfg = site_from_values(values), squeal_config(values)
     n = 10**5
     table = _passes(site, n)
-    t = best_of(lambda: squeal_risk.predict(cfg, site, table), 3)
+    t = best_of(lambda: predict(cfg, site, table), 3)
     print(f"site prediction (contact, k3, limit cycle, levels, friction-modifier what-if), {n:,} passes: "
           f"{n / t:.3g} passes/s")
     one_pass = table.take(slice(0, 1))
-    t1 = best_of(lambda: squeal_risk.predict(cfg, site, one_pass), 50)
+    t1 = best_of(lambda: predict(cfg, site, one_pass), 50)
     print(f"site prediction, one pass (the node's call):  {t1 * 1e6:.0f} us")
 
 

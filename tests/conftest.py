@@ -32,14 +32,14 @@ def _isolated_dds(monkeypatch: pytest.MonkeyPatch) -> None:
 
 @pytest.fixture()
 def site():
-    from rail_monitor.site import load_site
+    from rail_monitor.site_file import load_site
 
     return load_site(SITE_FILE)
 
 
 @pytest.fixture()
 def site_values() -> dict:
-    from rail_monitor.site import load_parameter_file
+    from rail_monitor.site_file import load_parameter_file
 
     return load_parameter_file(SITE_FILE)
 

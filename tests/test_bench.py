@@ -8,8 +8,8 @@ import sys
 
 import numpy as np
 
-from rail_monitor.batch import run_models
-from rail_monitor.passes import PassTable
+from rail_monitor.app.batch import run_models
+from rail_monitor.core.passes import PassTable
 
 from conftest import TOP
 
@@ -36,14 +36,14 @@ def test_batch_of_an_empty_history_gives_empty_outputs(site_values):
     r = run_models(PassTable.empty(), site_values)
     assert len(r.accepted) == len(r.trajectory) == 0 and r.alerts == [] and r.advice is None
     for out in r.noise.values():
-        assert out["lpaeq_tp_dba"].shape == (0,) and out["lp_db"].shape == (0, len(out["band_centre_hz"]))
+        assert out.lpaeq_tp_dba.shape == (0,) and out.lp_db.shape == (0, len(out.band_centre_hz))
     assert all(np.size(v) == 0 for v in r.squeal.values())
 
 
 def test_batch_in_chunks_equals_one_call(site_values, sample_passes, monkeypatch):
     # Batch mode bounds its memory by advancing the corrugation state and predicting the noise in
     # chunks of passes; the state carries over, so the chunks give the one call's numbers.
-    import rail_monitor.batch as batch
+    import rail_monitor.app.batch as batch
 
     whole = run_models(sample_passes, site_values)
     monkeypatch.setattr(batch, "HISTORY_CHUNK", 700)
@@ -54,6 +54,6 @@ def test_batch_in_chunks_equals_one_call(site_values, sample_passes, monkeypatch
     np.testing.assert_allclose(b.amplitude, a.amplitude, rtol=1e-12)
     np.testing.assert_allclose(b.forecast.days_to_threshold, a.forecast.days_to_threshold, rtol=1e-9)
     for name, out in whole.noise.items():
-        np.testing.assert_allclose(chunked.noise[name]["lp_db"], out["lp_db"], rtol=1e-12)
-        np.testing.assert_allclose(chunked.noise[name]["lpafmax_dba"], out["lpafmax_dba"], rtol=1e-12)
+        np.testing.assert_allclose(chunked.noise[name].lp_db, out.lp_db, rtol=1e-12)
+        np.testing.assert_allclose(chunked.noise[name].lpafmax_dba, out.lpafmax_dba, rtol=1e-12)
     assert chunked.alerts == whole.alerts

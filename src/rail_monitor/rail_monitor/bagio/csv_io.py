@@ -24,9 +24,9 @@ import io
 from collections.abc import Callable
 from pathlib import Path
 
-from rail_monitor.errors import InputError, RailMonitorError
-from rail_monitor.passes import FRICTION_BY_NAME, FRICTION_NAMES, PassTable
-from rail_monitor.timeutil import NS_PER_S, format_iso_ns, parse_iso_ns
+from rail_monitor.core.errors import InputError, RailMonitorError
+from rail_monitor.core.passes import FRICTION_BY_NAME, FRICTION_NAMES, PassTable
+from rail_monitor.core.timeutil import NS_PER_S, format_iso_ns, parse_iso_ns
 
 
 def _time_utc(text: str) -> int:

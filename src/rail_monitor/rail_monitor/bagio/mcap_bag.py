@@ -23,7 +23,7 @@ import yaml
 from mcap.writer import CompressionType, Writer
 
 from rail_monitor.bagio.typestore import schema_text, type_hash
-from rail_monitor.errors import RailMonitorError
+from rail_monitor.core.errors import RailMonitorError
 
 # rosbag2's "infinite" duration in QoS (deadline, lifespan, lease) as written by Jazzy.
 _INFINITE = {"sec": 9223372036, "nsec": 854775807}

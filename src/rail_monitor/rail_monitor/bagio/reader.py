@@ -1,6 +1,6 @@
 """Reading pass histories: rosbag2 bags (MCAP or sqlite3, via rosbags), bare MCAP files, CSV.
 
-Every failure becomes an :class:`~rail_monitor.errors.InputError` with one line naming the
+Every failure becomes an :class:`~rail_monitor.core.errors.InputError` with one line naming the
 file and the cause; front ends print it without a traceback and exit non-zero.
 """
 
@@ -15,10 +15,10 @@ from mcap.records import Channel, Message, Schema
 from mcap.stream_reader import StreamReader
 from rosbags.highlevel import AnyReader
 
+from rail_monitor.bagio.messages import pass_row
 from rail_monitor.bagio.typestore import TRAIN_PASS, typestore
-from rail_monitor.errors import InputError, RailMonitorError
-from rail_monitor.passes import PassTable
-from rail_monitor.timeutil import from_sec_nanosec
+from rail_monitor.core.errors import InputError, RailMonitorError
+from rail_monitor.core.passes import PassTable
 
 
 def _one_line(exc: BaseException) -> str:
@@ -79,22 +79,6 @@ def bag_info(path: str | Path) -> BagInfo:
         raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
     finally:
         reader.close()
-
-
-def pass_row(msg: Any) -> dict[str, Any]:
-    """A deserialised TrainPass (rosbags object) as a PassTable row."""
-    return {
-        "stamp_ns": from_sec_nanosec(msg.header.stamp.sec, msg.header.stamp.nanosec),
-        "train_id": msg.train_id,
-        "vehicle_class": msg.vehicle_class,
-        "vehicle_count": msg.vehicle_count,
-        "axle_count": msg.axle_count,
-        "speed_mps": msg.speed_mps,
-        "angle_of_attack_rad": msg.angle_of_attack_rad,
-        "wheel_load_n": msg.wheel_load_n,
-        "friction_state": msg.friction_state,
-        "train_length_m": msg.train_length_m,
-    }
 
 
 def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:

@@ -15,8 +15,8 @@ from pathlib import Path
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
-from rail_monitor.errors import RailMonitorError
-from rail_monitor.timeutil import from_sec_nanosec
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.timeutil import from_sec_nanosec
 
 SEPARATOR = "=" * 80
 TRAIN_PASS = "rail_msgs/msg/TrainPass"

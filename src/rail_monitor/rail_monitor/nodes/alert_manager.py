@@ -4,8 +4,9 @@ Subscribes ``train_pass`` (rejected inputs), ``noise/squeal``, ``noise/rolling``
 ``corrugation/state`` (every state, in order); publishes each raise and clear on ``alerts``
 (rail_msgs/WaysideAlert; reliable, transient local, depth 1000) and the standing set on
 ``alerts/standing`` (rail_msgs/WaysideAlertArray; latched), so a late subscriber sees the
-standing alerts at once. Thresholds and hysteresis: ``alerts.*`` (rail_monitor.alerts.ALERT_SPECS)
-and the corrugation lead time ``corrugation.lead_time_days``.
+standing alerts at once. Thresholds and hysteresis: ``alerts.*``
+(:data:`rail_monitor.alerts.config.ALERT_SPECS`) and the corrugation lead time
+``corrugation.lead_time_days``.
 """
 
 from __future__ import annotations
@@ -17,31 +18,21 @@ from typing import Any
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from rail_monitor.alerts import (
-    ALERT_SPECS,
-    KIND_NAMES,
-    NOISE_METRICS,
-    SEVERITY_CRITICAL,
-    Alert,
-    AlertManager,
-    alert_config,
-    describe,
-)
-from rail_monitor.corrugation_state import CORRUGATION_SPECS
-from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched
-from rail_monitor.nodes.convert import (
+from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, SEVERITY_CRITICAL, alert_config
+from rail_monitor.alerts.manager import Alert, AlertManager, describe
+from rail_monitor.bagio.messages import (
     corrugation_series,
     stamps_ns,
-    time_ns,
-    wayside_alert_array_msg,
-    wayside_alert_msg,
+    wayside_alert_array_fields,
+    wayside_alert_fields,
 )
+from rail_monitor.core.passes import PassTable
+from rail_monitor.corrugation.config import LEAD_TIME
+from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched
+from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
-from rail_monitor.passes import PassTable
-from rail_msgs.msg import CorrugationState, RollingNoise, SquealPrediction, TrainPass, WaysideAlert, WaysideAlertArray
-
-LEAD_TIME = next(s for s in CORRUGATION_SPECS if s.name == "lead_time_days")
+from rail_msgs.msg import CorrugationState, RollingNoise, SquealPrediction, WaysideAlert, WaysideAlertArray
 
 
 class AlertManagerNode(PassModelNode):
@@ -61,22 +52,19 @@ class AlertManagerNode(PassModelNode):
             subscribe_batched(self, msg_type, topic, handle, qos, self.max_batch)
         self._publish_standing(0)
 
-    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
-        self._emit(self.alerts.on_train_pass(time_ns(msg.header.stamp), False))
-
-    def on_rejected(self, msg: TrainPass, reason: str) -> None:
-        self._emit(self.alerts.on_train_pass(time_ns(msg.header.stamp), True))
+    def on_validated(self, table: PassTable, reasons: list[str]) -> None:
+        self._emit(self.alerts.on_train_passes(table.stamp_ns, np.array([bool(r) for r in reasons])))
 
     def _on_squeal(self, msgs: list[SquealPrediction]) -> None:
         self.inputs["noise/squeal"] += len(msgs)
-        self._emit(self.alerts.on_squeal_series(stamps_ns(msgs), np.array([m.risk for m in msgs])))
+        self._emit(self.alerts.on_squeal(stamps_ns(msgs), np.array([m.risk for m in msgs])))
 
     def _on_noise(self, msgs: list[RollingNoise]) -> None:
         self.inputs["noise/rolling"] += len(msgs)
         events: list[Alert] = []
         for model in dict.fromkeys(m.model for m in msgs):  # each source model's stream in its order
             mine = [m for m in msgs if m.model == model]
-            events += self.alerts.on_noise_series(stamps_ns(mine), model, {
+            events += self.alerts.on_noise(stamps_ns(mine), model, {
                 k: np.array([getattr(m, k) for m in mine]) for k in NOISE_METRICS})
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
 
@@ -90,14 +78,15 @@ class AlertManagerNode(PassModelNode):
 
     def _emit(self, events: list[Alert]) -> None:
         for e in events:
-            self.sent.publish(self.pub, wayside_alert_msg(e, self.site.site_id))
+            self.sent.publish(self.pub, to_msg(WaysideAlert, wayside_alert_fields(e, self.site.site_id)))
             self.get_logger().info(describe(e))
         if events:
             self._publish_standing(events[-1].stamp_ns)
 
     def _publish_standing(self, stamp_ns: int) -> None:
         alerts = sorted(self.alerts.standing.values(), key=lambda a: (a.kind, a.key))
-        self.sent.publish(self.standing_pub, wayside_alert_array_msg(alerts, stamp_ns, self.site.site_id))
+        self.sent.publish(self.standing_pub, to_msg(WaysideAlertArray, wayside_alert_array_fields(
+            alerts, stamp_ns, self.site.site_id)))
 
     def diagnostic_values(self) -> dict[str, Any]:
         events = self.alerts.events

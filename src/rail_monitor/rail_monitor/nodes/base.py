@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import signal
 import sys
 import threading
@@ -19,10 +20,10 @@ from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
-from rail_monitor.errors import ConfigError, RailMonitorError
+from rail_monitor.core.errors import ConfigError, RailMonitorError
+from rail_monitor.core.params import ParamSpec
+from rail_monitor.core.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
-from rail_monitor.params import ParamSpec
-from rail_monitor.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
 
 
 def _descriptor(spec: ParamSpec, prefix: str) -> ParameterDescriptor:
@@ -114,6 +115,22 @@ def runs(items: Sequence[Any], same: Callable[[Any, Any], bool]) -> Iterator[sli
         i = j
 
 
+def isolate_failures(n: int, call: Callable[[slice], None], failed: Callable[[int, Exception], None]) -> None:
+    """call(slice(0, n)); if it raises, call each item alone, and failed(i, exc) for those that raise."""
+    try:
+        call(slice(0, n))
+        return
+    except Exception as exc:  # a bug in a model: find the items it fails on, the others go through
+        if n == 1:
+            failed(0, exc)
+            return
+    for i in range(n):
+        try:
+            call(slice(i, i + 1))
+        except Exception as exc:
+            failed(i, exc)
+
+
 def wall_timer(node: Node, period_s: float, callback: Callable[[], None], **kwargs: Any):
     """A timer on the steady clock: housekeeping must run whether or not /clock (sim time) ticks."""
     return node.create_timer(period_s, callback, clock=Clock(clock_type=ClockType.STEADY_TIME), **kwargs)
@@ -181,44 +198,78 @@ def use_flow_control_profile() -> None:
             get_package_share_directory("rail_monitor"), "config", "fastdds_flow_control.xml")
 
 
-def run_node(make: Callable[[], Node], args: list[str] | None = None) -> int:
-    """The Jazzy main() pattern for a single node; returns the process exit code.
+@contextlib.contextmanager
+def ros_session(args: list[str] | None = None, flow_control: bool = False) -> Iterator[threading.Event]:
+    """rclpy initialised for one process, with SIGINT and SIGTERM setting the event it yields
+    instead of rclpy's handler (which would shut the context down at once, before a node could
+    take what DDS already delivered). Shut down on exit.
 
-    SIGINT and SIGTERM stop the spin loop (not rclpy's handler, which would shut the context down
-    at once): a node with a ``drain(executor)`` method then takes what DDS has already delivered
-    (the recorder: nothing published before the signal is lost), and ``close()`` runs.
-    Configuration errors, and errors on closing (a bag that cannot be finished), are one line on
-    stderr and exit code 2, not a traceback.
+    flow_control: load the package's Fast DDS profile (see use_flow_control_profile).
     """
+    if flow_control:
+        use_flow_control_profile()
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     stop = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: stop.set())
-    node = None
-    code = 0
+    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        node = make()
-        executor = SingleThreadedExecutor()
-        executor.add_node(node)
-        while not stop.is_set() and rclpy.ok():
-            executor.spin_once(timeout_sec=0.1)
-        drain = getattr(node, "drain", None)
-        if drain is not None and rclpy.ok():
-            drain(executor)
+        yield stop
+    finally:
+        rclpy.try_shutdown()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def exit_code(main: Callable[[], int]) -> int:
+    """main()'s exit code; a RailMonitorError is one line on stderr and exit code 2, not a traceback."""
+    try:
+        return main()
     except RailMonitorError as exc:
         print(f"error: {exc}", file=sys.stderr)
-        code = 2
+        return 2
     except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            close = getattr(node, "close", None)
+        return 130
+
+
+def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_control: bool = False) -> int:
+    """The main() of every single-node executable; returns the process exit code.
+
+    A node with a ``run(ok)`` method (a pass source) runs it in the foreground while the executor
+    spins in the background, and the process ends when it returns; any other node spins until
+    SIGINT or SIGTERM, then a node with a ``drain(executor)`` method takes what DDS has already
+    delivered (the recorder: nothing published before the signal is lost). ``close()`` runs in
+    every case; an error there (a bag that cannot be finished) is exit code 2.
+    """
+    def main() -> int:
+        with ros_session(args, flow_control) as stop:
+            node = make()
+            executor = SingleThreadedExecutor()
+            executor.add_node(node)
+            spinner = None
             try:
-                if close is not None:
-                    close()
-            except RailMonitorError as exc:
-                print(f"error: {exc}", file=sys.stderr)
-                code = 2
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+                def ok() -> bool:
+                    return not stop.is_set() and rclpy.ok()
+
+                job = getattr(node, "run", None)
+                if job is not None:
+                    spinner = threading.Thread(target=executor.spin, daemon=True)
+                    spinner.start()
+                    job(ok)
+                else:
+                    while ok():
+                        executor.spin_once(timeout_sec=0.1)
+                    drain = getattr(node, "drain", None)
+                    if drain is not None and rclpy.ok():
+                        drain(executor)
+            finally:
+                executor.shutdown(timeout_sec=1.0)
+                if spinner is not None and spinner.is_alive():  # leave no thread inside rcl at exit
+                    spinner.join(timeout=5.0)
+                try:
+                    close = getattr(node, "close", None)
+                    if close is not None:
+                        close()
+                finally:
+                    node.destroy_node()
+        return 0
+
+    return exit_code(main)

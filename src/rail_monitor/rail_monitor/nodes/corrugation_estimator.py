@@ -18,31 +18,25 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from rail_monitor.corrugation_state import CORRUGATION_SPECS, CorrugationEstimator, corrugation_config
+from rail_monitor.bagio.messages import corrugation_state_fields, speed_advisory_fields, time_ns
+from rail_monitor.core.node_params import ESTIMATOR_SPECS
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.timeutil import format_iso_ns
+from rail_monitor.corrugation import advice, checkpoint, surveys
+from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_config
+from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
-from rail_monitor.nodes.convert import corrugation_state_msg, speed_advisory_msg, time_ns
+from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS
-from rail_monitor.params import ParamSpec
-from rail_monitor.passes import PassTable
-from rail_monitor.timeutil import format_iso_ns
 from rail_msgs.msg import CorrugationState, RoughnessSurvey, SpeedAdvisory, TrainPass
 from rail_msgs.srv import EvaluateSpeedDistribution
-
-NODE_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("checkpoint_path", "", "File the state is checkpointed to and resumed from ('' : none)."),
-    ParamSpec("checkpoint_every_passes", 100, "Counted passes between checkpoints (checked after each "
-              "callback's passes: a backlog taken at once is checkpointed at its end) [-].", 1, 10**9),
-    ParamSpec("state_period_s", 0.0, "Least wall time between corrugation/state messages [s] (0: every pass).",
-              0.0, 86_400.0),
-    ParamSpec("advisory_period_s", 60.0, "Wall time between speed advisories [s].", 0.01, 86_400.0),
-)
 
 
 class CorrugationEstimatorNode(PassModelNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("corrugation_estimator", **kwargs)
-        self.params = declare(self, NODE_SPECS)
+        self.params = declare(self, ESTIMATOR_SPECS)
         cfg = corrugation_config(declare(self, CORRUGATION_SPECS, prefix="corrugation."), prefix="")
         self.est = CorrugationEstimator(self.site, cfg)
         self.checkpoint = self.params["checkpoint_path"]
@@ -53,7 +47,7 @@ class CorrugationEstimatorNode(PassModelNode):
         if self.checkpoint:
             # An unreadable checkpoint falls back to the previous one; none readable is a ConfigError
             # (no silent fresh start).
-            used, self.checkpoint_skipped = self.est.resume(self.checkpoint)
+            used, self.checkpoint_skipped = checkpoint.resume(self.est, self.checkpoint)
             for why in self.checkpoint_skipped:
                 self.get_logger().error(f"checkpoint skipped: {why}")
             if used is not None:
@@ -80,23 +74,26 @@ class CorrugationEstimatorNode(PassModelNode):
         now = time.monotonic()
         if self.params["state_period_s"] == 0.0:
             for k in range(len(traj)):
-                self.sent.publish(self.state_pub, corrugation_state_msg(*traj.state(k), self.site.site_id))
+                self.sent.publish(self.state_pub, to_msg(CorrugationState, corrugation_state_fields(
+                    *traj.state(k), self.site.site_id)))
         elif now - self._last_state_t >= self.params["state_period_s"]:
             self.publish_state()
             self._last_state_t = now
 
     def publish_state(self) -> None:
-        self.sent.publish(self.state_pub, corrugation_state_msg(self.est, self.est.forecast(), self.site.site_id))
+        self.sent.publish(self.state_pub, to_msg(CorrugationState, corrugation_state_fields(
+            self.est, self.est.forecast(), self.site.site_id)))
 
     def publish_advisory(self) -> None:
-        if not len(self.est.recent.stamp_ns):
+        if not len(self.est.kept):
             return
         try:
-            advice = self.est.advise()
+            advised = advice.advise(self.est)
         except ValueError as exc:
             self.get_logger().warning(f"no speed advice: {exc}", throttle_duration_sec=60.0)
             return
-        self.sent.publish(self.advisory_pub, speed_advisory_msg(advice, self.est.newest_ns, self.site.site_id))
+        self.sent.publish(self.advisory_pub, to_msg(SpeedAdvisory, speed_advisory_fields(
+            advised, self.est.newest_ns, self.site.site_id)))
 
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         stamp = time_ns(msg.header.stamp)
@@ -104,12 +101,12 @@ class CorrugationEstimatorNode(PassModelNode):
             if stamp <= self.est.last_survey_ns:
                 raise ValueError("not newer than the last survey or grinding applied")
             if msg.kind == RoughnessSurvey.KIND_SURVEY:
-                scale = self.est.apply_survey(msg.wavelength_m, msg.amplitude_m, stamp)
+                scale = surveys.apply_survey(self.est, msg.wavelength_m, msg.amplitude_m, stamp)
                 self.counts["surveys"] += 1
                 if scale is not None:
                     self.get_logger().info(f"survey re-fitted K_b by x{scale:.3g}: {self.est.k_b.tolist()}")
             elif msg.kind == RoughnessSurvey.KIND_GRINDING:
-                self.est.apply_grinding(stamp, msg.wavelength_m, msg.amplitude_m)
+                surveys.apply_grinding(self.est, stamp, msg.wavelength_m, msg.amplitude_m)
                 self.counts["grindings"] += 1
             else:
                 raise ValueError(f"unknown kind {msg.kind}")
@@ -123,7 +120,7 @@ class CorrugationEstimatorNode(PassModelNode):
     def _on_evaluate(self, req: EvaluateSpeedDistribution.Request,
                      res: EvaluateSpeedDistribution.Response) -> EvaluateSpeedDistribution.Response:
         try:
-            ev = self.est.evaluate(req.speed_mps, req.probability, req.friction_state, req.passes_per_day)
+            ev = advice.evaluate(self.est, req.speed_mps, req.probability, req.friction_state, req.passes_per_day)
         except ValueError as exc:
             res.success, res.message = False, str(exc)
             return res
@@ -138,7 +135,7 @@ class CorrugationEstimatorNode(PassModelNode):
         if not self.checkpoint:
             return
         try:
-            self.est.save(self.checkpoint)
+            checkpoint.save(self.est, self.checkpoint)
             self.counts["checkpoints"] += 1
         except OSError as exc:
             self.counts["checkpoint failures"] += 1

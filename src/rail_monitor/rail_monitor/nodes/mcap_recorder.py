@@ -26,30 +26,15 @@ from rclpy.qos import QoSProfile
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
-from rail_monitor.errors import RailMonitorError
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.node_params import RECORDER_SPECS
+from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, run_node, subscribe_batched, wall_timer
 from rail_monitor.nodes.qos import qos_to_dict, subscription_qos
-from rail_monitor.params import ParamSpec
-from rail_monitor.timeutil import NS_PER_S
 
 DEFAULT_TYPES_PREFIX = "rail_msgs/"
 DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
 
-RECORDER_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("output", "", "Bag folder to create; empty: rail_monitor_<UTC time> in the working folder."),
-    ParamSpec("topics", [""], "Topics to record (absolute or relative to the namespace); empty: every "
-              "rail_msgs topic and /diagnostics."),
-    ParamSpec("compression", "zstd", "Chunk compression.", choices=("zstd", "none")),
-    ParamSpec("chunk_size", 1 << 20, "Uncompressed bytes of messages per chunk [bytes].", 1024, 1 << 30),
-    ParamSpec("max_bag_size", 0, "Start a new file past this size; 0: never [bytes].", 0, 1 << 50),
-    ParamSpec("max_bag_duration_s", 0.0, "Start a new file past this span of log time; 0: never [s].", 0.0, 1.0e9),
-    ParamSpec("flush_period_s", 5.0, "Close the open chunk at least this often (bounds loss on a kill) [s].",
-              0.0, 3600.0),
-    ParamSpec("log_time", "header", "Log time of a message: header = its header.stamp (pass time; messages "
-              "without a header take the node clock), receive = the node clock at receipt, as rosbag2 does.",
-              choices=("header", "receive")),
-    ParamSpec("discovery_period_s", 0.2, "How often to look for new topics [s].", 0.01, 60.0),
-)
 
 
 class McapRecorder(Node):

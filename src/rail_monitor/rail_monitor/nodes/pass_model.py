@@ -1,8 +1,9 @@
-"""Shared base of the model nodes: take train_pass, validate, count rejections, diagnose.
+"""Shared base of the nodes that take train_pass: the one place a pass is validated, rejections
+counted and diagnostics published.
 
-A malformed pass is rejected with its reason (rail_monitor.passes.rejection_reasons), counted
-per reason on /diagnostics, logged (throttled) and never reaches the model, so it leaves any
-state untouched. A model raising on an accepted pass is a bug: it is counted and logged, the
+A malformed pass is rejected with its reason (:func:`rail_monitor.core.passes.rejection_reasons`),
+counted per reason on /diagnostics, logged (throttled) and never reaches the model, so it leaves
+any state untouched. A model raising on an accepted pass is a bug: it is counted and logged, the
 node's diagnostics go to ERROR, and the node goes on with the next pass.
 
 A callback takes the passes already queued behind its message too (at most ``max_batch``), and
@@ -18,22 +19,25 @@ from typing import Any
 from diagnostic_msgs.msg import DiagnosticStatus
 from rclpy.node import Node
 
-from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, declare_site, subscribe_batched
-from rail_monitor.nodes.convert import time_ns, train_pass_row
-from rail_monitor.nodes.qos import STREAM_SUB_QOS
-from rail_monitor.params import ParamSpec
-from rail_monitor.passes import PassTable, rejection_reasons, with_class_defaults
-from rail_monitor.timeutil import format_iso_ns
-from rail_msgs.msg import TrainPass
-
-BATCH_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("max_batch", 200, "Most queued train passes a callback takes and handles at once (1: one by one) [-].",
-              1, 10_000),
+from rail_monitor.bagio.messages import pass_row, time_ns
+from rail_monitor.core.node_params import BATCH_SPECS
+from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.timeutil import format_iso_ns
+from rail_monitor.nodes.base import (
+    Diagnostics,
+    RateMeter,
+    declare,
+    declare_site,
+    isolate_failures,
+    runs,
+    subscribe_batched,
 )
+from rail_monitor.nodes.qos import STREAM_SUB_QOS
+from rail_msgs.msg import TrainPass
 
 
 class PassModelNode(Node):
-    """Subscribes ``train_pass``; subclasses implement :meth:`on_pass` for accepted passes."""
+    """Subscribes ``train_pass``; subclasses implement :meth:`on_passes` for accepted passes."""
 
     def __init__(self, name: str, **kwargs: Any) -> None:
         super().__init__(name, **kwargs)
@@ -47,18 +51,12 @@ class PassModelNode(Node):
         subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, self.max_batch)
         Diagnostics(self, self.diagnostic_values, level=self._level)
 
-    def on_pass(self, table: PassTable, msg: TrainPass) -> None:
-        """Handle one accepted pass: a one-row table with class defaults filled, and its message."""
-        raise NotImplementedError
-
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
-        """Handle consecutive accepted passes, in order (table rows match msgs). Default: on_pass
-        one by one; a model overrides it with one vectorised call, computing before it publishes."""
-        for i, msg in enumerate(msgs):
-            self.on_pass(table.take(slice(i, i + 1)), msg)
+        """Handle consecutive accepted passes in order (table rows, class defaults filled, match
+        msgs): one vectorised call, computing before it publishes. Nothing by default."""
 
-    def on_rejected(self, msg: TrainPass, reason: str) -> None:
-        """Handle one rejected pass (after it is counted); nothing by default."""
+    def on_validated(self, table: PassTable, reasons: list[str]) -> None:
+        """See every taken pass with its reason ('' accepted), once, before on_passes. Nothing by default."""
 
     def _on_train_passes(self, msgs: list[TrainPass]) -> None:
         try:
@@ -68,37 +66,23 @@ class PassModelNode(Node):
 
     def _handle(self, msgs: list[TrainPass]) -> None:
         """Rejections and runs of accepted passes, in message order."""
-        table = PassTable.from_rows([train_pass_row(m) for m in msgs])
+        table = PassTable.from_rows([pass_row(m) for m in msgs])
         reasons = rejection_reasons(table, self.site).tolist()
-        i = 0
-        while i < len(msgs):
-            if reasons[i]:
-                self.rejected[reasons[i]] += 1
-                self.get_logger().warning(f"pass {msgs[i].train_id!r} rejected: {reasons[i]}",
-                                          throttle_duration_sec=5.0)
-                self.on_rejected(msgs[i], reasons[i])
-                i += 1
+        self.on_validated(table, reasons)
+        for run in runs(reasons, lambda a, b: not a and not b):
+            why = reasons[run.start]
+            if not why:
+                self._accept(with_class_defaults(table.take(run), self.site), msgs[run])
                 continue
-            j = i + 1
-            while j < len(msgs) and not reasons[j]:
-                j += 1
-            self._accept(with_class_defaults(table.take(slice(i, j)), self.site), msgs[i:j])
-            i = j
+            self.rejected[why] += 1
+            self.get_logger().warning(f"pass {msgs[run.start].train_id!r} rejected: {why}", throttle_duration_sec=5.0)
 
     def _accept(self, table: PassTable, msgs: list[TrainPass]) -> None:
         self.accepted.tick(len(msgs))
         self.last_pass_ns = time_ns(msgs[-1].header.stamp)
-        self._run(table, msgs)
-
-    def _run(self, table: PassTable, msgs: list[TrainPass]) -> None:
-        try:
-            self.on_passes(table, msgs)
-        except Exception as exc:  # a model failing on one accepted pass must not stop the node
-            if len(msgs) > 1:  # find the pass it fails on: the others go through
-                for i, msg in enumerate(msgs):
-                    self._run(table.take(slice(i, i + 1)), [msg])
-                return
-            self.model_error(msgs[0], exc)
+        # A model failing on one accepted pass must not stop the node, nor the other passes.
+        isolate_failures(len(msgs), lambda rows: self.on_passes(table.take(rows), msgs[rows]),
+                         lambda i, exc: self.model_error(msgs[i], exc))
 
     def model_error(self, msg: TrainPass, exc: Exception) -> None:
         """Count and log a model raising on an accepted pass (diagnostics go to ERROR)."""

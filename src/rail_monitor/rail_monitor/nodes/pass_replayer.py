@@ -1,7 +1,7 @@
 """pass_replayer: replay TrainPass history from a rosbag2 bag (MCAP or sqlite3) or a CSV file.
 
 Publishes ``train_pass`` (rail_msgs/TrainPass) and ``/clock``; exits 0 when done. See
-PUBLISH_SPECS for timing, offsets and flow control.
+rail_monitor.core.node_params.PUBLISH_SPECS for timing, offsets and flow control.
 """
 
 from __future__ import annotations
@@ -9,19 +9,11 @@ from __future__ import annotations
 import sys
 
 from rail_monitor.bagio.reader import read_passes
-from rail_monitor.errors import RailMonitorError
-from rail_monitor.nodes.base import declare
-from rail_monitor.nodes.pass_source import PassSourceNode, run_source
-from rail_monitor.params import ParamSpec
-from rail_monitor.passes import PassTable
-
-REPLAYER_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("source", "", "History to replay: a bag folder, an .mcap or .db3 file, or a .csv export."),
-    ParamSpec("source_topic", "", "TrainPass topic in the bag; empty: its only TrainPass topic."),
-    ParamSpec("skip_bad_rows", False, "CSV: leave malformed rows out (counted) instead of failing."),
-    ParamSpec("salvage", False, "MCAP: read the passes in every complete chunk of a file cut off mid-write "
-              "(a killed recorder, a full disk) instead of failing."),
-)
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.node_params import REPLAYER_SPECS
+from rail_monitor.core.passes import PassTable
+from rail_monitor.nodes.base import declare, run_node
+from rail_monitor.nodes.pass_source import PassSourceNode
 
 
 class PassReplayer(PassSourceNode):
@@ -48,7 +40,7 @@ class PassReplayer(PassSourceNode):
 
 
 def main(args: list[str] | None = None) -> int:
-    return run_source(PassReplayer, args)
+    return run_node(PassReplayer, args, flow_control=True)
 
 
 if __name__ == "__main__":

@@ -9,19 +9,13 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable
 
+from rail_monitor.app.simulator import SIMULATOR_SPECS, simulate, simulator_config
 from rail_monitor.bagio.passes_bag import write_passes_bag
-from rail_monitor.errors import RailMonitorError
-from rail_monitor.nodes.base import declare, declare_site
-from rail_monitor.nodes.pass_source import PassSourceNode, run_source
-from rail_monitor.params import ParamSpec
-from rail_monitor.passes import PassTable
-from rail_monitor.simulator import SIMULATOR_SPECS, simulate, simulator_config
-
-MODE_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("mode", "publish", "publish: into the graph; bag: write a bag at 'output' and exit.",
-              choices=("publish", "bag")),
-    ParamSpec("output", "", "Bag folder to write in mode 'bag' (must not exist)."),
-)
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.node_params import MODE_SPECS
+from rail_monitor.core.passes import PassTable
+from rail_monitor.nodes.base import declare, declare_site, run_node
+from rail_monitor.nodes.pass_source import PassSourceNode
 
 
 class PassSimulator(PassSourceNode):
@@ -47,7 +41,7 @@ class PassSimulator(PassSourceNode):
 
 
 def main(args: list[str] | None = None) -> int:
-    return run_source(PassSimulator, args)
+    return run_node(PassSimulator, args, flow_control=True)
 
 
 if __name__ == "__main__":

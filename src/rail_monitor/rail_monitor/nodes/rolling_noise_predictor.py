@@ -3,7 +3,7 @@
 Subscribes ``train_pass`` and ``corrugation/state`` (every state, in order); publishes
 ``noise/rolling`` (rail_msgs/RollingNoise) per pass, one message per source model: ``noise.model``
 is cnossos, mechanics or both. Parameters: the site (track, contact, rolling stock), ``noise.*``
-(rail_monitor.rolling_noise.NOISE_SPECS: baseline rail roughness, CNOSSOS track type,
+(:data:`rail_monitor.noise.config.NOISE_SPECS`: baseline rail roughness, CNOSSOS track type,
 interpolation rule, receiver and ground, mechanics radiators) and ``state_wait_s``.
 
 Which corrugation a pass is predicted on: the state that includes it. While corrugation/state has
@@ -24,20 +24,18 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched, wall_timer
-from rail_monitor.nodes.convert import corrugation_from_msg, rolling_noise_msg, time_ns
+from rail_monitor.bagio.messages import corrugation_from_msg, header_of, rolling_noise_fields, time_ns
+from rail_monitor.core.node_params import PREDICTOR_SPECS
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.timeutil import format_iso_ns
+from rail_monitor.nodes.base import Sent, declare, isolate_failures, run_node, runs, subscribe_batched, wall_timer
+from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
-from rail_monitor.params import ParamSpec
-from rail_monitor.passes import PassTable
-from rail_monitor.rolling_noise import NOISE_SPECS, Corrugation, RollingNoiseModel, noise_config
-from rail_monitor.timeutil import format_iso_ns
+from rail_monitor.noise.config import NOISE_SPECS, noise_config
+from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
 
-NODE_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("state_wait_s", 5.0, "Longest wall time a pass waits for the corrugation state that includes it; "
-              "0: take the latest state at once [s].", 0.0, 3600.0),
-)
 STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass queue is as deep)
 
 
@@ -54,7 +52,7 @@ class RollingNoisePredictor(PassModelNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("rolling_noise_predictor", **kwargs)
         cfg = noise_config(declare(self, NOISE_SPECS, prefix="noise."), prefix="")
-        self.wait_s = declare(self, NODE_SPECS)["state_wait_s"]
+        self.wait_s = declare(self, PREDICTOR_SPECS)["state_wait_s"]
         self.model = RollingNoiseModel(self.site, cfg)
         self.states: deque[tuple[int, str, Corrugation]] = deque(maxlen=STATES_KEPT)  # in arrival order
         self.pending: deque[_Pending] = deque()
@@ -123,20 +121,18 @@ class RollingNoisePredictor(PassModelNode):
 
     def _predict_run(self, ready: list[_Pending], states: list[Corrugation | None]) -> None:
         first = states[0]
-        corrugation = None if first is None else Corrugation(
-            first.wavelength_m, np.stack([np.asarray(s.amplitude_m) for s in states]), first.post_grinding_m)
-        try:
-            values = [self.model.predict(_rows(ready), name, corrugation) for name in self.model.models]
-        except Exception as exc:  # a bug: find the pass it fails on, the others go through
-            if len(ready) == 1:
-                self.model_error(ready[0].msg, exc)
-                return
-            for k in range(len(ready)):
-                self._predict_run(ready[k:k + 1], states[k:k + 1])
-            return
-        for k, p in enumerate(ready):
-            for v in values:
-                self.sent.publish(self.pub, rolling_noise_msg(v, k, p.msg, self.model.receiver))
+
+        def predict(rows: slice) -> None:
+            corrugation = None if first is None else Corrugation(
+                first.wavelength_m, np.stack([np.asarray(s.amplitude_m) for s in states[rows]]), first.post_grinding_m)
+            passes = ready[rows]
+            values = [self.model.predict(_rows(passes), name, corrugation) for name in self.model.models]
+            for k, p in enumerate(passes):
+                for v in values:
+                    self.sent.publish(self.pub, to_msg(RollingNoise, rolling_noise_fields(
+                        v, k, header_of(p.msg), p.msg.train_id, self.model.receiver)))
+
+        isolate_failures(len(ready), predict, lambda i, exc: self.model_error(ready[i].msg, exc))
 
     def diagnostic_values(self) -> dict[str, Any]:
         last = self.states[-1][0] if self.states else 0

@@ -1,8 +1,9 @@
 """squeal_risk_model: predicted wheel squeal for every accepted train pass.
 
 Subscribes ``train_pass``; publishes ``noise/squeal`` (rail_msgs/SquealPrediction). Parameters:
-the site and its rolling-stock table, and ``squeal.*`` (rail_monitor.squeal_risk.SQUEAL_SPECS:
-wheel mode, contact geometry, creep curves per friction state, receiver, risk thresholds).
+the site and its rolling-stock table, and ``squeal.*`` (:data:`rail_monitor.squeal.config.
+SQUEAL_SPECS`: wheel mode, k3 convention, creep curves per friction state, receiver, risk
+thresholds).
 """
 
 from __future__ import annotations
@@ -10,16 +11,18 @@ from __future__ import annotations
 import sys
 from typing import Any
 
+from rail_monitor.bagio.messages import header_of, squeal_prediction_fields
+from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Sent, declare, run_node
-from rail_monitor.nodes.convert import squeal_prediction_msg
+from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_model import PassModelNode
 from rail_monitor.nodes.qos import STREAM_QOS
-from rail_monitor.passes import PassTable
-from rail_monitor.squeal_risk import SQUEAL_SPECS, predict, squeal_config
+from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
+from rail_monitor.squeal.predict import predict
 from rail_msgs.msg import SquealPrediction, TrainPass
 
 
-class SquealRiskModel(PassModelNode):
+class SquealRiskNode(PassModelNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("squeal_risk_model", **kwargs)
         self.cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
@@ -29,14 +32,15 @@ class SquealRiskModel(PassModelNode):
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         values = predict(self.cfg, self.site, table)
         for i, msg in enumerate(msgs):
-            self.sent.publish(self.pub, squeal_prediction_msg(values, i, msg))
+            self.sent.publish(self.pub, to_msg(SquealPrediction, squeal_prediction_fields(
+                values, i, header_of(msg), msg.train_id)))
 
     def diagnostic_values(self) -> dict[str, Any]:
         return {**super().diagnostic_values(), "published": sum(self.sent.values())}
 
 
 def main(args: list[str] | None = None) -> int:
-    return run_node(SquealRiskModel, args)
+    return run_node(SquealRiskNode, args)
 
 
 if __name__ == "__main__":

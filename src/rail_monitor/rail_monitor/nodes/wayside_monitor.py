@@ -15,31 +15,20 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import rclpy
-from rclpy.executors import Executor, ExternalShutdownException, MultiThreadedExecutor, SingleThreadedExecutor
+from rclpy.executors import Executor, MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.node import Node
 
-from rail_monitor.errors import RailMonitorError
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE
 from rail_monitor.nodes.alert_manager import AlertManagerNode
-from rail_monitor.nodes.base import declare, use_flow_control_profile
+from rail_monitor.nodes.base import declare, exit_code, ros_session
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_model import PassModelNode
-from rail_monitor.nodes.pass_replayer import REPLAYER_SPECS, PassReplayer
+from rail_monitor.nodes.pass_replayer import PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
-from rail_monitor.nodes.squeal_risk_model import SquealRiskModel
-from rail_monitor.params import ParamSpec
-
-MONITOR_SPECS: tuple[ParamSpec, ...] = (
-    ParamSpec("record", True, "Host an mcap_recorder for every output topic."),
-    ParamSpec("drain_timeout_s", 60.0, "After the replay, wait at most this for the recorder to catch up [s].",
-              0.0, 3600.0),
-    ParamSpec("executor", "single_threaded", "Executor hosting the nodes: single_threaded, or multi_threaded "
-              "(like a component container; measured 30x slower here on the sample: rclpy's thread pool costs more "
-              "than it gains for Python callbacks under the GIL).", choices=("single_threaded", "multi_threaded")),
-    ParamSpec("threads", 4, "Threads of the multi_threaded executor [-].", 1, 64),
-)
+from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 
 
 @dataclass
@@ -57,11 +46,11 @@ class _Settings(Node):
 
     def __init__(self) -> None:
         super().__init__("wayside_monitor")
-        self.cfg = declare(self, (*MONITOR_SPECS, REPLAYER_SPECS[0]))
+        self.cfg = declare(self, (*MONITOR_SPECS, SOURCE))
 
 
 def _real_models() -> list[PassModelNode]:
-    return [CorrugationEstimatorNode(), RollingNoisePredictor(), SquealRiskModel(), AlertManagerNode()]
+    return [CorrugationEstimatorNode(), RollingNoisePredictor(), SquealRiskNode(), AlertManagerNode()]
 
 
 def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node]] = _real_models,
@@ -71,70 +60,74 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
     make_models, make_recorder: the nodes hosted (the benchmark's no-op graph passes stand-ins
     with the same topics, types and QoS).
     """
-    use_flow_control_profile()  # for subscribers in other processes (in-process ones are paced exactly)
-    rclpy.init(args=args)
-    nodes: list[Node] = []
-    executor = None
-    spinner = None
-    t0 = time.monotonic()
-    try:
-        settings = _Settings()
-        nodes.append(settings)
-        recorder = make_recorder() if settings.cfg["record"] else None
-        models = make_models()
-        nodes += ([recorder] if recorder is not None else []) + models
-        source = PassReplayer() if settings.cfg["source"] else PassSimulator()
-        nodes.append(source)
-        estimator, predictor, squeal, alerts = models
-        subscribers = len(models) + (recorder is not None)
-        source.cfg["wait_for_subscribers"] = max(source.cfg["wait_for_subscribers"], subscribers)
-        source.consumed = _passes_through(models, recorder, source.pub.topic_name)
-        executor = _make_executor(settings.cfg["executor"], settings.cfg["threads"])
-        for n in nodes:
-            executor.add_node(n)
-        spinner = threading.Thread(target=executor.spin, daemon=True)
-        spinner.start()
-        if recorder is not None:
-            _wait(lambda: _outputs(models) <= set(recorder.counts), settings.cfg["drain_timeout_s"],
-                  lambda: f"recorder did not subscribe to {sorted(_outputs(models) - set(recorder.counts))}")
-        t_replay = time.monotonic()
-        published = source.run()
-        timeout = settings.cfg["drain_timeout_s"]
-        _wait(lambda: all(m.taken >= published for m in models) and not predictor.pending, timeout,
-              lambda: f"models took {[m.taken for m in models]} of {published} passes")
-        _wait(lambda: alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
-              and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
-              and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name], timeout,
-              lambda: f"alert_manager took {dict(alerts.inputs)}")
-        estimator.publish_advisory()  # the advice on the final state
-        recorded: dict[str, int] = {}
-        bag = None
-        if recorder is not None:
-            sent = {source.pub.topic_name: published}
-            for m in models:
-                sent.update(m.sent)
-            _wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
-                  timeout, lambda: f"recorder got {dict(recorder.counts)} of {sent}")
-            if recorder.writer.error:  # e.g. a full disk: say so now, not after the drain timeout
-                raise RailMonitorError(recorder.writer.error)
-        replay_s = time.monotonic() - t_replay
-        if recorder is not None:
-            bag = str(recorder.close())
-            recorded = dict(recorder.counts)
-        rejected = {m.get_name(): sum(m.rejected.values()) for m in models}
-        return MonitorResult(published, recorded, bag, time.monotonic() - t0, rejected, replay_s)
-    finally:
-        if executor is not None:
-            executor.shutdown(timeout_sec=2.0)
-            if spinner is not None and spinner.is_alive():
-                spinner.join(timeout=5.0)
-        for n in reversed(nodes):
-            close = getattr(n, "close", None)
-            if close is not None:
-                with contextlib.suppress(RailMonitorError):  # already raised above (a failed bag)
-                    close()
-            n.destroy_node()
-        rclpy.try_shutdown()
+    # The flow-control profile is for subscribers in other processes (in-process ones are paced exactly).
+    with ros_session(args, flow_control=True) as stop:
+        nodes: list[Node] = []
+        executor = spinner = None
+        t0 = time.monotonic()
+        try:
+            settings = _Settings()
+            nodes.append(settings)
+            recorder = make_recorder() if settings.cfg["record"] else None
+            models = make_models()
+            nodes += ([recorder] if recorder is not None else []) + models
+            source = PassReplayer() if settings.cfg["source"] else PassSimulator()
+            nodes.append(source)
+            source.cfg["wait_for_subscribers"] = max(source.cfg["wait_for_subscribers"],
+                                                     len(models) + (recorder is not None))
+            source.consumed = _passes_through(models, recorder, source.pub.topic_name)
+            executor = _make_executor(settings.cfg["executor"], settings.cfg["threads"])
+            for n in nodes:
+                executor.add_node(n)
+            spinner = threading.Thread(target=executor.spin, daemon=True)
+            spinner.start()
+            return _replay(source, models, recorder, settings.cfg["drain_timeout_s"], stop, t0)
+        finally:
+            if executor is not None:
+                executor.shutdown(timeout_sec=2.0)
+                if spinner is not None and spinner.is_alive():
+                    spinner.join(timeout=5.0)
+            for n in reversed(nodes):
+                close = getattr(n, "close", None)
+                if close is not None:
+                    with contextlib.suppress(RailMonitorError):  # already raised (a failed bag)
+                        close()
+                n.destroy_node()
+
+
+def _replay(source: PassReplayer | PassSimulator, models: list[PassModelNode], recorder: McapRecorder | None,
+            timeout: float, stop: threading.Event, t0: float) -> MonitorResult:
+    """Replay every pass, wait until every model and the recorder took what was published, and
+    publish the advice on the final state."""
+    estimator, predictor, squeal, alerts = models
+    if recorder is not None:
+        _wait(lambda: _outputs(models) <= set(recorder.counts), timeout,
+              lambda: f"recorder did not subscribe to {sorted(_outputs(models) - set(recorder.counts))}")
+    t_replay = time.monotonic()
+    published = source.run(lambda: not stop.is_set() and source.context.ok())
+    _wait(lambda: all(m.taken >= published for m in models) and not predictor.pending, timeout,
+          lambda: f"models took {[m.taken for m in models]} of {published} passes")
+    _wait(lambda: alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
+          and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
+          and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name], timeout,
+          lambda: f"alert_manager took {dict(alerts.inputs)}")
+    estimator.publish_advisory()  # the advice on the final state
+    recorded: dict[str, int] = {}
+    bag = None
+    if recorder is not None:
+        sent = {source.pub.topic_name: published}
+        for m in models:
+            sent.update(m.sent)
+        _wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
+              timeout, lambda: f"recorder got {dict(recorder.counts)} of {sent}")
+        if recorder.writer.error:  # e.g. a full disk: say so now, not after the drain timeout
+            raise RailMonitorError(recorder.writer.error)
+    replay_s = time.monotonic() - t_replay
+    if recorder is not None:
+        bag = str(recorder.close())
+        recorded = dict(recorder.counts)
+    rejected = {m.get_name(): sum(m.rejected.values()) for m in models}
+    return MonitorResult(published, recorded, bag, time.monotonic() - t0, rejected, replay_s)
 
 
 def _passes_through(models: list[PassModelNode], recorder: McapRecorder | None, topic: str) -> Callable[[], int]:
@@ -177,19 +170,16 @@ def _make_executor(kind: str, threads: int) -> Executor:
 
 
 def main(args: list[str] | None = None) -> int:
-    try:
+    def run() -> int:
         r = run_graph(args)
-    except RailMonitorError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        return 130
-    print(f"wayside_monitor: {r.published} passes through the graph in {r.wall_s:.1f} s "
-          f"({r.published / max(r.replay_s, 1e-9):.0f} passes/s over the {r.replay_s:.1f} s of the replay)")
-    if r.bag:
-        print(f"recorded {sum(r.recorded.values())} messages to {r.bag}: "
-              + ", ".join(f"{t} {n}" for t, n in sorted(r.recorded.items())))
-    return 0
+        print(f"wayside_monitor: {r.published} passes through the graph in {r.wall_s:.1f} s "
+              f"({r.published / max(r.replay_s, 1e-9):.0f} passes/s over the {r.replay_s:.1f} s of the replay)")
+        if r.bag:
+            print(f"recorded {sum(r.recorded.values())} messages to {r.bag}: "
+                  + ", ".join(f"{t} {n}" for t, n in sorted(r.recorded.items())))
+        return 0
+
+    return exit_code(run)
 
 
 if __name__ == "__main__":

@@ -1,0 +1,61 @@
+"""The site's alert parameters (thresholds, windows, hysteresis) and the alert kinds and severities."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.params import ParamSpec, ParamValues, resolve, section
+
+# WaysideAlert.KIND_* and SEVERITY_* values.
+KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED = range(1, 6)
+KIND_NAMES = {KIND_GRINDING_DUE: "grinding due", KIND_GRINDING_FORECAST: "grinding forecast",
+              KIND_NOISE_LIMIT: "noise limit", KIND_SQUEAL: "squeal", KIND_INPUT_REJECTED: "inputs rejected"}
+SEVERITY_INFO, SEVERITY_WARNING, SEVERITY_CRITICAL = range(3)
+NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")  # RollingNoise single numbers
+RISK_NAMES = ("none", "low", "medium", "high")
+
+ALERT_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("grinding_clear_fraction", 0.9, "A grinding-due alert clears below this fraction of the band's "
+              "threshold [-].", 0.01, 1.0),
+    ParamSpec("forecast_clear_factor", 1.2, "A grinding-forecast alert clears when the forecast is beyond this "
+              "multiple of the lead time [-].", 1.0, 100.0),
+    ParamSpec("noise_metric", "lpafmax_dba", "Pass-by level compared with the limit.", choices=NOISE_METRICS),
+    ParamSpec("noise_limit_dba", 88.0, "Pass-by noise limit at the receiver [dB(A)].", 0.0, 200.0),
+    ParamSpec("noise_hysteresis_db", 3.0, "A pass counts towards clearing only below the limit minus this [dB].",
+              0.0, 60.0),
+    ParamSpec("noise_window_passes", 20, "Passes over which noise exceedances are counted [-].", 1, 100_000),
+    ParamSpec("noise_raise_count", 1, "Exceedances in the window that raise the alert [-].", 1, 100_000),
+    ParamSpec("noise_clear_count", 0, "Exceedances in the window at or below which it clears [-].", 0, 100_000),
+    ParamSpec("squeal_min_risk", "medium", "Squeal risk that counts as an occurrence.", choices=RISK_NAMES[1:]),
+    ParamSpec("squeal_window_passes", 200, "Passes over which squeal occurrences are counted [-].", 1, 100_000),
+    ParamSpec("squeal_raise_share", 0.2, "Share of squealing passes in the window that raises the alert [-].",
+              0.0, 1.0),
+    ParamSpec("squeal_clear_share", 0.125, "Share at or below which it clears [-].", 0.0, 1.0),
+    ParamSpec("rejected_window_passes", 100, "TrainPass messages over which rejections are counted [-].",
+              1, 100_000),
+    ParamSpec("rejected_raise_share", 0.05, "Share of rejected messages that raises the alert [-].", 0.0, 1.0),
+    ParamSpec("rejected_clear_share", 0.0, "Share at or below which it clears [-].", 0.0, 1.0),
+)
+
+
+@dataclass(frozen=True)
+class AlertConfig(ParamValues):
+    """The site's alert parameters (names and units as in ALERT_SPECS), with the corrugation lead time."""
+
+
+def alert_config(values: Mapping[str, Any], lead_time_days: float, prefix: str = "alerts.") -> AlertConfig:
+    """Checked alert parameters from flat values (keys under prefix); ConfigError without hysteresis."""
+    out = resolve(ALERT_SPECS, section(values, prefix), where=prefix, strict=True)
+    for name, raise_key, clear_key in (("noise", "noise_raise_count", "noise_clear_count"),
+                                       ("squeal", "squeal_raise_share", "squeal_clear_share"),
+                                       ("rejected", "rejected_raise_share", "rejected_clear_share")):
+        if out[clear_key] >= out[raise_key]:
+            raise ConfigError(f"parameter '{prefix}{clear_key}' must be below '{prefix}{raise_key}' "
+                              f"(the {name} alert needs hysteresis)")
+    if out["noise_raise_count"] > out["noise_window_passes"]:
+        raise ConfigError(f"parameter '{prefix}noise_raise_count' exceeds '{prefix}noise_window_passes'")
+    out["lead_time_days"] = float(lead_time_days)
+    return AlertConfig(out)

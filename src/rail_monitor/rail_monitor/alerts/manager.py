@@ -1,0 +1,231 @@
+"""The standing alerts of a site and the raise/clear events that change them (no ROS).
+
+The rules are in :mod:`rail_monitor.alerts`; thresholds in :mod:`rail_monitor.alerts.config`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.alerts.config import (
+    KIND_GRINDING_DUE,
+    KIND_GRINDING_FORECAST,
+    KIND_INPUT_REJECTED,
+    KIND_NAMES,
+    KIND_NOISE_LIMIT,
+    KIND_SQUEAL,
+    RISK_NAMES,
+    SEVERITY_CRITICAL,
+    SEVERITY_INFO,
+    SEVERITY_WARNING,
+    AlertConfig,
+)
+from rail_monitor.alerts.windows import Window, hysteresis_changes
+from rail_monitor.core.timeutil import format_iso_ns
+
+
+@dataclass(frozen=True)
+class Alert:
+    """One raise or clear (fields and units as in rail_msgs/WaysideAlert; times in ns)."""
+
+    kind: int
+    key: str
+    severity: int
+    active: bool
+    summary: str
+    value: float
+    threshold: float
+    unit: str
+    stamp_ns: int
+    raised_ns: int
+    due_ns: int = 0
+
+
+class AlertManager:
+    """The standing alerts of one site and the raise/clear events that change them."""
+
+    def __init__(self, cfg: AlertConfig) -> None:
+        self.cfg = cfg
+        self.standing: dict[tuple[int, str], Alert] = {}
+        self.events: list[Alert] = []
+        self._noise: dict[str, Window] = {}
+        self._squeal = Window(cfg["squeal_window_passes"])
+        self._rejected = Window(cfg["rejected_window_passes"])
+        self._min_risk = RISK_NAMES.index(cfg["squeal_min_risk"])
+        self._keys: dict[bytes, list[str]] = {}
+
+    # -- raise / clear ----------------------------------------------------------------------------
+    def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
+             threshold: float, unit: str, due_ns: int = 0) -> Alert | None:
+        """Raise or clear (kind, key) if that changes it; return the event or None."""
+        old = self.standing.get((kind, key))
+        if active == (old is not None):
+            if old is not None and due_ns and due_ns != old.due_ns:  # keep a standing forecast current
+                self.standing[(kind, key)] = replace(old, due_ns=due_ns, value=value)
+            return None
+        raised = stamp_ns if active else old.raised_ns
+        event = Alert(kind, key, severity, active, summary, float(value), float(threshold), unit, int(stamp_ns),
+                      int(raised), int(due_ns))
+        if active:
+            self.standing[(kind, key)] = event
+        else:
+            del self.standing[(kind, key)]
+        self.events.append(event)
+        return event
+
+    def _windowed_change(self, active: bool, kind: int, key: str, stamp_ns: int, what: str, threshold_text: str,
+                         unit: str, value: float, threshold: float) -> Alert | None:
+        if active:
+            return self._set(True, kind, key, stamp_ns, SEVERITY_WARNING, f"{what} ({threshold_text})", value,
+                             threshold, unit)
+        return self._set(False, kind, key, stamp_ns, SEVERITY_INFO, f"{what}: cleared", value, threshold, unit)
+
+    def _windowed(self, kind: int, key: str, stamp_ns: np.ndarray, can_raise: np.ndarray, can_clear: np.ndarray,
+                  what: str, threshold_text: Any, unit: str, value: np.ndarray, threshold: float) -> list[Alert]:
+        """A window alert over a series: events only where it changes (threshold_text(i): the text at i)."""
+        out = [self._windowed_change(active, kind, key, int(stamp_ns[i]), what, threshold_text(i), unit,
+                                     float(value[i]), threshold)
+               for i, active in hysteresis_changes((kind, key) in self.standing, can_raise, can_clear)]
+        return [e for e in out if e]
+
+    # -- inputs -----------------------------------------------------------------------------------
+    # Each input takes a series of one stream's messages in order (one message is a series of
+    # length 1): batch mode feeds a whole stream, the node each backlog it takes.
+
+    def _band_change(self, active: bool, key: str, stamp_ns: int, lam: float, z: float, t: float) -> Alert | None:
+        if active:
+            return self._set(True, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_CRITICAL,
+                             f"grinding due: {1e3 * lam:.1f} mm band at {1e6 * z:.2f} um r.m.s., "
+                             f"threshold {1e6 * t:.2f} um", z, t, "m")
+        return self._set(False, KIND_GRINDING_DUE, key, stamp_ns, SEVERITY_INFO,
+                         f"grinding due: {1e3 * lam:.1f} mm band cleared at {1e6 * z:.2f} um r.m.s.", z, t, "m")
+
+    def _forecast_change(self, active: bool, stamp_ns: int, days: float, due_standing: bool,
+                         due_ns: int) -> Alert | None:
+        lead = self.cfg["lead_time_days"]
+        if active:
+            return self._set(True, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_WARNING,
+                             f"grinding forecast in {days:.1f} days, inside the {lead:g}-day lead time",
+                             days, lead, "day", due_ns)
+        why = "grinding is due" if due_standing else f"forecast {days:.1f} days"
+        return self._set(False, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_INFO,
+                         f"grinding forecast cleared: {why}", days, lead, "day")
+
+    def on_states(self, stamp_ns: np.ndarray, wavelength_m: np.ndarray, amplitude_m: np.ndarray,
+                  threshold_m: np.ndarray, days_to_threshold: np.ndarray, grinding_due: np.ndarray,
+                  grinding_due_ns: np.ndarray) -> list[Alert]:
+        """K corrugation states of the same bands, in order (CorrugationState fields): amplitude_m
+        (K, B) [m]; stamp_ns [ns], days_to_threshold [day], grinding_due, grinding_due_ns [ns] (K,);
+        wavelength_m, threshold_m (B,) [m]."""
+        stamps = np.asarray(stamp_ns, np.int64)
+        wl, thr = np.asarray(wavelength_m, float), np.asarray(threshold_m, float)
+        amp = np.asarray(amplitude_m, float).reshape(len(stamps), len(wl))
+        days, due = np.asarray(days_to_threshold, float), np.asarray(grinding_due, bool)
+        due_ns = np.asarray(grinding_due_ns, np.int64)
+        keys = self._band_keys(wl)
+        over = amp >= thr
+        under = ~over & (amp < self.cfg["grinding_clear_fraction"] * thr)
+        changes: list[tuple[int, int, bool]] = []  # (state, band; len(keys) for the forecast, active)
+        up = np.empty(amp.shape, bool)  # band's alert standing after each state
+        for b, key in enumerate(keys):
+            was = (KIND_GRINDING_DUE, key) in self.standing
+            band = hysteresis_changes(was, over[:, b], under[:, b])
+            flips = np.zeros(len(stamps), np.int64)
+            flips[[i for i, _ in band]] = 1
+            up[:, b] = was ^ (np.cumsum(flips) % 2 == 1)
+            changes += [(i, b, active) for i, active in band]
+        others = any(kind == KIND_GRINDING_DUE and k not in keys for kind, k in self.standing)
+        due_standing = up.any(axis=1) | others
+        fkey = (KIND_GRINDING_FORECAST, "forecast")
+        can_raise = due & ~due_standing
+        beyond = days > self.cfg["forecast_clear_factor"] * self.cfg["lead_time_days"]
+        can_clear = ~can_raise & (due_standing | beyond)
+        forecast = hysteresis_changes(fkey in self.standing, can_raise, can_clear)
+        changes += [(i, len(keys), active) for i, active in forecast]
+        events: list[Alert | None] = []
+        for i, b, active in sorted(changes):
+            if b < len(keys):
+                events.append(self._band_change(active, keys[b], int(stamps[i]), float(wl[b]), float(amp[i, b]),
+                                                float(thr[b])))
+            else:
+                events.append(self._forecast_change(active, int(stamps[i]), float(days[i]), bool(due_standing[i]),
+                                                    int(due_ns[i]) if active else 0))
+        # A standing forecast follows each newer due time (_set keeps it current).
+        if fkey in self.standing:
+            since = forecast[-1][0] + 1 if forecast else 0
+            old = self.standing[fkey]
+            seq = since + np.flatnonzero(can_raise[since:] & (due_ns[since:] != 0))
+            prev = np.concatenate([[old.due_ns], due_ns[seq[:-1]]])
+            moved = seq[due_ns[seq] != prev]
+            if len(moved):
+                self.standing[fkey] = replace(old, due_ns=int(due_ns[moved[-1]]), value=float(days[moved[-1]]))
+        return [e for e in events if e]
+
+    def _band_keys(self, wavelength_m: np.ndarray) -> list[str]:
+        """The alert key of each band (its centre wavelength to 0.1 mm), formatted once per set of
+        bands; unique by construction (full precision, then an index, where bands are closer)."""
+        cache_key = wavelength_m.tobytes()
+        keys = self._keys.get(cache_key)
+        if keys is None:
+            if len(self._keys) >= 16:  # bands change only with the site's configuration
+                self._keys.clear()
+            keys = [f"{lam:.4f}m" for lam in wavelength_m.tolist()]
+            if len(set(keys)) < len(keys):
+                keys = [f"{lam!r}m" for lam in wavelength_m.tolist()]
+            if len(set(keys)) < len(keys):
+                keys = [f"{k}#{i}" for i, k in enumerate(keys)]
+            self._keys[cache_key] = keys
+        return keys
+
+    def _noise_what(self, model: str) -> str:
+        return f"{model} {self.cfg['noise_metric'][:-4]} above {self.cfg['noise_limit_dba']:g} dB(A)"
+
+    def on_noise(self, stamp_ns: np.ndarray, model: str, values: Mapping[str, np.ndarray]) -> list[Alert]:
+        """RollingNoise predictions of one source model in order (values: arrays of their single-number
+        fields, at least ``noise_metric``)."""
+        metric, limit = self.cfg["noise_metric"], self.cfg["noise_limit_dba"]
+        level = np.asarray(values[metric], float)
+        w = self._noise.setdefault(model, Window(self.cfg["noise_window_passes"]))
+        over, near, _ = w.push(level > limit, level > limit - self.cfg["noise_hysteresis_db"])
+        n = self.cfg["noise_window_passes"]
+        return self._windowed(KIND_NOISE_LIMIT, model, stamp_ns, over >= self.cfg["noise_raise_count"],
+                              near <= self.cfg["noise_clear_count"], self._noise_what(model),
+                              lambda i: f"{over[i]} of the last {n} passes, this one {level[i]:.1f} dB(A)",
+                              "dB(A)", level, limit)
+
+    def _share(self, w: Window, hits: np.ndarray, kind: int, key: str, stamp_ns: np.ndarray, name: str,
+               what: str, full_window: bool) -> list[Alert]:
+        """A share-of-window alert over a series of hits: raised at ``<name>_raise_share`` of the whole
+        window (only once the window is full, with full_window), cleared at or below
+        ``<name>_clear_share`` of what it holds."""
+        over, near, n = w.push(hits, hits)
+        raise_share, share = self.cfg[f"{name}_raise_share"], over / n
+        raise_at = np.where((n == w.flags.maxlen) | (not full_window), w.flags.maxlen * raise_share, np.inf)
+        return self._windowed(kind, key, stamp_ns, over >= np.maximum(raise_at, 1),
+                              near <= self.cfg[f"{name}_clear_share"] * n, what,
+                              lambda i: f"{over[i]} of the last {n[i]}, {share[i]:.0%}", "-", share,
+                              raise_share)
+
+    def _squeal_what(self) -> str:
+        return f"squeal risk {self.cfg['squeal_min_risk']} or above"
+
+    def on_squeal(self, stamp_ns: np.ndarray, risk: np.ndarray) -> list[Alert]:
+        """SquealPredictions' risks (RISK_*) in order. The window must be full: a share over the
+        first few passes would raise on the first squeal."""
+        return self._share(self._squeal, np.asarray(risk) >= self._min_risk, KIND_SQUEAL, "site",
+                           np.asarray(stamp_ns), "squeal", self._squeal_what(), full_window=True)
+
+    def on_train_passes(self, stamp_ns: np.ndarray, rejected: np.ndarray) -> list[Alert]:
+        """TrainPass messages in order, rejected or not."""
+        return self._share(self._rejected, np.asarray(rejected, bool), KIND_INPUT_REJECTED, "train_pass",
+                           np.asarray(stamp_ns), "rejected", "train passes rejected", full_window=False)
+
+
+def describe(alert: Alert) -> str:
+    """One line for people: pass time, raised/cleared, kind, summary."""
+    verb = "raised " if alert.active else "cleared"
+    return f"{format_iso_ns(alert.stamp_ns)}  {verb}  {KIND_NAMES[alert.kind]:17s} {alert.summary}"

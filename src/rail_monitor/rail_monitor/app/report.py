@@ -1,0 +1,222 @@
+"""The run report: a console summary and a folder of PNG plots with an HTML page, from a recorded bag.
+
+Reads what the graph (or batch mode) recorded: train_pass, noise/squeal, corrugation/state,
+noise/rolling, alerts and speed_advisory, matched by message type, so any namespace works. The
+site file supplies what a bag does not hold: the model curves (squeal against crabbing velocity,
+spectra before and after growth) and the validation of the passes.
+"""
+
+from __future__ import annotations
+
+import html
+from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.alerts.config import KIND_NAMES
+from rail_monitor.alerts.manager import Alert, describe
+from rail_monitor.bagio.messages import alert_from_msg, pass_row, time_ns
+from rail_monitor.bagio.reader import read_messages
+from rail_monitor.core.errors import InputError
+from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.site import site_from_values
+from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns
+
+_TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory")
+_STATE = ("amplitude_m", "threshold_m", "post_grinding_m")
+_STATE_NUMBERS = ("days_to_threshold", "passes_per_day", "worst_band", "pass_count", "total_pass_count")
+
+
+@dataclass
+class RunData:
+    """The recorded outputs of one run, as arrays (units as in the messages)."""
+
+    bag: Path
+    passes: PassTable
+    squeal: dict[str, np.ndarray] = field(default_factory=dict)
+    states: dict[str, np.ndarray] = field(default_factory=dict)
+    noise: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
+    alerts: list[Alert] = field(default_factory=list)
+    advisory: Any = None
+
+
+def load_run(bag: str | Path) -> RunData:
+    """Everything the report needs from a bag (InputError with one line if it cannot be read)."""
+    path = Path(bag)
+    got = read_messages(path, [f"rail_msgs/msg/{n}" for n in _TYPES])
+    rows = [pass_row(m) for m in got["rail_msgs/msg/TrainPass"]]
+    sq, st, nz, al = (got[f"rail_msgs/msg/{n}"] for n in ("SquealPrediction", "CorrugationState", "RollingNoise",
+                                                           "WaysideAlert"))
+    advisories = got["rail_msgs/msg/SpeedAdvisory"]
+    if not rows:
+        raise InputError(f"{path}: no rail_msgs/msg/TrainPass messages: nothing to report")
+    run = RunData(path, PassTable.from_rows(rows))
+    run.squeal = {k: np.array([getattr(m, k) for m in sq]) for k in (
+        "crabbing_velocity_mps", "velocity_amplitude_mps", "risk", "level_dba", "friction_state", "speed_mps")}
+    run.squeal["stamp_ns"] = np.array([time_ns(m.header.stamp) for m in sq], np.int64)
+    if st:
+        run.states = {k: np.array([list(getattr(m, k)) for m in st]) for k in _STATE}
+        run.states.update({k: np.array([getattr(m, k) for m in st]) for k in _STATE_NUMBERS})
+        run.states["wavelength_m"] = np.array(st[-1].wavelength_m)
+        for k in ("stamp", "last_grinding_time", "grinding_due_time"):
+            run.states[k] = np.array([time_ns(getattr(m, k) if k != "stamp" else m.header.stamp) for m in st], np.int64)
+        run.states["grinding_due"] = np.array([m.grinding_due for m in st])
+    for model in sorted({m.model for m in nz}):
+        ms = [m for m in nz if m.model == model]
+        run.noise[model] = {k: np.array([getattr(m, k) for m in ms]) for k in (
+            "lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "speed_mps", "roughness_growth_increase_db")}
+        run.noise[model]["stamp_ns"] = np.array([time_ns(m.header.stamp) for m in ms], np.int64)
+        run.noise[model]["train_id"] = np.array([m.train_id for m in ms], object)
+        run.noise[model]["lp_db"] = np.array([list(m.lp_db) for m in ms])
+        run.noise[model]["band_centre_hz"] = np.array(ms[0].band_centre_hz)
+    run.alerts = sorted((alert_from_msg(m) for m in al), key=lambda a: (a.stamp_ns, a.kind, a.key, a.active))
+    run.advisory = advisories[-1] if advisories else None
+    return run
+
+
+# -- summary ------------------------------------------------------------------------------------
+def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12) -> list[str]:
+    """The console summary of a run."""
+    site = site_from_values(values)
+    p = run.passes
+    reasons = rejection_reasons(p, site)
+    lines = [f"site {site.site_id}: {len(p)} passes from {format_iso_ns(int(p.stamp_ns.min()))} to "
+             f"{format_iso_ns(int(p.stamp_ns.max()))} ({np.ptp(p.stamp_ns) / NS_PER_DAY:.1f} days)"]
+    bad = Counter(r for r in reasons.tolist() if r)
+    lines.append(f"processed {int((reasons == '').sum())}, rejected {sum(bad.values())}"
+                 + "".join(f"; {n} {why}" for why, n in bad.most_common(3)))
+    raised = [a for a in run.alerts if a.active]
+    lines.append(f"alerts: {len(raised)} raised, {len(run.alerts) - len(raised)} cleared"
+                 + (", by kind: " + ", ".join(f"{KIND_NAMES[k]} {n}" for k, n in
+                                             sorted(Counter(a.kind for a in raised).items())) if raised else ""))
+    lines += ["  " + describe(a) for a in run.alerts[:max_alerts]]
+    if len(run.alerts) > max_alerts:
+        lines.append(f"  ... and {len(run.alerts) - max_alerts} more (alerts topic, report page)")
+    lines += _grinding_lines(run)
+    for model, nz in run.noise.items():
+        top = np.argsort(-nz["lpaeq_tp_dba"], kind="stable")[:3]
+        cls = dict(zip(p.train_id.tolist(), p.vehicle_class.tolist(), strict=True))
+        lines.append(f"loudest passes ({model}, LpAeq,Tp / LpAFmax at the receiver):")
+        lines += [f"  {format_iso_ns(int(nz['stamp_ns'][i]))}  {nz['train_id'][i]:12s} "
+                  f"{cls.get(nz['train_id'][i], ''):8s}"
+                  f" {nz['speed_mps'][i]:5.1f} m/s  {nz['lpaeq_tp_dba'][i]:5.1f} / {nz['lpafmax_dba'][i]:5.1f} dB(A)"
+                  for i in top]
+    risk = run.squeal.get("risk", np.zeros(0, int))
+    if len(risk):
+        counts = np.bincount(risk.astype(int), minlength=4)
+        lines.append(f"squeal: {int((risk > 0).sum())} of {len(risk)} passes unstable; risk low {counts[1]}, "
+                     f"medium {counts[2]}, high {counts[3]}; loudest {np.max(run.squeal['level_dba']):.1f} dB(A)")
+    return lines
+
+
+def _grinding_lines(run: RunData) -> list[str]:
+    s = run.states
+    if not s:
+        return ["corrugation: no state recorded"]
+    w = int(s["worst_band"][-1])
+    amp, thr = s["amplitude_m"][-1, w], s["threshold_m"][-1, w]
+    lam = s["wavelength_m"][w]
+    days = float(s["days_to_threshold"][-1])
+    due = int(s["grinding_due_time"][-1])
+    when = format_iso_ns(due)[:10] if due else "beyond 2038"
+    head = "GRINDING DUE" if s["grinding_due"][-1] else "grinding forecast"
+    text = (f"{head}: worst band {1e3 * lam:.1f} mm at {1e6 * amp:.2f} um r.m.s. of its {1e6 * thr:.2f} um "
+            f"threshold; reached in {days:.0f} days ({when}) at {s['passes_per_day'][-1]:.0f} passes/day"
+            if np.isfinite(days) else f"{head}: no band grows towards its threshold")
+    grindings = sorted(set(s["last_grinding_time"].tolist()) - {0})
+    return [text] + ([f"grinding events: {', '.join(format_iso_ns(g)[:10] for g in grindings)}"] if grindings else [])
+
+
+# -- report folder ------------------------------------------------------------------------------
+def build_report(run: RunData, values: Mapping[str, Any], out_dir: str | Path) -> list[Path]:
+    """Write the PNG plots and index.html into out_dir; returns the files written."""
+    from rail_monitor.app import plots
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    site = site_from_values(values)
+    files = []
+    if run.states:
+        files.append(plots.corrugation_history(run.states, out / "corrugation.png"))
+    if run.noise:
+        before, after = _spectra(run, values)
+        files.append(plots.noise_history(run.noise, before, after, out / "noise.png"))
+    if len(run.squeal.get("risk", ())):
+        files.append(plots.squeal_passes(run.squeal, _squeal_curves(run, values), out / "squeal.png"))
+    files.append(plots.speed_distribution(run.passes.speed_mps, run.advisory, out / "speeds.png"))
+    page = out / "index.html"
+    page.write_text(_html(run, summary_lines(run, values, max_alerts=10**6), files, site.site_id), encoding="utf-8")
+    return [*files, page]
+
+
+def _reference_pass(run: RunData, values: Mapping[str, Any]) -> PassTable:
+    """The most common class at its median recorded speed, with its nominal consist."""
+    site = site_from_values(values)
+    names, counts = np.unique(run.passes.vehicle_class.astype(str), return_counts=True)
+    cls = str(names[np.argmax(counts)])
+    rows = run.passes.vehicle_class == cls
+    row = run.passes.take(np.flatnonzero(rows)[:1]).row(0)
+    row.update(speed_mps=float(np.median(run.passes.speed_mps[rows])), axle_count=0, train_length_m=0.0,
+               wheel_load_n=0.0, train_id="reference")
+    return with_class_defaults(PassTable.from_rows([row]), site)
+
+
+def _spectra(run: RunData, values: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """A-weighted 1/3-octave spectra of the reference pass on the post-grinding and the final rail."""
+    from rail_monitor.noise.config import noise_config
+    from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+
+    ref = _reference_pass(run, values)
+    model = RollingNoiseModel(site_from_values(values), noise_config(values))
+    before: dict[str, Any] = {"label": f"{ref.vehicle_class[0]} at {ref.speed_mps[0]:.1f} m/s"}
+    after: dict[str, Any] = {}
+    s = run.states
+    for name in model.models:
+        if s:
+            corr = Corrugation(s["wavelength_m"], s["amplitude_m"][-1], s["post_grinding_m"][-1])
+            post = Corrugation(s["wavelength_m"], s["post_grinding_m"][-1], s["post_grinding_m"][-1])
+            before[name] = model.predict(ref, name, post)
+            after[name] = model.predict(ref, name, corr)
+        else:
+            before[name] = after[name] = model.predict(ref, name)
+    return before, after
+
+
+def _squeal_curves(run: RunData, values: Mapping[str, Any]) -> dict[str, Any]:
+    """Amplitude against crabbing velocity for the reference pass, per friction state."""
+    from rail_monitor.squeal.config import squeal_config
+    from rail_monitor.squeal.whatif import site_case, sweep
+
+    ref = _reference_pass(run, values)
+    site = site_from_values(values)
+    cfg = squeal_config(values)
+    top = max(float(np.max(run.squeal["crabbing_velocity_mps"], initial=0.0)) * 1.1, 0.05)
+    vc = np.linspace(0.0, top, 200)
+    curves = {"label": f"{ref.vehicle_class[0]} at {ref.speed_mps[0]:.1f} m/s"}
+    for state, name in FRICTION_NAMES.items():
+        case = site_case(cfg, site, str(ref.vehicle_class[0]), state, float(ref.speed_mps[0]))
+        curves[name] = sweep(case, vc)
+    return curves
+
+
+def _html(run: RunData, summary: list[str], files: list[Path], site_id: str) -> str:
+    imgs = "\n".join(f'<figure><img src="{f.name}" alt="{f.stem}"><figcaption>{f.stem}</figcaption></figure>'
+                     for f in files)
+    rows = "\n".join(f"<tr><td>{format_iso_ns(a.stamp_ns)}</td><td>{'raised' if a.active else 'cleared'}</td>"
+                     f"<td>{KIND_NAMES[a.kind]}</td><td>{html.escape(a.key)}</td><td>{html.escape(a.summary)}</td></tr>"
+                     for a in run.alerts)
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>rail_monitor report: {html.escape(site_id)}</title>
+<style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}} img{{max-width:100%}}
+table{{border-collapse:collapse}} td{{border:1px solid #ccc;padding:2px 6px;font-size:90%}}</style></head>
+<body><h1>rail_monitor report: {html.escape(site_id)}</h1>
+<p>From {html.escape(str(run.bag))}.</p>
+<pre>{html.escape(chr(10).join(summary))}</pre>
+{imgs}
+<h2>Alerts</h2><table><tr><th>pass time</th><th></th><th>kind</th><th>key</th><th>summary</th></tr>
+{rows}</table></body></html>
+"""

@@ -1,0 +1,53 @@
+"""The graph's recorded topics: name (relative to the site namespace), message type and the QoS
+its publisher offers, as plain data (the nodes make rclpy profiles of them, batch mode writes
+them into its bag's metadata)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from rail_monitor.bagio.mcap_bag import qos_dict
+
+
+@dataclass(frozen=True)
+class Qos:
+    """A QoS profile: reliable or best effort, transient local or volatile, KEEP_LAST depth."""
+
+    depth: int
+    reliable: bool = True
+    transient_local: bool = False
+
+    def as_metadata(self) -> dict[str, Any]:
+        """The profile in rosbag2's metadata layout."""
+        return qos_dict(reliable=self.reliable, transient_local=self.transient_local, depth=self.depth)
+
+
+# Pass events and model outputs: reliable. Publishers keep 1000; subscribers queue 10000 so a
+# burst waits rather than drops (KEEP_ALL readers would give DDS-level backpressure, but Fast
+# DDS's stalled at about 5,100 samples here).
+STREAM = Qos(1000)
+STREAM_SUB = Qos(10000)
+# A state whose latest value is what matters (speed advisory, the standing alerts): a late
+# subscriber (a dashboard started later) gets the current one at once.
+LATEST = Qos(1, transient_local=True)
+# The corrugation state: every state matters to the noise predictor, the alert manager and the
+# recorder (each takes them all, in order), and the estimator publishes a backlog's states in one
+# burst. A reliable KEEP_LAST writer overwrites samples not yet delivered once its history is full,
+# so at depth 1 a burst over UDP lost states. Latched too: a late subscriber gets the recent states.
+STATE = Qos(1000, transient_local=True)
+STATE_SUB = Qos(10000, transient_local=True)
+# Rare events that must not be lost (roughness surveys, grinding events).
+EVENT = Qos(100)
+# Alert raise/clear events: reliable and latched, deep enough that a late subscriber gets the
+# recent history; the standing set is on alerts/standing (LATEST).
+ALERT = Qos(1000, transient_local=True)
+DIAGNOSTICS = Qos(100)
+CLOCK = Qos(10)
+
+GRAPH_TOPICS: dict[str, tuple[str, Qos]] = {
+    "train_pass": ("rail_msgs/msg/TrainPass", STREAM), "noise/squeal": ("rail_msgs/msg/SquealPrediction", STREAM),
+    "corrugation/state": ("rail_msgs/msg/CorrugationState", STATE),
+    "noise/rolling": ("rail_msgs/msg/RollingNoise", STREAM), "alerts": ("rail_msgs/msg/WaysideAlert", ALERT),
+    "alerts/standing": ("rail_msgs/msg/WaysideAlertArray", LATEST),
+    "speed_advisory": ("rail_msgs/msg/SpeedAdvisory", LATEST)}

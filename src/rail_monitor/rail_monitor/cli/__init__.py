@@ -1,0 +1,52 @@
+"""rail-monitor: the command line (simulate, info, replay, record, monitor, demo, batch, report, predict).
+
+One module per verb: its arguments, a call into the package's functions (what-ifs, batch mode,
+the report, the nodes), and the printing. Node options are generated from the same ParamSpecs
+the nodes declare, so --help shows every unit, range and default; they become
+``-p name:=value`` ROS arguments. Errors the user can act on are one line on stderr and exit
+code 2. :func:`main` takes the arguments and returns the exit code, so the command line is
+callable in-process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from rail_monitor.cli import batch, graph, info, predict_corrugation, predict_noise, predict_squeal, report, simulate
+from rail_monitor.core.errors import RailMonitorError
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="rail-monitor", description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    sub = p.add_subparsers(dest="command", required=True)
+    simulate.add_parser(sub)
+    info.add_parser(sub)
+    graph.add_parsers(sub)
+    s = sub.add_parser("predict", help="run one model on physical inputs")
+    models = s.add_subparsers(dest="model", required=True)
+    for verb in (predict_squeal, predict_corrugation, predict_noise):
+        verb.add_parser(models)
+    batch.add_parser(sub)
+    report.add_parser(sub)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line on argv (default: sys.argv[1:]); returns the exit code."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # Anything from --ros-args on goes to the nodes untouched (e.g. -p executor:=events).
+    cut = argv.index("--ros-args") if "--ros-args" in argv else len(argv)
+    ns = build_parser().parse_args(argv[:cut])
+    ns.ros_extra = argv[cut:]
+    try:
+        return ns.func(ns)
+    except RailMonitorError as exc:
+        print(f"rail-monitor: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,109 @@
+"""What every verb of the command line shares: the site option, node parameters as options,
+ROS arguments, output folders, the run summary and report, JSON output."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shutil
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.params import ParamSpec
+
+SALVAGE_HELP = ("read every complete chunk of an MCAP file cut off mid-write (a killed recorder, a full disk) "
+                "and say how many messages it recovered")
+
+
+def site_file(path: str | None) -> Path:
+    """The site parameter file given, or the shipped curve_250.yaml."""
+    if path:
+        return Path(path)
+    from ament_index_python.packages import get_package_share_directory
+
+    return Path(get_package_share_directory("rail_monitor")) / "config" / "curve_250.yaml"
+
+
+def site_values(path: str | None) -> dict[str, Any]:
+    """The flat parameter values of the site file given (or the shipped one), every name checked."""
+    from rail_monitor.site_file import load_parameter_file
+
+    return load_parameter_file(site_file(path))
+
+
+def add_site_option(parser: argparse.ArgumentParser, what: str = "site parameter file") -> None:
+    parser.add_argument("--site", help=f"{what} (default: the shipped curve_250.yaml)")
+
+
+def add_specs(parser: argparse.ArgumentParser, specs: Sequence[ParamSpec], skip: Sequence[str] = ()) -> None:
+    """An option per node parameter (name, unit, range and default from its spec)."""
+    group = parser.add_argument_group("node parameters (ROS 2 parameter in brackets)")
+    for s in specs:
+        if s.name in skip:
+            continue
+        flag = "--" + s.name.replace("_", "-").replace(".", "-")
+        extra = f" {s.range_text()}" if (s.low is not None or s.high is not None or s.choices) else ""
+        kw: dict = {"dest": "p:" + s.name, "default": None, "metavar": s.kind.__name__.upper(),
+                    "help": f"{s.description}{extra} default: {s.default!r} [{s.name}]"}
+        if isinstance(s.default, list):
+            kw["nargs"] = "*"
+        if s.kind is bool:
+            kw.update(action=argparse.BooleanOptionalAction, metavar=None)
+        else:
+            kw["type"] = s.kind
+        group.add_argument(flag, **kw)
+
+
+def _ros_value(v: object) -> str:
+    """A parameter value in ROS 2 command-line YAML."""
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, list):
+        return "[" + ",".join(f"'{x}'" if isinstance(x, str) else repr(x) for x in v) + "]"
+    if isinstance(v, str):
+        return f"'{v}'" if v else "''"
+    return repr(v)
+
+
+def ros_args(ns: argparse.Namespace, site: Path | None, extra: dict[str, object]) -> list[str]:
+    """argv for rclpy.init: the site file, the namespace, and -p for every option given."""
+    values = {k[2:]: v for k, v in vars(ns).items() if k.startswith("p:") and v is not None}
+    values.update({k: v for k, v in extra.items() if v is not None})
+    args = ["rail-monitor", *getattr(ns, "ros_extra", []), "--ros-args"]
+    if site is not None:
+        args += ["--params-file", str(site)]
+    if getattr(ns, "namespace", None):
+        args += ["-r", f"__ns:=/{ns.namespace.strip('/')}"]
+    for name, v in values.items():
+        args += ["-p", f"{name}:={_ros_value(v)}"]
+    return args
+
+
+def fresh_output(path: Path, overwrite: bool) -> None:
+    """Make room for an output folder: remove it with overwrite, else refuse to touch it."""
+    if path.exists():
+        if not overwrite:
+            raise RailMonitorError(f"{path} exists; remove it or pass --overwrite")
+        shutil.rmtree(path)
+
+
+def report_dir(bag: str, report: str | None) -> Path:
+    return Path(report) if report else Path(f"{str(bag).rstrip('/')}_report")
+
+
+def print_report(bag: str, site: str | None, report: str | None) -> None:
+    """Print the run summary and write the report folder."""
+    from rail_monitor.app.report import build_report, load_run, summary_lines
+
+    values = site_values(site)
+    run = load_run(bag)
+    print("\n".join(summary_lines(run, values)))
+    files = build_report(run, values, report_dir(bag, report))
+    print(f"report: {files[-1]} ({len(files) - 1} plots)")
+
+
+def print_json(data: Any) -> None:
+    """Print data as JSON (objects JSON does not know as null)."""
+    print(json.dumps(data, indent=1, default=lambda x: None))

@@ -1,0 +1,99 @@
+"""rail-monitor predict corrugation: growth per wavelength band, time to the grinding threshold,
+and speed advice, for a history or a speed distribution."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from rail_monitor.cli.common import add_site_option, print_json, site_values
+
+
+def add_parser(models: argparse._SubParsersAction) -> None:
+    from rail_monitor.core.passes import FRICTION_BY_NAME
+
+    c = models.add_parser("corrugation", help="corrugation growth per wavelength band, time to the grinding "
+                          "threshold, and speed advice", formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    add_site_option(c)
+    g = c.add_mutually_exclusive_group()
+    g.add_argument("--history", help="pass history (bag folder, .mcap, .db3 or .csv): state, speeds and traffic "
+                   "from it")
+    g.add_argument("--speeds", type=float, nargs="+", help="speed histogram bin centres [m/s]")
+    c.add_argument("--weights", type=float, nargs="+", help="weights of --speeds (default: equal)")
+    c.add_argument("--vehicle-class", help="vehicle class without --history (default: the site's first)")
+    c.add_argument("--speed-mean", type=float, help="mean speed of a normal distribution [m/s] (default: the class's)")
+    c.add_argument("--speed-cv", type=float, help="its coefficient of variation [-] (default: the class's sd/mean)")
+    c.add_argument("--friction", choices=tuple(FRICTION_BY_NAME),
+                   help="friction state (default: dry, or the history's mix)")
+    c.add_argument("--passes-per-day", type=float, help="train passes per day (default: the history's)")
+    c.add_argument("--advise", action="store_true", help="also propose a speed distribution with the same mean")
+    c.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    c.add_argument("--plot-receptance", metavar="PNG", help="save the track and wheel receptances to this PNG")
+    c.add_argument("--plot-growth", metavar="PNG", help="save growth against wavelength (current and advised)")
+    c.set_defaults(func=run)
+
+
+def run(ns: argparse.Namespace) -> int:
+    from rail_monitor.corrugation.whatif import predict_corrugation, summary
+
+    values = site_values(ns.site)
+    history = None
+    if ns.history:
+        from rail_monitor.bagio.reader import read_passes
+
+        history = read_passes(Path(ns.history))
+    r = predict_corrugation(values, history, ns.history or "", ns.speeds, ns.weights, ns.vehicle_class,
+                            ns.speed_mean, ns.speed_cv, ns.friction, ns.passes_per_day, ns.advise)
+    data = summary(r)
+    if ns.json:
+        print_json(data)
+    else:
+        _print_table(r, data)
+    if ns.plot_receptance:
+        _plot_receptance(r, ns.plot_receptance)
+    if ns.plot_growth:
+        _plot_growth(r, ns.plot_growth)
+    return 0
+
+
+def _print_table(r, data: dict) -> None:
+    est, ev, fc, advice = r.estimator, r.evaluation, r.forecast, r.advice
+    print(f"# {r.where}; K_b {', '.join(f'{k:.3g}' for k in est.k_b)} (dry, wet, modifier, contaminated)")
+    print(f"{'lambda [mm]':>11} {'g [1/axle]':>11} {'Z [um]':>8} {'limit [um]':>10}")
+    for b in data["bands"]:
+        print(f"{1e3 * b['wavelength_m']:11.1f} {b['growth_per_axle_pass']:11.3e} {1e6 * b['amplitude_m']:8.3f} "
+              f"{1e6 * b['threshold_m']:10.3f}")
+    print(f"peak g {ev.peak_growth:.3e} per axle pass at {1e3 * ev.peak_wavelength_m:.1f} mm; worst band "
+          f"{1e3 * est.bands[fc.worst_band]:.1f} mm reaches its limit in {fc.passes_to_threshold:.4g} train passes"
+          f" = {fc.days_to_threshold:.4g} days at {fc.passes_per_day:.4g} passes/day")
+    if advice is not None:
+        used = advice.recommended_probability > 1e-6
+        mix = zip(advice.speed_bin_centres_mps[used], advice.recommended_probability[used], strict=True)
+        factor = advice.grinding_interval_factor
+        print(f"advice: same mean {advice.mean_speed_mps:.2f} m/s, speeds "
+              + ", ".join(f"{v:.2f} ({100 * p:.0f} %)" for v, p in mix)
+              + f"; peak growth -{100 * advice.peak_growth_reduction:.0f} %, grinding interval x{factor:.2f}, "
+              f"grinding cost -{100 * (1 - 1 / factor):.0f} %")
+
+
+def _plot_receptance(r, path: str) -> None:
+    from rail_monitor.app.plots import track_receptance
+    from rail_monitor.corrugation.whatif import receptance_curves
+
+    site = r.estimator.site
+    f, curves = receptance_curves(site)
+    print(f"plot: {track_receptance(f, curves, path, title=f'track of {site.site_id}')}", file=sys.stderr)
+
+
+def _plot_growth(r, path: str) -> None:
+    from rail_monitor.app.plots import corrugation_growth
+    from rail_monitor.corrugation.advice import evaluate
+
+    curves = {"current speeds": r.evaluation.growth_per_axle_pass}
+    if r.advice is not None:
+        curves["advised speeds"] = evaluate(r.estimator, r.advice.speed_bin_centres_mps,
+                                            r.advice.recommended_probability, r.friction_state).growth_per_axle_pass
+    print(f"plot: {corrugation_growth(r.estimator.bands, curves, path, title=r.where)}", file=sys.stderr)
+
+

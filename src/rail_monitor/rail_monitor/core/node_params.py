@@ -1,0 +1,106 @@
+"""Parameters of the graph's nodes that belong to no model: pass sources, the recorder, the
+one-process graph, batching, checkpoints.
+
+Pure specs (no rclpy), so the site-file check (:mod:`rail_monitor.site_file`), the command
+line's options and the nodes share one list of names, units and ranges.
+"""
+
+from __future__ import annotations
+
+from rail_monitor.core.params import ParamSpec
+from rail_monitor.core.site import SITE_ID
+
+# Pass sources (pass_replayer, pass_simulator): what they publish and how fast.
+PUBLISH_SPECS: tuple[ParamSpec, ...] = (
+    SITE_ID,  # header.frame_id of every pass
+    ParamSpec("rate", 0.0, "Replay speed: 0 as fast as the graph takes it, 1 recorded timing, "
+              "k k-times faster [-].", 0.0, 1.0e9),
+    ParamSpec("start_offset_s", 0.0, "Skip passes earlier than the first pass plus this [s].", 0.0, 1.0e10),
+    ParamSpec("end_offset_s", 0.0, "Stop after the first pass plus this; 0: to the end [s].", 0.0, 1.0e10),
+    ParamSpec("publish_clock", True, "Publish /clock with pass time (nodes use use_sim_time)."),
+    ParamSpec("clock_period_s", 0.1, "Wall time between /clock ticks while waiting for the next pass [s].",
+              0.001, 60.0),
+    ParamSpec("wait_for_subscribers", 0, "Wait for this many train_pass subscribers before starting [-].", 0, 1000),
+    ParamSpec("wait_timeout_s", 30.0, "Give up waiting for subscribers after this [s].", 0.0, 3600.0),
+    ParamSpec("ack_batch", 100, "Passes published between flow-control checks (below the publisher's "
+              "QoS depth of 1000) [-].", 1, 999),
+    ParamSpec("ack_timeout_s", 60.0, "Longest wait for subscribers to catch up before the replay fails [s].",
+              0.1, 3600.0),
+    ParamSpec("max_backlog", 2000, "In one process: most passes published but not yet taken by the slowest "
+              "hosted subscriber (below their queue of 10000) [-].", 1, 9000),
+    ParamSpec("progress", True, "Show a progress bar on stderr."),
+)
+
+
+# pass_replayer: where the history comes from.
+SOURCE = ParamSpec("source", "", "History to replay: a bag folder, an .mcap or .db3 file, or a .csv export.")
+REPLAYER_SPECS: tuple[ParamSpec, ...] = (
+    SOURCE,
+    ParamSpec("source_topic", "", "TrainPass topic in the bag; empty: its only TrainPass topic."),
+    ParamSpec("skip_bad_rows", False, "CSV: leave malformed rows out (counted) instead of failing."),
+    ParamSpec("salvage", False, "MCAP: read the passes in every complete chunk of a file cut off mid-write "
+              "(a killed recorder, a full disk) instead of failing."),
+)
+
+
+# pass_simulator: publish into the graph or write a bag.
+MODE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("mode", "publish", "publish: into the graph; bag: write a bag at 'output' and exit.",
+              choices=("publish", "bag")),
+    ParamSpec("output", "", "Bag folder to write in mode 'bag' (must not exist)."),
+)
+
+
+# mcap_recorder.
+RECORDER_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("output", "", "Bag folder to create; empty: rail_monitor_<UTC time> in the working folder."),
+    ParamSpec("topics", [""], "Topics to record (absolute or relative to the namespace); empty: every "
+              "rail_msgs topic and /diagnostics."),
+    ParamSpec("compression", "zstd", "Chunk compression.", choices=("zstd", "none")),
+    ParamSpec("chunk_size", 1 << 20, "Uncompressed bytes of messages per chunk [bytes].", 1024, 1 << 30),
+    ParamSpec("max_bag_size", 0, "Start a new file past this size; 0: never [bytes].", 0, 1 << 50),
+    ParamSpec("max_bag_duration_s", 0.0, "Start a new file past this span of log time; 0: never [s].", 0.0, 1.0e9),
+    ParamSpec("flush_period_s", 5.0, "Close the open chunk at least this often (bounds loss on a kill) [s].",
+              0.0, 3600.0),
+    ParamSpec("log_time", "header", "Log time of a message: header = its header.stamp (pass time; messages "
+              "without a header take the node clock), receive = the node clock at receipt, as rosbag2 does.",
+              choices=("header", "receive")),
+    ParamSpec("discovery_period_s", 0.2, "How often to look for new topics [s].", 0.01, 60.0),
+)
+
+
+# wayside_monitor: the one-process graph.
+MONITOR_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("record", True, "Host an mcap_recorder for every output topic."),
+    ParamSpec("drain_timeout_s", 60.0, "After the replay, wait at most this for the recorder to catch up [s].",
+              0.0, 3600.0),
+    ParamSpec("executor", "single_threaded", "Executor hosting the nodes: single_threaded, or multi_threaded "
+              "(like a component container; measured 30x slower here on the sample: rclpy's thread pool costs more "
+              "than it gains for Python callbacks under the GIL).", choices=("single_threaded", "multi_threaded")),
+    ParamSpec("threads", 4, "Threads of the multi_threaded executor [-].", 1, 64),
+)
+
+
+# Every node that takes train_pass.
+BATCH_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("max_batch", 200, "Most queued train passes a callback takes and handles at once (1: one by one) [-].",
+              1, 10_000),
+)
+
+
+# corrugation_estimator: checkpoints and publishing periods.
+ESTIMATOR_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("checkpoint_path", "", "File the state is checkpointed to and resumed from ('' : none)."),
+    ParamSpec("checkpoint_every_passes", 100, "Counted passes between checkpoints (checked after each "
+              "callback's passes: a backlog taken at once is checkpointed at its end) [-].", 1, 10**9),
+    ParamSpec("state_period_s", 0.0, "Least wall time between corrugation/state messages [s] (0: every pass).",
+              0.0, 86_400.0),
+    ParamSpec("advisory_period_s", 60.0, "Wall time between speed advisories [s].", 0.01, 86_400.0),
+)
+
+
+# rolling_noise_predictor: waiting for the corrugation state of a pass.
+PREDICTOR_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("state_wait_s", 5.0, "Longest wall time a pass waits for the corrugation state that includes it; "
+              "0: take the latest state at once [s].", 0.0, 3600.0),
+)

@@ -1,0 +1,181 @@
+"""Train passes as a columnar table (numpy arrays), and their validation.
+
+The same table feeds the live graph (one row per TrainPass message), batch mode (whole arrays)
+and the bag and CSV readers and writers, so every path shares one validation and one set of
+defaults. Field names, units and enumeration values mirror ``rail_msgs/msg/TrainPass``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar
+
+import numpy as np
+
+from rail_monitor.core.site import Site
+
+# TrainPass.FRICTION_* values and their names in CSV files and site parameters.
+FRICTION_UNSET, FRICTION_DRY, FRICTION_WET, FRICTION_MODIFIER, FRICTION_CONTAMINATED = range(5)
+FRICTION_NAMES: dict[int, str] = {
+    FRICTION_DRY: "dry",
+    FRICTION_WET: "wet",
+    FRICTION_MODIFIER: "friction_modifier",
+    FRICTION_CONTAMINATED: "contaminated",
+}
+FRICTION_BY_NAME: dict[str, int] = {v: k for k, v in FRICTION_NAMES.items()}
+
+# Plausibility limits that separate a malformed event from an unusual pass.
+MAX_SPEED_MPS = 120.0           # above any line speed at a curve
+MIN_SPEED_MPS = 1.0             # below a walking pace: not a rolling pass (the models divide by the speed)
+MIN_WHEEL_LOAD_N = 5.0e3        # half a tonne per wheel, under any empty vehicle (0 still means nominal)
+MIN_TRAIN_LENGTH_M = 5.0        # shorter than any rail vehicle (0 still means from the class)
+MAX_ANGLE_OF_ATTACK_RAD = 0.1   # 100 mrad: far past flange contact for any bogie
+MAX_WHEEL_LOAD_N = 3.0e5        # 30 t axle load is about 147 kN per wheel
+MAX_TRAIN_LENGTH_M = 5000.0
+MAX_VEHICLE_COUNT = 500         # record heavy-haul trains run about 300 wagons in 3 km
+MAX_AXLE_COUNT = 4 * MAX_VEHICLE_COUNT
+
+
+@dataclass
+class PassTable:
+    """Columns of train passes; row i of every column is one pass (units as in TrainPass).
+
+    stamp_ns is the pass time in nanoseconds since the Unix epoch (UTC).
+    """
+
+    stamp_ns: np.ndarray              # int64 [ns]
+    train_id: np.ndarray              # str (object)
+    vehicle_class: np.ndarray         # str (object)
+    vehicle_count: np.ndarray         # int64 [-]
+    axle_count: np.ndarray            # int64 [-]
+    speed_mps: np.ndarray             # float64 [m/s]
+    angle_of_attack_rad: np.ndarray   # float64 [rad]
+    wheel_load_n: np.ndarray          # float64 [N]
+    friction_state: np.ndarray        # int64, FRICTION_*
+    train_length_m: np.ndarray        # float64 [m]
+
+    DTYPES: ClassVar[dict[str, type]] = {
+        "stamp_ns": np.int64, "train_id": object, "vehicle_class": object, "vehicle_count": np.int64,
+        "axle_count": np.int64, "speed_mps": np.float64, "angle_of_attack_rad": np.float64,
+        "wheel_load_n": np.float64, "friction_state": np.int64, "train_length_m": np.float64,
+    }
+
+    def __post_init__(self) -> None:
+        n = None
+        for f in fields(self):
+            col = np.asarray(getattr(self, f.name), dtype=self.DTYPES[f.name])
+            if col.ndim != 1 or (n is not None and len(col) != n):
+                raise ValueError(f"column {f.name} must be 1-D with the same length as the others")
+            n = len(col)
+            setattr(self, f.name, col)
+
+    @classmethod
+    def columns(cls) -> list[str]:
+        """The column names, in TrainPass field order."""
+        return [f.name for f in fields(cls)]
+
+    @classmethod
+    def empty(cls) -> PassTable:
+        return cls(**{name: [] for name in cls.columns()})
+
+    @classmethod
+    def from_rows(cls, rows: Iterable[Mapping[str, Any]]) -> PassTable:
+        """Build a table from row mappings keyed by column name."""
+        rows = list(rows)
+        return cls(**{name: [r[name] for r in rows] for name in cls.columns()})
+
+    @classmethod
+    def concat(cls, tables: Sequence[PassTable]) -> PassTable:
+        """The rows of the tables, one after the other."""
+        return cls(**{name: np.concatenate([getattr(t, name) for t in tables]) for name in cls.columns()})
+
+    def __len__(self) -> int:
+        return len(self.stamp_ns)
+
+    def row(self, i: int) -> dict[str, Any]:
+        """Row i as a dict of Python scalars."""
+        return {name: getattr(self, name)[i].item() if name not in ("train_id", "vehicle_class")
+                else str(getattr(self, name)[i]) for name in self.columns()}
+
+    def take(self, index: np.ndarray | Sequence[int] | slice) -> PassTable:
+        """The rows selected by a boolean mask, an index array or a slice."""
+        return PassTable(**{name: getattr(self, name)[index] for name in self.columns()})
+
+    def sorted(self) -> PassTable:
+        """The rows in time order (stable, so equal stamps keep their order)."""
+        return self.take(np.argsort(self.stamp_ns, kind="stable"))
+
+    def equals(self, other: PassTable) -> bool:
+        """True when every column is equal element by element (NaN equal to NaN)."""
+        return len(self) == len(other) and all(
+            np.array_equal(getattr(self, n), getattr(other, n), equal_nan=getattr(self, n).dtype.kind == "f")
+            for n in self.columns()
+        )
+
+
+def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
+    """Why each pass is unusable: an array of strings, '' where the pass is valid.
+
+    The first failing check names the reason. With a site, the vehicle class must be in its
+    rolling-stock table. Checks are vectorised; the table is not modified.
+    """
+    n = len(table)
+    reasons = np.full(n, "", dtype=object)
+
+    def flag(bad: np.ndarray, why: str) -> None:
+        reasons[(reasons == "") & bad] = why
+
+    stripped = np.array([s.strip() for s in table.train_id], dtype=object)
+    flag(table.stamp_ns <= 0, "stamp not set")
+    flag(stripped == "", "empty train_id")
+    flag(np.array([len(s) > 64 for s in table.train_id], dtype=bool), "train_id longer than 64 characters")
+    flag(~np.isfinite(table.speed_mps), "speed_mps not finite")
+    flag(table.speed_mps <= 0.0, "speed_mps not positive")
+    flag(table.speed_mps < MIN_SPEED_MPS, f"speed_mps below {MIN_SPEED_MPS:g} m/s")
+    flag(table.speed_mps > MAX_SPEED_MPS, f"speed_mps above {MAX_SPEED_MPS:g} m/s")
+    flag(~np.isfinite(table.angle_of_attack_rad), "angle_of_attack_rad not finite")
+    flag(np.abs(table.angle_of_attack_rad) > MAX_ANGLE_OF_ATTACK_RAD,
+         f"|angle_of_attack_rad| above {MAX_ANGLE_OF_ATTACK_RAD:g} rad")
+    flag(~np.isfinite(table.wheel_load_n), "wheel_load_n not finite")
+    flag(table.wheel_load_n < 0.0, "wheel_load_n negative")
+    flag((table.wheel_load_n > 0.0) & (table.wheel_load_n < MIN_WHEEL_LOAD_N),
+         f"wheel_load_n below {MIN_WHEEL_LOAD_N:g} N (0: the class's nominal load)")
+    flag(table.wheel_load_n > MAX_WHEEL_LOAD_N, f"wheel_load_n above {MAX_WHEEL_LOAD_N:g} N")
+    flag(~np.isin(table.friction_state, list(FRICTION_NAMES)), "friction_state unknown")
+    flag((table.axle_count == 0) & (table.vehicle_count == 0), "neither axle_count nor vehicle_count set")
+    flag(table.vehicle_count > MAX_VEHICLE_COUNT, f"vehicle_count above {MAX_VEHICLE_COUNT}")
+    flag(table.axle_count > MAX_AXLE_COUNT, f"axle_count above {MAX_AXLE_COUNT}")
+    flag(~np.isfinite(table.train_length_m), "train_length_m not finite")
+    flag(table.train_length_m < 0.0, "train_length_m negative")
+    flag((table.train_length_m > 0.0) & (table.train_length_m < MIN_TRAIN_LENGTH_M),
+         f"train_length_m below {MIN_TRAIN_LENGTH_M:g} m (0: from the counts and the class)")
+    flag(table.train_length_m > MAX_TRAIN_LENGTH_M, f"train_length_m above {MAX_TRAIN_LENGTH_M:g} m")
+    if site is not None:
+        known = np.array([c in site.vehicles for c in table.vehicle_class], dtype=bool)
+        flag(~known, "vehicle_class unknown to the site")
+        # A zero length is filled from the counts and the class: that length must be plausible too.
+        ok = reasons == ""
+        filled = with_class_defaults(table.take(ok), site).train_length_m
+        implied = np.zeros(n)
+        implied[ok] = filled
+        flag(implied > MAX_TRAIN_LENGTH_M,
+             f"train length from vehicle_count and the class's vehicle length above {MAX_TRAIN_LENGTH_M:g} m")
+    return reasons
+
+
+def with_class_defaults(table: PassTable, site: Site) -> PassTable:
+    """A copy with zero axle_count, wheel_load_n and train_length_m filled from the site's table.
+
+    Rows must be valid for the site (see :func:`rejection_reasons`).
+    """
+    out = table.take(slice(None))
+    cls = [site.vehicle(c) for c in table.vehicle_class]
+    axles = np.array([c.axles_per_vehicle for c in cls], dtype=np.int64)
+    load = np.array([c.wheel_load_n for c in cls], dtype=np.float64)
+    length = np.array([c.vehicle_length_m for c in cls], dtype=np.float64)
+    out.axle_count = np.where(out.axle_count == 0, out.vehicle_count * axles, out.axle_count)
+    out.vehicle_count = np.where(out.vehicle_count == 0, -(-out.axle_count // axles), out.vehicle_count)
+    out.wheel_load_n = np.where(out.wheel_load_n == 0.0, load, out.wheel_load_n)
+    out.train_length_m = np.where(out.train_length_m == 0.0, out.vehicle_count * length, out.train_length_m)
+    return out

@@ -1,0 +1,156 @@
+"""The site: its identity, curve, wheel-rail contact, track and rolling-stock table.
+
+The specs below are the single source of the site parameters' names, defaults, units and
+ranges; nodes declare them as ROS 2 parameters and :mod:`rail_monitor.site_file` reads them from
+a site parameter file without ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.params import ParamSpec, resolve, section
+from rail_monitor.models import hertz
+from rail_monitor.models.cnossos import BRAKE_TYPES
+from rail_monitor.models.track import Track
+
+SITE_ID = ParamSpec("site_id", "site", "Site identifier, written to header.frame_id of every message.")
+SITE_SPECS: tuple[ParamSpec, ...] = (
+    SITE_ID,
+    ParamSpec("curve_radius_m", 250.0, "Radius of the curve at the site [m].", 10.0, 1.0e5),
+    ParamSpec("vehicle_classes", ["emu"], "Names of the vehicle classes of the rolling-stock table."),
+)
+
+# Wheel-rail contact, under contact.: one geometry for every model (squeal's k3, the corrugation
+# kernel's contact stiffness and contact filter, rolling noise).
+CONTACT_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("young_modulus_pa", 210.0e9, "Young's modulus of wheel and rail steel [Pa].", 1.0e9, 1.0e12),
+    ParamSpec("poisson_ratio", 0.28, "Poisson's ratio of wheel and rail steel [-].", 0.0, 0.5),
+    ParamSpec("rail_head_radius_m", 0.3, "Transverse radius of the rail head at the contact [m].", 0.01, 100.0),
+    ParamSpec("wheel_transverse_radius_m", 1.0e6, "Transverse radius of the wheel tread at the contact [m] "
+              "(1e6: a conical tread).", 0.05, 1.0e9),
+)
+
+# Track, under track.: one track model for corrugation and rolling noise (models.track.Track;
+# defaults: UIC60 on a typical ballasted track, see docs/models.md).
+TRACK_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("young_modulus_pa", 210.0e9, "Young's modulus of the rail [Pa].", 1.0e9, 1.0e12),
+    ParamSpec("poisson_ratio", 0.3, "Poisson's ratio of the rail [-].", 0.0, 0.5),
+    ParamSpec("area_m2", 7.69e-3, "Rail cross-section area [m2] (UIC60: 7.69e-3).", 1.0e-4, 0.1),
+    ParamSpec("second_moment_m4", 30.55e-6, "Vertical second moment of area of the rail [m4] (UIC60: 30.55e-6).",
+              1.0e-7, 1.0e-3),
+    ParamSpec("mass_per_length_kgpm", 60.4, "Rail mass per metre [kg/m].", 5.0, 500.0),
+    ParamSpec("shear_coefficient", 0.4, "Timoshenko shear coefficient of the rail section [-].", 0.05, 1.0),
+    ParamSpec("rail_loss_factor", 0.02, "Loss factor of the rail [-].", 0.0, 1.0),
+    ParamSpec("pad_stiffness_npm", 350.0e6, "Rail pad stiffness per rail seat [N/m] (soft 100e6 to stiff 1e9).",
+              1.0e6, 1.0e11),
+    ParamSpec("pad_loss_factor", 0.25, "Rail pad loss factor [-].", 0.0, 2.0),
+    ParamSpec("sleeper_mass_kg", 150.0, "Half-sleeper mass per rail seat [kg].", 1.0, 2000.0),
+    ParamSpec("ballast_stiffness_npm", 50.0e6, "Ballast stiffness under a half sleeper [N/m].", 1.0e5, 1.0e10),
+    ParamSpec("ballast_loss_factor", 1.0, "Ballast loss factor [-].", 0.0, 5.0),
+    ParamSpec("sleeper_spacing_m", 0.6, "Sleeper spacing [m].", 0.2, 2.0),
+)
+
+# Per vehicle class, under vehicle.<name>.: rolling stock, then the traffic it runs in.
+VEHICLE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("axles_per_vehicle", 4, "Axles per vehicle [-].", 1, 12),
+    ParamSpec("wheel_diameter_m", 0.84, "Nominal wheel diameter [m].", 0.3, 1.5),
+    ParamSpec("brake_type", "disc", "Brake type (sets wheel roughness).", choices=BRAKE_TYPES),
+    ParamSpec("wheel_load_n", 60000.0, "Nominal static wheel load [N].", 1.0e3, 2.5e5),
+    ParamSpec("unsprung_mass_kg", 600.0, "Unsprung mass per wheel (half a wheelset and what moves with it) "
+              "[kg].", 50.0, 5000.0),
+    ParamSpec("vehicle_length_m", 20.0, "Vehicle length over couplers [m].", 3.0, 40.0),
+    ParamSpec("bogie_semi_wheelbase_m", 1.25, "Half the bogie wheelbase (axle to bogie centre) [m].", 0.3, 5.0),
+    ParamSpec("traffic_share", 1.0, "Share of the site's trains of this class [-].", 0.0, 1.0),
+    ParamSpec("vehicles_min", 3, "Fewest vehicles in a consist [-].", 1, 100),
+    ParamSpec("vehicles_max", 6, "Most vehicles in a consist [-].", 1, 100),
+    ParamSpec("speed_mean_mps", 19.0, "Mean pass speed of the class at the site [m/s].", 0.5, 100.0),
+    ParamSpec("speed_sd_mps", 1.5, "Standard deviation of the pass speed [m/s].", 0.0, 30.0),
+    ParamSpec("speed_min_mps", 8.0, "Lowest pass speed (the distribution is truncated) [m/s].", 0.5, 100.0),
+    ParamSpec("speed_max_mps", 22.0, "Highest pass speed (line speed at the curve) [m/s].", 0.5, 100.0),
+)
+
+
+@dataclass(frozen=True)
+class VehicleClass:
+    """One entry of the rolling-stock table (units as in VEHICLE_SPECS)."""
+
+    name: str
+    axles_per_vehicle: int
+    wheel_diameter_m: float
+    brake_type: str
+    wheel_load_n: float
+    unsprung_mass_kg: float
+    vehicle_length_m: float
+    bogie_semi_wheelbase_m: float
+    traffic_share: float
+    vehicles_min: int
+    vehicles_max: int
+    speed_mean_mps: float
+    speed_sd_mps: float
+    speed_min_mps: float
+    speed_max_mps: float
+
+    @property
+    def mean_axles_per_train(self) -> float:
+        """Axles of a consist of the mean length (vehicles_min to vehicles_max) [-]."""
+        return self.axles_per_vehicle * (self.vehicles_min + self.vehicles_max) / 2
+
+
+@dataclass(frozen=True)
+class ContactGeometry:
+    """Materials and transverse radii of the wheel-rail contact (units as in CONTACT_SPECS)."""
+
+    young_modulus_pa: float
+    poisson_ratio: float
+    rail_head_radius_m: float
+    wheel_transverse_radius_m: float
+
+
+@dataclass(frozen=True)
+class Site:
+    """A wayside site: identity, curve, wheel-rail contact and rolling-stock table."""
+
+    site_id: str
+    curve_radius_m: float
+    vehicles: Mapping[str, VehicleClass]
+    contact: ContactGeometry = field(default_factory=lambda: ContactGeometry(**{s.name: s.default
+                                                                                for s in CONTACT_SPECS}))
+    track: Track = field(default_factory=Track)
+
+    def contact_patch(self, wheel_radius_m: np.ndarray | float, load_n: np.ndarray | float) -> hertz.HertzContact:
+        """Hertz contact of a wheel of rolling radius [m] on the straight rail head under load [N]
+        (semi-axis a along the rail)."""
+        c = self.contact
+        return hertz.contact_ellipse(wheel_radius_m, c.wheel_transverse_radius_m, np.inf, c.rail_head_radius_m,
+                                     hertz.contact_modulus(c.young_modulus_pa, c.poisson_ratio), load_n)
+
+    def vehicle(self, name: str) -> VehicleClass:
+        """The vehicle class called name, or a ConfigError listing the known ones."""
+        try:
+            return self.vehicles[name]
+        except KeyError:
+            raise ConfigError(f"unknown vehicle class {name!r}; the site knows {sorted(self.vehicles)}") from None
+
+
+def site_from_values(values: Mapping[str, Any]) -> Site:
+    """Build a Site from flat dotted parameter values (a parameter file or a node's parameters)."""
+    top = resolve(SITE_SPECS, values)
+    vehicles = {}
+    for name in top["vehicle_classes"]:
+        prefix = f"vehicle.{name}."
+        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, section(values, prefix), where=prefix))
+        if v.vehicles_min > v.vehicles_max or v.speed_min_mps > v.speed_max_mps:
+            raise ConfigError(f"vehicle class {name!r}: a minimum exceeds its maximum (vehicles or speed)")
+        vehicles[name] = v
+    if not vehicles:
+        raise ConfigError("parameter 'vehicle_classes' names no vehicle class")
+    return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles,
+                contact=ContactGeometry(**resolve(CONTACT_SPECS, section(values, "contact."), "contact.",
+                                                  strict=True)),
+                track=Track(**resolve(TRACK_SPECS, section(values, "track."), "track.", strict=True)))

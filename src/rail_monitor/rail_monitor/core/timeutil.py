@@ -1,0 +1,42 @@
+"""Time conversions, in one place: ISO 8601 text, ns since the Unix epoch, (sec, nanosec)."""
+
+from __future__ import annotations
+
+import re
+from datetime import UTC, datetime
+
+from rail_monitor.core.errors import RailMonitorError
+
+NS_PER_S = 1_000_000_000
+NS_PER_HOUR = 3600 * NS_PER_S
+NS_PER_DAY = 86400 * NS_PER_S
+_ISO = re.compile(r"^(\d{4}-\d\d-\d\d[T ]\d\d:\d\d:\d\d)(?:\.(\d{1,9}))?(Z|[+-]\d\d:?\d\d)?$")
+
+
+def parse_iso_ns(text: str) -> int:
+    """ISO 8601 time with up to 9 fractional digits (Z, an offset, or naive = UTC) -> ns."""
+    m = _ISO.match(text.strip())
+    if not m:
+        raise RailMonitorError(f"not an ISO 8601 time: {text!r}")
+    whole, frac, zone = m.groups()
+    try:
+        t = datetime.fromisoformat(whole + ("+00:00" if zone in (None, "Z") else zone))
+    except ValueError:
+        raise RailMonitorError(f"not a valid time: {text!r}") from None
+    return int(t.timestamp()) * NS_PER_S + int((frac or "0").ljust(9, "0"))
+
+
+def format_iso_ns(ns: int) -> str:
+    """ns since the epoch -> 'YYYY-MM-DDTHH:MM:SS.fffffffffZ' (UTC, lossless)."""
+    sec, frac = divmod(int(ns), NS_PER_S)
+    return datetime.fromtimestamp(sec, UTC).strftime("%Y-%m-%dT%H:%M:%S") + f".{frac:09d}Z"
+
+
+def to_sec_nanosec(ns: int) -> tuple[int, int]:
+    """ns since the epoch -> (sec, nanosec) as in builtin_interfaces/Time."""
+    return divmod(int(ns), NS_PER_S)
+
+
+def from_sec_nanosec(sec: int, nanosec: int) -> int:
+    """builtin_interfaces/Time fields -> ns since the epoch."""
+    return int(sec) * NS_PER_S + int(nanosec)

@@ -1,0 +1,226 @@
+"""The corrugation state of one site: roughness per wavelength band, advanced pass by pass.
+
+Each band is tracked as components at wavelengths across it (:mod:`.growth`); a band's r.m.s.
+is the energy sum of its components, so it tends to grow at the rate of its fastest one: that
+rate is the band's g, and the peak g over bands is what the speed advice minimises.
+
+A pass is identified by (stamp, train_id): a pass already counted, or older than the kept
+history, is not counted (so a replay does not grow the state twice), and because ln Z is a sum,
+passes give the same state one by one or in a batch. Live, replay and batch all call
+:meth:`CorrugationEstimator.advance_history` with one pass or many.
+
+Surveys and grinding (:mod:`.surveys`), what-if speed distributions and advice (:mod:`.advice`)
+and checkpoints (:mod:`.checkpoint`) are functions of this state.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.site import Site
+from rail_monitor.core.timeutil import NS_PER_DAY
+from rail_monitor.corrugation import forecast as fcst
+from rail_monitor.corrugation.config import CorrugationConfig
+from rail_monitor.corrugation.growth import GrowthTables
+from rail_monitor.corrugation.history import KeptPasses
+from rail_monitor.corrugation.records import Forecast, StateSnapshot, Trajectory
+from rail_monitor.models import corrugation as cg
+
+
+class CorrugationEstimator:
+    """The corrugation state of one site and its forecast (no ROS)."""
+
+    def __init__(self, site: Site, cfg: CorrugationConfig, tables: GrowthTables | None = None) -> None:
+        self.site, self.cfg = site, cfg
+        self.tables = tables or GrowthTables(site, cfg)
+        self.tables.set_k_b(cfg.k_b)
+        self.bands = self.tables.bands
+        acceptance = cg.band_limits(self.bands) * cfg["acceptance_factor"]
+        if np.any(np.isnan(acceptance)):
+            raise ConfigError("corrugation bands reach outside the 10-3000 mm of the Grassie et al. (1999) limits")
+        self.threshold = acceptance * cfg["intervention_factor"]
+        self.post_grinding = acceptance * cfg["post_grinding_fraction"]
+        self.history_ns = int(cfg["history_days"] * NS_PER_DAY)
+        self.points = cfg["points_per_band"]
+        self.log_components = self.flat(self.post_grinding)
+        self.grinding_amplitude = self.post_grinding.copy()             # r.m.s. after the last grinding
+        self.pass_count = self.axle_pass_count = self.total_pass_count = 0
+        self.last_grinding_ns = self.newest_ns = 0
+        self.newest_train_id = ""                                      # train_id of the newest pass counted
+        self.last_survey_ns = 0                                        # last survey or grinding applied
+        self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
+        self.kept = KeptPasses()
+        # Running sums over the kept passes of axles x per-axle growth, and of axles (forecast).
+        self._growth_sum = np.zeros_like(self.log_components)
+        self._axle_sum = 0
+
+    # -- passes ---------------------------------------------------------------------------------
+    def advance(self, passes: PassTable) -> np.ndarray:
+        """Count the passes not seen before; return the mask of those counted.
+
+        ``passes`` must be valid for the site with class defaults filled. A pass is not counted
+        when its (stamp, train_id) was counted already or is older than the kept history.
+        """
+        return self._advance(passes)[0]
+
+    def _growth(self, class_idx: np.ndarray, friction: np.ndarray, speed: np.ndarray,
+                axles: np.ndarray) -> np.ndarray:
+        """Log growth of each component (N, B, P) over the axles of N passes."""
+        return self.tables.at(class_idx, friction, speed) * axles[:, None, None]
+
+    def _advance(self, passes: PassTable) -> tuple[np.ndarray, np.ndarray]:
+        """advance(), also returning ln Z after each counted pass (counted, B, P)."""
+        counted = np.zeros(len(passes), bool)
+        horizon = self.newest_ns - self.history_ns
+        seen = self.kept.seen
+        for i, (stamp, tid) in enumerate(zip(passes.stamp_ns.tolist(), passes.train_id, strict=True)):
+            key = (stamp, tid)
+            if key in seen or stamp < horizon:
+                continue
+            seen.add(key)
+            counted[i] = True
+            horizon = max(horizon, stamp - self.history_ns)
+        if not counted.any():
+            return counted, np.zeros((0, *self.log_components.shape))
+        new = passes.take(counted)
+        cls = self.tables.class_index(new.vehicle_class)
+        growth = self._growth(cls, new.friction_state, new.speed_mps, new.axle_count)
+        # Sequential sum (cumsum), so a batch adds as the same passes one by one would.
+        steps = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[1:]
+        self.log_components = steps[-1].copy()
+        self._growth_sum += growth.sum(axis=0)
+        self._axle_sum += int(new.axle_count.sum())
+        m = int(counted.sum())
+        self.pass_count += m
+        self.total_pass_count += m
+        self.axle_pass_count += int(new.axle_count.sum())
+        i_new = len(new) - 1 - int(np.argmax(new.stamp_ns[::-1]))  # the last of equal stamps, as one by one
+        if int(new.stamp_ns[i_new]) >= self.newest_ns:
+            self.newest_ns, self.newest_train_id = int(new.stamp_ns[i_new]), str(new.train_id[i_new])
+        self.kept.extend(stamp_ns=new.stamp_ns, train_id=new.train_id, class_idx=cls,
+                         friction=new.friction_state, speed=new.speed_mps, axles=new.axle_count)
+        self._prune()
+        return counted, steps
+
+    def advance_history(self, passes: PassTable) -> Trajectory:
+        """advance() over one pass or a history, returning the state and forecast after every
+        counted pass, equal to what advancing one pass at a time gives.
+
+        Vectorised when the passes are in time order and none is older than the newest counted:
+        the forecast of pass k then uses the passes within history_days before it, through prefix
+        sums. Otherwise the passes are taken one by one.
+        """
+        stamps = np.asarray(passes.stamp_ns, np.int64)
+        k = self.kept
+        if len(stamps) and (np.any(np.diff(stamps) < 0) or stamps[0] < self.newest_ns):
+            return self._history_one_by_one(passes)
+        kept_growth = self._growth(k.class_idx, k.friction, k.speed, k.axles)
+        kept_stamps, kept_axles = k.stamp_ns.copy(), k.axles.copy()
+        before = self.snapshot()
+        counted, steps = self._advance(passes)
+        new = passes.take(counted)
+        m, k0 = len(new), len(kept_stamps)
+        all_stamps = np.concatenate([kept_stamps, new.stamp_ns])
+        new_growth = self._growth(self.tables.class_index(new.vehicle_class), new.friction_state, new.speed_mps,
+                                  new.axle_count)
+        g_prefix = np.concatenate([np.zeros((1, *steps.shape[1:])), np.cumsum(
+            np.concatenate([kept_growth, new_growth]), axis=0)])
+        a_prefix = np.concatenate([[0], np.cumsum(np.concatenate([kept_axles, new.axle_count]))])
+        end = k0 + np.arange(1, m + 1)                                   # one past pass k
+        start = np.searchsorted(all_stamps, new.stamp_ns - self.history_ns, side="left")
+        axles = (a_prefix[end] - a_prefix[start]).astype(float)
+        growth = (g_prefix[end] - g_prefix[start]) / axles[:, None, None]
+        span_days = (new.stamp_ns - all_stamps[start]) / NS_PER_DAY
+        with np.errstate(divide="ignore", invalid="ignore"):
+            rate = np.where((span_days > 0) & (span_days >= self.cfg["min_traffic_days"]),
+                            (end - start - 1) / span_days, np.nan)
+        fc = self._forecasts(steps, growth, rate, axles / (end - start), new.stamp_ns)
+        ordinal = np.arange(1, m + 1)
+        return Trajectory(
+            index=np.flatnonzero(counted), stamp_ns=new.stamp_ns.copy(), train_id=new.train_id.copy(),
+            amplitude=cg.band_amplitude(steps), pass_count=before.pass_count + ordinal,
+            axle_pass_count=before.axle_pass_count + np.cumsum(new.axle_count),
+            total_pass_count=before.total_pass_count + ordinal, forecast=fc, constants=before)
+
+    def _history_one_by_one(self, passes: PassTable) -> Trajectory:
+        rows: list[tuple[int, StateSnapshot, Forecast]] = []
+        for i in range(len(passes)):
+            if self.advance(passes.take(np.arange(len(passes)) == i))[0]:
+                rows.append((i, self.snapshot(), self.forecast()))
+        return Trajectory.from_rows(rows, self.snapshot())
+
+    def snapshot(self) -> StateSnapshot:
+        """The state as a CorrugationState carries it (without the forecast)."""
+        return StateSnapshot(self.newest_ns, self.newest_train_id, self.pass_count, self.axle_pass_count,
+                             self.total_pass_count, self.last_grinding_ns, self.bands, self.amplitude,
+                             self.threshold, self.grinding_amplitude.copy(), self.k_b.copy())
+
+    def _prune(self) -> None:
+        k = self.kept
+        gone = k.stamp_ns < self.newest_ns - self.history_ns
+        if gone.any():
+            self._growth_sum -= np.einsum("n,nbp->bp", k.axles[gone], self.tables.at(k.class_idx[gone],
+                                                                                     k.friction[gone], k.speed[gone]))
+            self._axle_sum -= int(k.axles[gone].sum())
+            k.drop(gone)
+
+    def set_k_b(self, k_b: np.ndarray) -> None:
+        """Use K_b per friction state (4,) [-/axle pass] from now on (the kept passes' sums follow)."""
+        self.tables.set_k_b(k_b)
+        self.resum()
+
+    def resum(self) -> None:
+        """Recompute the running sums from the kept passes (after K_b changes or a load)."""
+        k = self.kept
+        self._growth_sum = np.einsum("n,nbp->bp", k.axles, self.tables.at(k.class_idx, k.friction, k.speed)) \
+            if len(k) else np.zeros_like(self.log_components)
+        self._axle_sum = int(k.axles.sum())
+
+    # -- state and forecast ---------------------------------------------------------------------
+    def flat(self, band_rms: np.ndarray) -> np.ndarray:
+        """ln Z of components sharing each band's r.m.s. [m] equally, (B, P)."""
+        return np.repeat(np.log(band_rms / np.sqrt(self.points))[:, None], self.points, axis=1)
+
+    @property
+    def amplitude(self) -> np.ndarray:
+        """r.m.s. roughness per band [m]."""
+        return cg.band_amplitude(self.log_components)
+
+    @property
+    def log_amplitude(self) -> np.ndarray:
+        return np.log(self.amplitude)
+
+    @property
+    def k_b(self) -> np.ndarray:
+        return self.tables.k_b
+
+    def recent_growth(self) -> np.ndarray:
+        """g per component (B, P) [1/axle pass]: the kept passes' growth, averaged per axle pass."""
+        if self._axle_sum == 0:
+            return np.zeros((len(self.bands), self.points))
+        return self._growth_sum / self._axle_sum
+
+    def traffic(self) -> tuple[float, float]:
+        """Recent traffic (see :func:`.forecast.traffic`)."""
+        return fcst.traffic(self.kept, self.cfg["min_traffic_days"])
+
+    def forecast(self, growth: np.ndarray | None = None, passes_per_day: float | None = None) -> Forecast:
+        """Time to the intervention threshold per band at growth g and the traffic.
+
+        growth: g per component (B, P) [1/axle pass] (default: the recent passes');
+        passes_per_day: train passes [1/day] (default: the recent rate).
+        """
+        g = self.recent_growth() if growth is None else np.asarray(growth, float)
+        rate, axles = self.traffic()
+        if passes_per_day:
+            rate = passes_per_day
+        return fcst.single(self._forecasts(self.log_components[None], g[None], np.array([rate]), np.array([axles]),
+                                           np.array([self.newest_ns])))
+
+    def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
+                   newest_ns: np.ndarray) -> Forecast:
+        fallback = float(np.mean([v.mean_axles_per_train for v in self.site.vehicles.values()]))
+        return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
+                              self.cfg["lead_time_days"], fallback)

@@ -1,0 +1,55 @@
+"""The grinding forecast: time to the intervention threshold of each band, and the recent traffic.
+
+For one component, passes to threshold = ln(Z_threshold / Z) / g per axle pass; for a band,
+the energy sum of its components (:func:`rail_monitor.models.corrugation.passes_to_band_level`);
+days = train passes / train passes per day (docs/models.md, "Grinding forecast").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rail_monitor.core.timeutil import NS_PER_DAY
+from rail_monitor.corrugation.history import KeptPasses
+from rail_monitor.corrugation.records import Forecast
+from rail_monitor.models import corrugation as cg
+
+
+def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
+              newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
+              fallback_axles: float) -> Forecast:
+    """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
+    day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
+    band thresholds (B,) [m]; a Forecast of arrays."""
+    axles = np.where(np.isfinite(axles), axles, fallback_axles)
+    log_threshold = np.log(threshold)
+    margin = log_threshold - np.log(cg.band_amplitude(log_components))
+    axle_passes = cg.passes_to_band_level(log_components, growth, log_threshold)
+    rows = np.arange(len(rate))
+    worst = np.where(np.isfinite(axle_passes).any(axis=1), np.argmin(axle_passes, axis=1),
+                     np.argmin(margin, axis=1))
+    passes = axle_passes[rows, worst] / axles
+    with np.errstate(divide="ignore", invalid="ignore"):
+        days = np.where(np.isfinite(rate) & (rate > 0), passes / rate, np.inf)
+    days = np.where(passes == 0.0, 0.0, days)
+    due = (margin.min(axis=1) <= 0) | (days <= lead_time_days)
+    due_ns = np.array([int(t) + int(d * NS_PER_DAY) if np.isfinite(d) else 0
+                       for t, d in zip(newest_ns.tolist(), days.tolist(), strict=True)], np.int64)
+    return Forecast(growth.max(axis=2), worst, passes, days, rate, due, due_ns)
+
+
+def single(fc: Forecast) -> Forecast:
+    """Row 0 of a Forecast of arrays, as scalars."""
+    return Forecast(fc.growth_per_axle_pass[0], int(fc.worst_band[0]), float(fc.passes_to_threshold[0]),
+                    float(fc.days_to_threshold[0]), float(fc.passes_per_day[0]), bool(fc.grinding_due[0]),
+                    int(fc.grinding_due_ns[0]))
+
+
+def traffic(kept: KeptPasses, min_traffic_days: float) -> tuple[float, float]:
+    """Recent traffic: (train passes per day, axles per train); NaN rate with fewer than 2 passes or
+    over less than min_traffic_days [day]."""
+    if len(kept) == 0:
+        return float("nan"), float("nan")
+    span = (int(kept.stamp_ns.max()) - int(kept.stamp_ns.min())) / NS_PER_DAY
+    rate = (len(kept) - 1) / span if span > 0 and span >= min_traffic_days else float("nan")
+    return rate, float(kept.axles.mean())

@@ -1,0 +1,42 @@
+"""The passes a corrugation state keeps: their identity (so none is counted twice) and what the
+forecast and the advice need (class, friction state, speed, axles)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+COLUMNS = ("stamp_ns", "train_id", "class_idx", "friction", "speed", "axles")
+
+
+@dataclass
+class KeptPasses:
+    """Columns of the kept passes, in the order they were counted, and the set of their
+    (stamp [ns], train_id) keys."""
+
+    stamp_ns: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    train_id: np.ndarray = field(default_factory=lambda: np.zeros(0, object))
+    class_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    friction: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    speed: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))   # [m/s]
+    axles: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    seen: set[tuple[int, str]] = field(default_factory=set)
+
+    def __post_init__(self) -> None:
+        if not self.seen and len(self.stamp_ns):
+            self.seen = set(zip(self.stamp_ns.tolist(), self.train_id.tolist(), strict=True))
+
+    def __len__(self) -> int:
+        return len(self.stamp_ns)
+
+    def extend(self, **cols: np.ndarray) -> None:
+        """Append passes (their keys must already be in ``seen``)."""
+        for name in COLUMNS:
+            setattr(self, name, np.concatenate([getattr(self, name), cols[name]]))
+
+    def drop(self, gone: np.ndarray) -> None:
+        """Forget the passes of a boolean mask, keys included."""
+        self.seen.difference_update(zip(self.stamp_ns[gone].tolist(), self.train_id[gone].tolist(), strict=True))
+        for name in COLUMNS:
+            setattr(self, name, getattr(self, name)[~gone])

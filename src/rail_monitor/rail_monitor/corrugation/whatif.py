@@ -1,0 +1,114 @@
+"""What-if corrugation: the growth, forecast and advice for a history or a given speed distribution,
+as ``rail-monitor predict corrugation`` reports them (callable from Python too)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.passes import FRICTION_BY_NAME, PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.site import site_from_values
+from rail_monitor.corrugation import advice as adv
+from rail_monitor.corrugation.config import corrugation_config
+from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.records import Advice, Evaluation, Forecast
+
+
+@dataclass
+class CorrugationWhatIf:
+    """A what-if's inputs and results (units as in rail_msgs/CorrugationState and SpeedAdvisory)."""
+
+    where: str                      # what was evaluated, for people
+    estimator: CorrugationEstimator  # the state evaluated against
+    speeds: np.ndarray              # [m/s]
+    weights: np.ndarray             # relative weights of the speeds [-]
+    friction_state: int             # 0: the history's mix
+    evaluation: Evaluation
+    forecast: Forecast
+    advice: Advice | None
+
+
+def speed_distribution(mean_mps: float, cv: float) -> tuple[np.ndarray, np.ndarray]:
+    """A normal distribution of speeds over +-3 sd on 121 points (speeds [m/s], weights), or the
+    mean alone when cv = 0."""
+    if cv <= 0:
+        return np.array([mean_mps]), np.ones(1)
+    speeds = mean_mps * (1 + cv * np.linspace(-3, 3, 121))
+    return speeds, np.exp(-0.5 * ((speeds - mean_mps) / (mean_mps * cv)) ** 2)
+
+
+def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = None, history_name: str = "",
+                        speeds: np.ndarray | None = None, weights: np.ndarray | None = None,
+                        vehicle_class: str | None = None, speed_mean_mps: float | None = None,
+                        speed_cv: float | None = None, friction: str | None = None,
+                        passes_per_day: float | None = None, advise: bool = False) -> CorrugationWhatIf:
+    """Evaluate a speed distribution for the site of the flat parameter values.
+
+    With a history, the state, speeds (axle-weighted) and traffic come from it; otherwise the
+    post-grinding rail with the given speeds and weights, or a normal distribution of the
+    class's mean and sd (overridden by speed_mean_mps [m/s] and speed_cv [-]), on dry rail
+    unless friction names a state. RailMonitorError for unusable inputs.
+    """
+    site = site_from_values(values)
+    est = CorrugationEstimator(site, corrugation_config(values))
+    state = FRICTION_BY_NAME[friction] if friction else 0
+    if history is not None:
+        ok = rejection_reasons(history, site) == ""
+        est.advance(with_class_defaults(history.take(ok), site))
+        where = f"site {site.site_id}, history {history_name} ({int(ok.sum())} passes, {int((~ok).sum())} rejected)"
+        if not len(est.kept):
+            raise RailMonitorError(f"{history_name}: no valid pass for site {site.site_id}")
+        v, w = est.kept.speed, est.kept.axles.astype(float)
+    else:
+        cls = site.vehicle(vehicle_class or next(iter(site.vehicles)))
+        if speeds is not None:
+            v = np.asarray(speeds, float)
+            w = np.asarray(weights, float) if weights is not None else np.ones_like(v)
+            if w.shape != v.shape:
+                raise RailMonitorError("--weights needs one weight per --speeds value")
+        else:
+            v, w = speed_distribution(speed_mean_mps or cls.speed_mean_mps,
+                                      speed_cv if speed_cv is not None else cls.speed_sd_mps / cls.speed_mean_mps)
+        state = state or FRICTION_BY_NAME["dry"]
+        where = f"site {site.site_id}, post-grinding rail, {friction or 'dry'}"
+    try:
+        ev = adv.evaluate(est, v, w, state, passes_per_day or 0.0)
+        advice = adv.advise(est, None if history is not None and not friction else v, w, state) if advise else None
+    except ValueError as exc:
+        raise RailMonitorError(str(exc)) from None
+    fc = est.forecast(adv.growth_at_speeds(est, v, state) @ (w / w.sum()), passes_per_day)
+    return CorrugationWhatIf(where, est, v, w, state, ev, fc, advice)
+
+
+def summary(r: CorrugationWhatIf) -> dict[str, Any]:
+    """The what-if as plain data (JSON): single numbers, the advice, and a row per band."""
+    est, ev, fc = r.estimator, r.evaluation, r.forecast
+    out: dict[str, Any] = {
+        "where": r.where, "peak_growth": ev.peak_growth, "peak_wavelength_m": ev.peak_wavelength_m,
+        "worst_wavelength_m": float(est.bands[fc.worst_band]), "passes_to_threshold": fc.passes_to_threshold,
+        "days_to_threshold": fc.days_to_threshold, "passes_per_day": fc.passes_per_day,
+        "k_b_by_friction": est.k_b.tolist()}
+    if r.advice is not None:
+        out["advice"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in vars(r.advice).items()}
+    out["bands"] = [{"wavelength_m": float(est.bands[i]), "growth_per_axle_pass": float(ev.growth_per_axle_pass[i]),
+                     "amplitude_m": float(est.amplitude[i]), "threshold_m": float(est.threshold[i])}
+                    for i in range(len(est.bands))]
+    return out
+
+
+def receptance_curves(site: Any) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The site's track receptances [m/N] (continuous Timoshenko and Euler, discrete at mid-span
+    and above a sleeper) and its first class's wheel, on 20 Hz-5 kHz [Hz]."""
+    from rail_monitor.models import track as tr
+
+    f = np.geomspace(20.0, 5000.0, 600)
+    mid, above = tr.discrete_receptance(f, site.track, position=np.array([0.5, 0.0])).T
+    wheel = site.vehicle(next(iter(site.vehicles))).unsprung_mass_kg
+    return f, {"continuous, Timoshenko": tr.continuous_receptance(f, site.track),
+               "continuous, Euler": tr.continuous_receptance(f, site.track, "euler"),
+               "discrete, mid-span": mid, "discrete, above a sleeper": above,
+               f"wheel ({wheel:g} kg)": tr.wheel_receptance(f, wheel)}

@@ -1,0 +1,78 @@
+"""The site's rolling-noise parameters: source model, interpolation rule, baseline rail roughness,
+CNOSSOS-EU track terms, receiver and ground, mechanics radiators."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.params import ParamSpec, ParamValues, resolve, section
+from rail_monitor.models import cnossos as cn
+from rail_monitor.models import wheel_rail_noise as wrn
+from rail_monitor.models.passby import Receiver
+
+MODELS = ("cnossos", "mechanics")
+ROUGHNESS_SOURCES = ("E", "M", "measured")
+_CLASS_E = cn.rail_roughness("E")
+
+NOISE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("model", "cnossos", "Source model of noise/rolling: CNOSSOS-EU (Directive 2015/996 as amended by "
+              "2021/1226), the mechanics model, or both (one message per model).", choices=(*MODELS, "both")),
+    ParamSpec("interpolation", "reference", "Wavelength-to-frequency rule: the European reference module's (dB "
+              "linear in wavelength, ends held) or energy against lg frequency.", choices=cn.INTERPOLATION_RULES),
+    ParamSpec("rail_roughness", "E", "Baseline rail roughness: class E (EN ISO 3095:2013), class M (CNOSSOS "
+              "average network) or the measured spectrum below.", choices=ROUGHNESS_SOURCES),
+    ParamSpec("rail_roughness_wavelength_m", cn.tables().wavelength_m.tolist(), "Wavelengths of the measured "
+              "rail roughness, ascending [m] (default: the CNOSSOS grid).", 1e-4, 10.0),
+    ParamSpec("rail_roughness_db", _CLASS_E.tolist(), "Measured rail roughness per 1/3-octave wavelength band "
+              "[dB re 1 um] (default: class E).", -60.0, 80.0),
+    ParamSpec("sleeper_type", "monoblock", "Sleeper type for CNOSSOS's track transfer (Table G-3a); the pad class "
+              "follows track.pad_stiffness_npm.", choices=cn.SLEEPER_TYPES),
+    ParamSpec("bridge", "none", "Bridge at the site (CNOSSOS Table G-7).", choices=cn.BRIDGE_TYPES),
+    ParamSpec("joints_per_100m", 0.0, "Rail joints (impact noise, CNOSSOS Table G-4) per 100 m [-]; 0: none.",
+              0.0, 100.0),
+    ParamSpec("curve_squeal", False, "Add CNOSSOS's curve-squeal term (+8 dB R <= 300 m, +5 dB to 500 m) to the "
+              "CNOSSOS rolling noise. Off: squeal is squeal_risk_model's, noise/squeal."),
+    ParamSpec("receiver_distance_m", 7.5, "Horizontal distance of the receiver from the track centre [m].",
+              0.5, 1000.0),
+    ParamSpec("receiver_height_m", 1.2, "Receiver height above the rail head [m].", -10.0, 100.0),
+    ParamSpec("source_height_m", 0.05, "Height of the rolling-noise source line above the rail head [m] "
+              "(CNOSSOS source A).", 0.0, 5.0),
+    ParamSpec("ground_reflection", 1.0, "Energy reflection coefficient of the ground [-] (1: hard, 0: free "
+              "field).", 0.0, 1.0),
+    ParamSpec("ground_depth_m", 0.0, "Depth of the reflecting ground plane below the rail head [m].", 0.0, 10.0),
+    ParamSpec("rail_radius_m", float(wrn.Radiators.rail_radius_m), "Mechanics: radius of the cylinder radiating "
+              "like the rail's vertical motion [m].", 0.01, 1.0),
+    ParamSpec("sleeper_area_m2", wrn.Radiators.sleeper_area_m2, "Mechanics: radiating top area of a half sleeper "
+              "[m2].", 0.0, 5.0),
+    ParamSpec("wheel_rim_width_m", wrn.Radiators.wheel_rim_width_m, "Mechanics: wheel rim width [m].", 0.01, 0.5),
+    ParamSpec("band_points", 5, "Mechanics: frequencies per 1/3-octave band for band averages [-].", 1, 50),
+)
+
+
+@dataclass(frozen=True)
+class NoiseConfig(ParamValues):
+    """The site's noise parameters (names and units as in NOISE_SPECS)."""
+
+    @property
+    def receiver(self) -> Receiver:
+        return Receiver(self["receiver_distance_m"], self["receiver_height_m"], self["source_height_m"],
+                        self["ground_depth_m"], self["ground_reflection"])
+
+    @property
+    def radiators(self) -> wrn.Radiators:
+        return wrn.Radiators(self["rail_radius_m"], self["sleeper_area_m2"], self["wheel_rim_width_m"])
+
+
+def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConfig:
+    """Checked noise parameters from flat parameter values (keys under prefix)."""
+    values = resolve(NOISE_SPECS, section(values, prefix), where=prefix, strict=True)
+    wl, db = values["rail_roughness_wavelength_m"], values["rail_roughness_db"]
+    if len(wl) != len(db) or len(wl) < 2 or np.any(np.diff(wl) <= 0):
+        raise ConfigError(f"parameters '{prefix}rail_roughness_wavelength_m' and '{prefix}rail_roughness_db' must "
+                          "have the same length (at least 2), wavelengths strictly ascending")
+    return NoiseConfig(values)

@@ -1,0 +1,228 @@
+"""Rolling noise at a site: its noise parameters and the prediction for each train pass.
+
+Glue between the pass table, the site (track, contact, rolling stock), the corrugation state and
+the two source models: :mod:`rail_monitor.models.cnossos` (the EU method, default) and
+:mod:`rail_monitor.models.wheel_rail_noise` (mechanics, sharing :mod:`rail_monitor.models.track`
+with the corrugation model, so pad stiffness and corrugation change the noise for mechanical
+reasons). Both share one roughness input and one propagation (:mod:`rail_monitor.models.passby`).
+
+Roughness. The rail roughness is the site's baseline (ISO 3095 class E, CNOSSOS class M, or a
+measured spectrum in dB re 1 um on 1/3-octave wavelength bands) plus, in energy, the corrugation
+state's r.m.s. amplitude in each of its bands (the nearest baseline wavelength within 1/6
+octave). The level increase due to roughness growth since grinding is LpAeq,Tp with the current
+state minus LpAeq,Tp with the state's post-grinding amplitudes. The wheel roughness is
+CNOSSOS-EU's for the class's brake type.
+
+Per pass: the class's wheel (diameter, nominal load: Hertz contact of ``site.contact``),
+axles and length from the pass (class defaults filled), speed from the pass. Sound power per
+metre of train: L_W' = L_R,TOT + L_H + 10 lg(axles / length) per band.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.site import Site
+from rail_monitor.models import cnossos as cn
+from rail_monitor.models import wheel_rail_noise as wrn
+from rail_monitor.models.levels import level, power
+from rail_monitor.models.passby import PassBy, pass_by
+from rail_monitor.noise.config import MODELS, NoiseConfig
+
+
+def roughness_power(amplitude_m: np.ndarray) -> np.ndarray:
+    """Squared roughness re (1 um)^2 [-] of an r.m.s. amplitude [m] (10 lg of it: dB re 1 um)."""
+    return (np.asarray(amplitude_m, float) / 1e-6) ** 2
+
+
+@dataclass(frozen=True)
+class Corrugation:
+    """The part of a CorrugationState the noise needs: bands [m] and r.m.s. amplitudes [m].
+
+    amplitude_m and post_grinding_m are (bands,) for one state, or (passes, bands) for a state per
+    pass (batch mode)."""
+
+    wavelength_m: np.ndarray
+    amplitude_m: np.ndarray
+    post_grinding_m: np.ndarray
+
+
+@dataclass(frozen=True)
+class NoisePrediction:
+    """Rolling noise of passes by one source model (fields and units as in rail_msgs/RollingNoise):
+    the model, band centres and component names, then arrays over passes (bands last)."""
+
+    model: str
+    band_centre_hz: np.ndarray              # (B,) [Hz]
+    component_names: list[str]
+    speed_mps: np.ndarray                   # (N,) [m/s]
+    lp_db: np.ndarray                       # (N, B) LpZeq,Tp per band [dB re 20 uPa]
+    lw_db: np.ndarray                       # (N, B) sound power per metre of train [dB re 1 pW/m]
+    roughness_db: np.ndarray                # (N, B) effective roughness [dB re 1 um]
+    pass_by_time_s: np.ndarray              # (N,) [s]
+    lpaeq_tp_dba: np.ndarray                # (N,) [dB(A)]
+    lpafmax_dba: np.ndarray                 # (N,) [dB(A)]
+    tel_dba: np.ndarray                     # (N,) [dB(A)]
+    component_lpaeq_dba: np.ndarray         # (N, components) [dB(A)]
+    roughness_growth_increase_db: np.ndarray  # (N,) [dB]
+
+    CONSTANTS = ("model", "band_centre_hz", "component_names")
+
+    def __len__(self) -> int:
+        return len(self.speed_mps)
+
+    def per_pass(self) -> dict[str, np.ndarray]:
+        """The arrays over passes, by field name."""
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name not in self.CONSTANTS}
+
+    @classmethod
+    def concat(cls, parts: Sequence[NoisePrediction]) -> NoisePrediction:
+        """The passes of parts (same model and bands), one after the other."""
+        return replace(parts[0], **{k: np.concatenate([p.per_pass()[k] for p in parts])
+                                    for k in parts[0].per_pass()})
+
+    def merged(self, mask: np.ndarray, other: NoisePrediction) -> NoisePrediction:
+        """These rows where mask is true and other's where it is false, in pass order."""
+        out = {}
+        for k, mine in self.per_pass().items():
+            col = np.empty((len(mask), *mine.shape[1:]), mine.dtype)
+            col[mask], col[~mask] = mine, other.per_pass()[k]
+            out[k] = col
+        return replace(self, **out)
+
+
+@dataclass(frozen=True)
+class _ClassTerms:
+    """Per vehicle class, speed-independent: wheel roughness, filters and transfers."""
+
+    wheel_db: np.ndarray                 # on the CNOSSOS wavelength grid [dB re 1 um]
+    a3_db: np.ndarray                    # CNOSSOS contact filter on the grid [dB]
+    semi_length_m: float                 # Hertz semi-axis along the rail [m]
+    cnossos: dict[str, np.ndarray]       # L_H per component [dB per axle], 24 bands
+    mechanics: dict[str, np.ndarray]     # L_H,mech per component [dB per axle]
+
+
+class RollingNoiseModel:
+    """Both source models for one site, with everything speed-independent computed once."""
+
+    def __init__(self, site: Site, cfg: NoiseConfig) -> None:
+        self.site, self.cfg = site, cfg
+        t = cn.tables()
+        self.grid = t.wavelength_m
+        self.band, self.band_hz = t.band, t.band_hz
+        self.receiver = cfg.receiver
+        (_, psi), _ = self.receiver.paths()
+        self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz)
+        self.baseline_db = self._baseline()
+        self.impact_db = cn.impact_roughness(cfg["joints_per_100m"] / 100.0) if cfg["joints_per_100m"] > 0 else None
+        self.track_name, track_db = cn.track_transfer(cfg["sleeper_type"], site.track.pad_stiffness_npm)
+        self.bridge_db = cn.bridge_transfer(cfg["bridge"])
+        self.squeal_db = cn.curve_squeal_db(site.curve_radius_m) if cfg["curve_squeal"] else 0.0
+        self.classes: dict[str, _ClassTerms] = {}
+        for name, v in site.vehicles.items():
+            contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
+            _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m)
+            _, veh = cn.vehicle_transfer(v.wheel_diameter_m)
+            cnossos = {"track": track_db + self.squeal_db, "vehicle": veh + self.squeal_db,
+                       "superstructure": np.full(len(self.band), self.squeal_db)}
+            if self.bridge_db is not None:
+                cnossos["bridge"] = self.bridge_db
+            mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
+                                     v.wheel_diameter_m, cfg.radiators, cfg["band_points"])
+            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type), a3, float(contact.a), cnossos, mech)
+
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The source models the site's ``noise.model`` selects."""
+        return MODELS if self.cfg["model"] == "both" else (self.cfg["model"],)
+
+    def _baseline(self) -> np.ndarray:
+        source = self.cfg["rail_roughness"]
+        if source != "measured":
+            return cn.rail_roughness(source)
+        wl = np.asarray(self.cfg["rail_roughness_wavelength_m"], float)
+        return np.interp(self.grid, wl, np.asarray(self.cfg["rail_roughness_db"], float))
+
+    def rail_roughness_db(self, corrugation: Corrugation | None = None, post_grinding: bool = False) -> np.ndarray:
+        """Rail roughness on the CNOSSOS wavelength grid [dB re 1 um]: baseline plus the corrugation
+        state (or its post-grinding amplitudes) in energy; (grid,) or, for a state per pass, (passes, grid)."""
+        if corrugation is None:
+            return self.baseline_db
+        amp = corrugation.post_grinding_m if post_grinding else corrugation.amplitude_m
+        wl = np.asarray(corrugation.wavelength_m, float)
+        if not len(wl):
+            return self.baseline_db
+        octaves = np.abs(np.log2(self.grid[:, None] / wl[None, :]))
+        nearest = np.argmin(octaves, axis=1)
+        inside = octaves[np.arange(len(self.grid)), nearest] <= 1.0 / 6.0
+        extra = np.where(inside, roughness_power(amp)[..., nearest], 0.0)
+        return level(power(self.baseline_db) + extra)
+
+    def predict(self, passes: PassTable, model: str | None = None,
+                corrugation: Corrugation | None = None) -> NoisePrediction:
+        """RollingNoise fields per pass (arrays over passes; bands last), vectorised.
+
+        ``passes`` must be valid for the site with class defaults filled. model: one of MODELS
+        (default: the first of the site's ``noise.model``).
+        """
+        model = model or self.models[0]
+        if model not in MODELS:
+            raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
+        roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model)
+        pb = self._pass_by(components, passes)
+        names = list(components)
+        growth = np.zeros(len(passes))
+        if corrugation is not None:
+            _, ground = self._sources(self.rail_roughness_db(corrugation, post_grinding=True), passes, model)
+            growth = pb.lpaeq_tp_dba - self._pass_by(ground, passes, False).lpaeq_tp_dba
+        return NoisePrediction(
+            model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
+            lp_db=pb.lp_db, lw_db=_total(components), roughness_db=roughness, pass_by_time_s=pb.pass_by_time_s,
+            lpaeq_tp_dba=pb.lpaeq_tp_dba, lpafmax_dba=pb.lpafmax_dba, tel_dba=pb.tel_dba,
+            component_lpaeq_dba=np.stack([self._pass_by({c: components[c]}, passes, False).lpaeq_tp_dba
+                                          for c in names], axis=-1),
+            roughness_growth_increase_db=growth)
+
+    def _sources(self, rail_db: np.ndarray, passes: PassTable,
+                 model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Effective roughness [dB re 1 um] and sound power per metre of train per component
+        [dB re 1 pW/m] (passes x bands) on a rail roughness spectrum."""
+        n, nb = len(passes), len(self.band)
+        per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
+        roughness = np.empty((n, nb))
+        # Every component of the model, even with no passes (an empty history gives empty arrays).
+        terms = next(iter(self.classes.values()))
+        components = {c: np.full((n, nb), -np.inf) for c in (terms.cnossos if model == "cnossos" else terms.mechanics)}
+        for name in set(passes.vehicle_class.tolist()):
+            rows = passes.vehicle_class == name
+            rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
+            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model)
+            roughness[rows] = lr
+            for comp, lh in transfers.items():
+                components[comp][rows] = lr + lh + per_metre[rows]
+        return roughness, components
+
+    def _pass_by(self, components: dict[str, np.ndarray], passes: PassTable, time_weighted: bool = True) -> PassBy:
+        return pass_by(_total(components), self.band, passes.train_length_m, passes.speed_mps, self.receiver,
+                       self.vertical_db, time_weighted)
+
+    def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray,
+                   model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
+        rule = self.cfg["interpolation"]
+        if model == "cnossos":
+            lr = cn.total_roughness(rail_db, terms.wheel_db, terms.a3_db, self.impact_db)
+            return cn.at_band_frequencies(lr, speed, self.band_hz, rule), terms.cnossos
+        combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
+        filt = wrn.contact_filter_power(speed, self.band, terms.semi_length_m, self.cfg["band_points"])
+        lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + level(filt)
+        return lr, terms.mechanics
+
+
+def _total(components: dict[str, np.ndarray]) -> np.ndarray:
+    """Energy sum of component levels [dB]."""
+    return level(sum(power(c) for c in components.values()))

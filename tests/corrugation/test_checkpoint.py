@@ -1,0 +1,78 @@
+"""Checkpoints: round trip, refusals, fallback to the previous good file
+(rail_monitor.corrugation.checkpoint)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from corrugation.conftest import _estimator, _passes
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.corrugation import checkpoint, surveys
+from rail_monitor.corrugation.checkpoint import CorruptCheckpoint
+
+
+def test_checkpoint_round_trip_and_refusals(site_, tables, tmp_path):
+    est = _estimator(site_, tables)
+    passes = _passes(site_, np.linspace(15, 21, 200))
+    est.advance(passes.take(slice(0, 150)))
+    surveys.apply_survey(est, est.bands, est.amplitude * 1.1)
+    path = tmp_path / "state" / "corrugation.npz"
+    checkpoint.save(est, path)
+    assert [p.name for p in path.parent.iterdir()] == ["corrugation.npz"]   # no temporary left behind
+    again = _estimator(site_, tables)
+    checkpoint.load(again, path)
+    np.testing.assert_array_equal(again.log_components, est.log_components)
+    np.testing.assert_array_equal(again.k_b, est.k_b)
+    assert again.total_pass_count == 150
+    # Resumed: the passes already counted are recognised, the rest count.
+    assert again.advance(passes).sum() == 50
+    est.advance(passes)
+    np.testing.assert_allclose(again.log_components, est.log_components, rtol=0, atol=1e-12)
+    (tmp_path / "bad.npz").write_bytes(b"not a checkpoint")
+    with pytest.raises(ConfigError, match="not a readable corrugation checkpoint"):
+        checkpoint.load(again, tmp_path / "bad.npz")
+    other = _estimator(site_, None, longest_wavelength_m=0.5)
+    with pytest.raises(ConfigError, match="bands differ"):
+        checkpoint.load(other, path)
+
+
+def test_an_unreadable_checkpoint_falls_back_to_the_previous_one(site_, tables, tmp_path, tally):
+    """Issue 8: a corrupt or truncated newest checkpoint is detected (zip CRCs, missing arrays) and
+    the previous good one is resumed; with neither readable the estimator refuses, never zero."""
+    est = _estimator(site_, tables)
+    passes = _passes(site_, np.linspace(15, 21, 300))
+    path = tmp_path / "corrugation.npz"
+    est.advance(passes.take(slice(0, 100)))
+    checkpoint.save(est, path)
+    at_100 = est.log_components.copy()
+    est.advance(passes.take(slice(100, 200)))
+    checkpoint.save(est, path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["corrugation.npz", "corrugation.npz.prev"]
+    newest = path.read_bytes()
+    faults = {"truncated": newest[: len(newest) // 2], "zero-length": b"",
+              "flipped byte": newest[:200] + bytes([newest[200] ^ 0xFF]) + newest[201:],
+              "not a zip": b"PK\x03\x04" + b"\x00" * 64}
+    for what, data in faults.items():
+        path.write_bytes(data)
+        again = _estimator(site_, tables)
+        used, skipped = checkpoint.resume(again, path)
+        assert used == tmp_path / "corrugation.npz.prev", what
+        assert len(skipped) == 1 and str(path) in skipped[0] and "\n" not in skipped[0], what
+        np.testing.assert_array_equal(again.log_components, at_100)
+        assert again.total_pass_count == 100
+        # replaying the history counts only what the fallback had not seen
+        assert again.advance(passes.take(slice(0, 200))).sum() == 100, what
+        np.testing.assert_array_equal(again.log_components, est.log_components)
+    # a crash between save()'s two renames leaves only the previous file
+    path.unlink()
+    assert checkpoint.resume(_estimator(site_, tables), path)[0] == tmp_path / "corrugation.npz.prev"
+    # both unreadable: refuse (one line), do not start from zero
+    path.write_bytes(b"")
+    (tmp_path / "corrugation.npz.prev").write_bytes(newest[:300])
+    with pytest.raises(CorruptCheckpoint, match="no readable previous checkpoint") as err:
+        checkpoint.resume(_estimator(site_, tables), path)
+    assert "\n" not in str(err.value)
+    assert checkpoint.resume(_estimator(site_, tables), tmp_path / "none.npz") == (None, [])
+    tally("checkpoint", f"{len(faults)} corrupt newest checkpoints, both corrupt, crash between renames",
+          "previous good state resumed; refusal when neither is readable", 0)

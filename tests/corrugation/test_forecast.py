@@ -1,0 +1,63 @@
+"""The grinding forecast (rail_monitor.corrugation.forecast) against stepping the passes, the traffic
+span, the lead time and the sample history."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from corrugation.conftest import _estimator, _passes
+from rail_monitor.core.timeutil import NS_PER_DAY
+
+
+def test_forecast_agrees_with_stepping_the_passes(site_, tables):
+    # Independent method: the forecast number of passes, then advancing pass by pass at the same
+    # speed and friction, crosses the threshold within one pass of the forecast.
+    est = _estimator(site_, tables, min_traffic_days=0.0)  # 50 passes span 8 h
+    est.advance(_passes(site_, [19.0] * 50, prefix="A"))
+    fc = est.forecast()
+    assert 0 < fc.passes_to_threshold < np.inf and not fc.grinding_due
+    assert fc.passes_per_day == pytest.approx(49 / (49 * 600 / 86_400))
+    assert fc.days_to_threshold == pytest.approx(fc.passes_to_threshold / fc.passes_per_day)
+    n = int(np.floor(fc.passes_to_threshold))
+    start = 50 * 600.0
+    est.advance(_passes(site_, [19.0] * n, start_s=start, prefix="B"))
+    worst = fc.worst_band
+    assert est.amplitude[worst] < est.threshold[worst]
+    est.advance(_passes(site_, [19.0], start_s=start + n * 600.0, prefix="C"))
+    assert est.amplitude[worst] >= est.threshold[worst]
+    assert est.forecast().grinding_due and est.forecast().days_to_threshold == 0.0
+
+
+def test_no_forecast_in_days_until_the_passes_span_min_traffic_days(site_, tables):
+    # 50 passes 10 min apart span 8.2 h: the daily timetable would bias a rate from them.
+    est = _estimator(site_, tables)
+    est.advance(_passes(site_, [19.0] * 50))
+    fc = est.forecast()
+    assert np.isnan(fc.passes_per_day) and fc.days_to_threshold == np.inf and not fc.grinding_due
+    assert 0 < fc.passes_to_threshold < np.inf   # the forecast in passes does not need the rate
+    est.advance(_passes(site_, [19.0] * 100, start_s=50 * 600.0, prefix="B"))  # now 25 h
+    assert est.forecast().passes_per_day == pytest.approx(149 / (149 * 600 / 86_400))
+
+
+def test_lead_time_makes_grinding_due_before_the_threshold(site_, tables):
+    est = _estimator(site_, tables, min_traffic_days=0.0)
+    est.advance(_passes(site_, [19.0] * 50))
+    days = est.forecast().days_to_threshold
+    assert not est.forecast().grinding_due
+    near = _estimator(site_, None, lead_time_days=float(np.ceil(days)), min_traffic_days=0.0)
+    near.advance(_passes(site_, [19.0] * 50))
+    fc = near.forecast()
+    assert fc.grinding_due and np.all(near.amplitude < near.threshold)
+    assert fc.grinding_due_ns == near.newest_ns + int(fc.days_to_threshold * NS_PER_DAY)
+
+
+def test_the_sample_history_gives_a_plausible_forecast(site_, tables, sample):
+    # 90 days of the bundled history (96 trains a day): the worst band is a 50-80 mm one and
+    # grinding is a year or more away with the default K_b (a metro curve is ground every 1-3 years).
+    est = _estimator(site_, tables)
+    assert est.advance(sample).all()
+    fc = est.forecast()
+    assert 0.05 <= est.bands[fc.worst_band] <= 0.08
+    assert 365 <= fc.days_to_threshold <= 3 * 365
+    assert fc.passes_per_day == pytest.approx(96.2, rel=0.01)

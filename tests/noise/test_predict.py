@@ -1,0 +1,143 @@
+"""Rolling noise at the site (rail_monitor.noise.predict): the published targets (docs/models.md, "Rolling
+noise"), for both source models."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
+from rail_monitor.models import cnossos as cn
+from rail_monitor.models.corrugation import band_limits, wavelength_bands
+from rail_monitor.noise.config import MODELS, noise_config
+from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.site_file import load_parameter_file, load_site
+
+from conftest import SITE_FILE
+
+
+def _passes(site, vehicle_class: str, speeds, vehicles: int = 4) -> PassTable:
+    n = len(speeds)
+    return with_class_defaults(PassTable(
+        stamp_ns=np.arange(1, n + 1) * 10**9, train_id=[f"T{i}" for i in range(n)], vehicle_class=[vehicle_class] * n,
+        vehicle_count=[vehicles] * n, axle_count=[0] * n, speed_mps=np.asarray(speeds, float),
+        angle_of_attack_rad=[0.0] * n, wheel_load_n=[0.0] * n, friction_state=[FRICTION_DRY] * n,
+        train_length_m=[0.0] * n), site)
+
+
+@pytest.fixture(scope="module")
+def model():
+    return RollingNoiseModel(load_site(SITE_FILE), noise_config(load_parameter_file(SITE_FILE)))
+
+
+@pytest.mark.parametrize("name", MODELS)
+@pytest.mark.parametrize("vehicle_class", ["emu", "freight"])      # disc braked; cast-iron tread braked
+def test_doubling_the_speed_adds_about_9_db(model, name, vehicle_class):
+    """docs/models.md, "Rolling noise": rolling noise rises about 30 lg v, 9 dB per doubling (the UQ paper:
+    up to 10 dB(A));
+    tolerance 1.5 dB, from 20 to 40 m/s (72 to 144 km/h). Measured: CNOSSOS 8.7 (EMU) and 9.3 (freight),
+    mechanics 8.0 and 10.3. (Outside this range the mechanics model departs: its wheel has no modes, so
+    for the cast-iron freight it saturates above 30 m/s; see the README.)"""
+    out = model.predict(_passes(model.site, vehicle_class, [20.0, 40.0]), name)
+    assert np.diff(out.lpaeq_tp_dba)[0] == pytest.approx(9.0, abs=1.5)
+
+
+def _grown(model, added_db: float) -> Corrugation:
+    """Corrugation that, added in energy, lifts the rail roughness at 31.5-80 mm by added_db."""
+    wl = cn.tables().wavelength_m
+    bands = wl[(wl >= 0.0315 - 1e-9) & (wl <= 0.080 + 1e-9)]
+    base = np.interp(bands, wl, model.baseline_db)
+    amp = 1e-6 * 10 ** ((base + added_db) / 20) * np.sqrt(1 - 10 ** (-added_db / 10))
+    grown = Corrugation(bands, amp, np.zeros(len(bands)))
+    np.testing.assert_allclose(model.rail_roughness_db(grown)[np.isin(wl, bands)], base + added_db, atol=1e-9)
+    return grown
+
+
+@pytest.mark.parametrize("name", MODELS)
+@pytest.mark.parametrize("added_db", [15.0, 20.0])
+def test_rail_roughness_at_31_to_80_mm_raises_the_level_by_8_to_14_db(model, name, added_db):
+    """docs/models.md (the UQ paper: corrugation adds 10-15 dB): 15-20 dB more rail roughness at
+    31.5-80 mm raises the A-weighted level by roughly 8-14 dB for a disc-braked train at 30 m/s, where
+    those wavelengths fall on 375-950 Hz. (At 20 m/s they fall on 250-630 Hz, below the A-weighted
+    peak, and the rise is smaller: 8.3/12.9 dB CNOSSOS, 5.8/10.0 dB mechanics.)"""
+    grown = _grown(model, added_db)
+    emu = _passes(model.site, "emu", [30.0])
+    rise = model.predict(emu, name, grown).lpaeq_tp_dba - model.predict(emu, name).lpaeq_tp_dba
+    assert 8.0 <= rise[0] <= 14.0
+    # A cast-iron-braked wheel is rougher than the rail there: the same rail growth matters less.
+    freight = _passes(model.site, "freight", [30.0])
+    rise_ci = model.predict(freight, name, grown).lpaeq_tp_dba - model.predict(freight, name).lpaeq_tp_dba
+    assert rise_ci[0] < rise[0] - 3.0
+
+
+def test_mechanics_and_cnossos_agree_within_a_few_dba(model):
+    """Same vehicle, track and roughness: the mechanics model is within 4 dB(A) of CNOSSOS-EU for the
+    disc-braked EMU on the site's track at 15-30 m/s (measured: about +2 to +3 dB(A); the rail transfer
+    agrees with Table G-3a within 3 dB from 630 Hz to 2.5 kHz, see the closing note)."""
+    passes = _passes(model.site, "emu", [15.0, 20.0, 30.0])
+    gap = model.predict(passes, "mechanics").lpaeq_tp_dba - model.predict(passes, "cnossos").lpaeq_tp_dba
+    assert np.all(np.abs(gap) <= 4.0), gap
+
+
+def test_post_grinding_state_gives_no_increase_and_growth_raises_it(model):
+    bands = wavelength_bands(0.01, 1.0)
+    post = 0.5 * band_limits(bands)
+    passes = _passes(model.site, "emu", [20.0])
+    same = model.predict(passes, "cnossos", Corrugation(bands, post, post))
+    assert same.roughness_growth_increase_db[0] == pytest.approx(0.0, abs=1e-12)
+    grown = model.predict(passes, "cnossos", Corrugation(bands, 6 * post, post))
+    assert grown.roughness_growth_increase_db[0] > 5.0
+    assert grown.lpaeq_tp_dba[0] - same.lpaeq_tp_dba[0] == pytest.approx(
+        grown.roughness_growth_increase_db[0], abs=1e-9)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_a_batch_equals_passes_one_by_one(model, name):
+    rng = np.random.default_rng(3)
+    classes = rng.choice(["emu", "dmu", "freight"], 40)
+    speeds = rng.uniform(8.0, 30.0, 40)
+    table = with_class_defaults(PassTable(
+        stamp_ns=np.arange(1, 41) * 10**9, train_id=[f"T{i}" for i in range(40)], vehicle_class=classes,
+        vehicle_count=rng.integers(2, 20, 40), axle_count=[0] * 40, speed_mps=speeds, angle_of_attack_rad=[0.0] * 40,
+        wheel_load_n=[0.0] * 40, friction_state=[FRICTION_DRY] * 40, train_length_m=[0.0] * 40), model.site)
+    batch = model.predict(table, name)
+    for i in (0, 7, 39):
+        one = model.predict(table.take([i]), name)
+        for key in ("lp_db", "lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "component_lpaeq_dba"):
+            np.testing.assert_allclose(getattr(one, key)[0], getattr(batch, key)[i], rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_a_batch_with_a_state_per_pass_equals_passes_one_by_one(model, name):
+    # rolling_noise_predictor predicts a backlog in one call, each pass on its own corrugation
+    # state (amplitudes per pass); alone, a pass is predicted on its state's one row.
+    grown = _grown(model, 12.0)
+    n = 30
+    scale = np.linspace(0.2, 3.0, n)[:, None]
+    states = Corrugation(grown.wavelength_m, grown.amplitude_m[None, :] * scale, grown.post_grinding_m)
+    table = _passes(model.site, "emu", np.linspace(10.0, 28.0, n))
+    batch = model.predict(table, name, states)
+    for i in (0, 11, n - 1):
+        one = model.predict(table.take([i]), name, Corrugation(grown.wavelength_m, states.amplitude_m[i],
+                                                               grown.post_grinding_m))
+        for key in ("lp_db", "roughness_db", "lpaeq_tp_dba", "lpafmax_dba", "roughness_growth_increase_db"):
+            np.testing.assert_allclose(getattr(one, key)[0], getattr(batch, key)[i], rtol=1e-12, atol=1e-12)
+
+
+def test_metrics_are_ordered_and_components_add_up(model):
+    out = model.predict(_passes(model.site, "freight", [14.0], vehicles=20), "mechanics")
+    assert out.lpaeq_tp_dba[0] < out.lpafmax_dba[0] < out.tel_dba[0]
+    total = 10 * np.log10(np.sum(10 ** (out.component_lpaeq_dba[0] / 10)))
+    assert total == pytest.approx(out.lpaeq_tp_dba[0], abs=1e-9)
+    assert out.component_names == ["rail", "sleeper", "wheel"]
+
+
+def test_noise_parameters_are_checked(site_values):
+    values = {**site_values, "noise.rail_roughness_db": [1.0, 2.0]}
+    with pytest.raises(ConfigError, match="same length"):
+        noise_config(values)
+    with pytest.raises(ConfigError, match=r"noise\.modle"):
+        noise_config({**site_values, "noise.modle": "cnossos"})
+    with pytest.raises(ConfigError, match=r"noise\.model"):
+        noise_config({**site_values, "noise.model": "twins"})
