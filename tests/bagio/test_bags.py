@@ -16,9 +16,10 @@ from mcap_ros2.decoder import DecoderFactory
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag2 import StoragePlugin, Writer
 
-from rail_monitor.bagio.mcap_bag import McapBagWriter, qos_dict
+from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.passes_bag import pass_cdr, write_passes_bag
 from rail_monitor.bagio.reader import bag_info, read_bag_passes, read_passes, salvage_mcap
+from rail_monitor.bagio.topics import qos_dict
 from rail_monitor.bagio.typestore import TRAIN_PASS, msg_file, type_hash, typestore
 from rail_monitor.core.errors import InputError
 

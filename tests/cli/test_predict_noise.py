@@ -6,24 +6,15 @@ import json
 
 import numpy as np
 import pytest
+from noise.test_predict import _passes
 
 from rail_monitor.cli import main
-from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 from rail_monitor.site_file import load_parameter_file, load_site
 
 from conftest import SITE_FILE
-
-
-def _passes(site, vehicle_class: str, speeds, vehicles: int = 4) -> PassTable:
-    n = len(speeds)
-    return with_class_defaults(PassTable(
-        stamp_ns=np.arange(1, n + 1) * 10**9, train_id=[f"T{i}" for i in range(n)], vehicle_class=[vehicle_class] * n,
-        vehicle_count=[vehicles] * n, axle_count=[0] * n, speed_mps=np.asarray(speeds, float),
-        angle_of_attack_rad=[0.0] * n, wheel_load_n=[0.0] * n, friction_state=[FRICTION_DRY] * n,
-        train_length_m=[0.0] * n), site)
 
 
 def test_predict_noise_json_equals_the_library(tmp_path, capsys):

@@ -12,7 +12,7 @@ from rail_monitor.corrugation import advice
 
 
 def test_speed_spread_at_the_site_lowers_peak_growth_about_40_percent(site_, tables):
-    # MODELS.md section 2 (generic UIC60, CV about 25 % cuts peak growth about 40 %): the site's
+    # docs/models.md (generic UIC60, CV about 25 % cuts peak growth about 40 %): the site's
     # EMU on its UIC60 track at 20 m/s mean, dry rail, band-component peak. Measured 42 %; range 35-50 %.
     est = _estimator(site_, tables)
     peaks = []
@@ -24,11 +24,11 @@ def test_speed_spread_at_the_site_lowers_peak_growth_about_40_percent(site_, tab
     assert 0.35 <= 1 - peaks[-1] / peaks[0] <= 0.50
 
 
-def test_seed_like_speed_control_lengthens_the_grinding_interval_as_the_seed_reports(site_):
-    # Seed section 2.1: on a suburban curve, re-spreading pass speeds at the same mean gave a
+def test_speed_control_as_on_the_papers_suburban_curve_lengthens_the_grinding_interval(site_):
+    # The UQ paper's section 2.1: on a suburban curve, re-spreading pass speeds at the same mean gave a
     # grinding interval x1.7 and grinding cost down up to 45 %. Scenario: one EMU class on dry rail
     # at 17 m/s with a narrow field spread (CV 5 %), advice allowed 11 m/s (the slowest passes lose
-    # under 10 s over a 300 m section, the seed's "less than 20 s") to the 22.2 m/s line speed, at
+    # under 10 s over a 300 m section, the UQ paper's "less than 20 s") to the 22.2 m/s line speed, at
     # most 20 % of trains per 0.5 m/s bin. Tested: interval x1.6-2.0, cost down 35-50 %.
     rng = np.random.default_rng(7)
     est = _estimator(site_, None, advice_min_speed_mps=11.0, advice_max_speed_mps=22.2)

@@ -1,7 +1,7 @@
 """CNOSSOS-EU railway source model (models.cnossos) against the Directive's tables.
 
 Source: Commission Directive (EU) 2015/996, Annex II 2.3 and Appendix G, as amended by
-Commission Delegated Directive (EU) 2021/1226 (tables in ../shared/reference/, transcribed into
+Commission Delegated Directive (EU) 2021/1226 (tables transcribed into
 the package's data files).
 """
 

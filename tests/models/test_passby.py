@@ -4,34 +4,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 
-from rail_monitor.models import iec61260, levels, passby
-
-CNOSSOS_NOMINAL = [50, 63, 80, 100, 125, 160, 200, 250, 315, 400, 500, 630, 800, 1000, 1250, 1600, 2000, 2500,
-                   3150, 4000, 5000, 6300, 8000, 10000]
-
-
-def test_band_numbers_round_trip_the_nominal_centres_of_iec_61260_annex_e():
-    x = iec61260.band_index(CNOSSOS_NOMINAL)
-    np.testing.assert_array_equal(x, np.arange(-13, 11))
-    np.testing.assert_array_equal(iec61260.nominal_centre(x), CNOSSOS_NOMINAL)
-    # Exact centres are within 2 % of the labels (Annex E) and 1/3 octave (base ten) apart.
-    np.testing.assert_allclose(iec61260.exact_centre(x), CNOSSOS_NOMINAL, rtol=0.02)
-    lo, hi = iec61260.band_edges(x)
-    np.testing.assert_allclose(hi / lo, 10 ** 0.1, rtol=1e-12)
-    np.testing.assert_allclose(hi[:-1], lo[1:], rtol=1e-12)
-
-
-def test_energy_sum_and_octaves():
-    assert levels.energy_sum([80.0, 80.0]) == pytest.approx(80.0 + 10 * np.log10(2), abs=1e-12)
-    assert levels.energy_sum([80.0, -np.inf]) == pytest.approx(80.0)
-    x = np.arange(-13, 11)
-    octaves, lv = levels.octave_levels(np.full(24, 70.0), x)
-    np.testing.assert_array_equal(octaves, np.arange(-12, 10, 3))       # 63 Hz ... 8 kHz octaves
-    np.testing.assert_allclose(lv, 70.0 + 10 * np.log10(3))
-    # A-weighted total of a flat spectrum equals the energy sum of the A-weights.
-    total = levels.a_weighted_total(np.zeros(24), x)
-    assert total == pytest.approx(levels.energy_sum(levels.a_weighted(np.zeros(24), x)))
-
+from rail_monitor.models import levels, passby
 
 RECEIVER = passby.Receiver(7.5, 1.2, 0.05, 0.0, 1.0)
 

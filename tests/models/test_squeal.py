@@ -1,7 +1,8 @@
-"""Wheel squeal: contact mechanics, the closed-form limit cycle against the seed and the ODE.
+"""Wheel squeal: contact mechanics, the closed-form limit cycle against the UQ paper and the ODE.
 
-Seed = ../shared/seed/000_a9be5aeeb3936325.txt (UQ Rail Mechanics Group seminar), section 3,
-Figure 5 (rig parameters), Figures 6-7 (results); MODELS.md section 1.
+The UQ paper = Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic
+and acoustic phenomena", seminar paper: section 3, Figure 5 (rig parameters), Figures 6-7 (results);
+docs/models.md, "Wheel squeal".
 """
 
 from __future__ import annotations
@@ -9,17 +10,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rail_monitor.models import hertz, iec61672, kalker, squeal
-
-# Seed Figure 5: the two-disc rig.
-RIG = {"e": 175e9, "nu": 0.28, "load": 1000.0, "m": 3.1, "c": 42.0, "k": 1.6e8, "v0": 17.8, "k1": 0.27, "k2": -0.02}
-RIG_RADII = (0.213, 0.300, 0.085, 0.040)  # lower wheel rolling/transverse, upper wheel rolling/transverse [m]
+from models.test_hertz import RIG, rig_contact
+from rail_monitor.models import squeal
 
 
-def rig_contact() -> hertz.HertzContact:
-    return hertz.contact_ellipse(*RIG_RADII, hertz.contact_modulus(RIG["e"], RIG["nu"]), RIG["load"])
-
-
+# The UQ paper's Figure 5: the two-disc rig.
 def rig_k3(convention: str = "kalker_unit") -> float:
     g_ab_c22 = squeal.kalker_lateral_stiffness(rig_contact(), RIG["e"], RIG["nu"])
     return float(squeal.lateral_creep_stiffness(g_ab_c22, RIG["k1"], convention))
@@ -38,64 +33,19 @@ def rig_ode(vc: float) -> squeal.TimeDomainResult:
 # --- contact mechanics -------------------------------------------------------------------
 
 
-def test_hertz_rig_semi_axes_match_the_seed():
-    # MODELS.md section 1: Hertz gives a = 0.853 mm, b = 0.595 mm for the rig (3 significant figures).
-    c = rig_contact()
-    assert float(c.a) == pytest.approx(0.853e-3, rel=1e-3)
-    assert float(c.b) == pytest.approx(0.595e-3, rel=2e-3)
-
-
-def test_hertz_sphere_limit_is_the_circular_solution():
-    # Johnson (1985) eqs. 4.22-4.23: sphere on a flat, a^3 = 3 P R / (4 E*), delta = a^2 / R.
-    e_star = hertz.contact_modulus(210e9, 0.3)
-    load, radius = np.array([1e3, 5e4, 1e5]), 0.46
-    c = hertz.contact_ellipse(radius, radius, np.inf, np.inf, e_star, load)
-    a_ref = np.cbrt(3 * load * radius / (4 * e_star))
-    np.testing.assert_allclose(c.a, a_ref, rtol=1e-9)
-    np.testing.assert_allclose(c.b, a_ref, rtol=1e-9)
-    np.testing.assert_allclose(c.approach, a_ref**2 / radius, rtol=1e-9)
-
-
-def test_hertz_stiffness_is_the_derivative_of_load_against_approach():
-    # Independent method: central finite difference of P(delta) against the closed 3P/(2 delta).
-    e_star = hertz.contact_modulus(210e9, 0.28)
-    load = 65e3 * np.array([1 - 1e-4, 1, 1 + 1e-4])
-    c = hertz.contact_ellipse(0.42, 1e6, np.inf, 0.3, e_star, load)
-    slope = (load[2] - load[0]) / (c.approach[2] - c.approach[0])
-    assert slope == pytest.approx(float(c.stiffness[1]), rel=1e-6)
-    # and a wheel on a rail is an ellipse elongated along the rail (a > b) with a mean pressure p0 * 2/3
-    assert c.a[1] > c.b[1]
-    assert load[1] / (np.pi * c.a[1] * c.b[1]) == pytest.approx(2 / 3 * c.p0[1], rel=1e-12)
-
-
-def test_kalker_table_nodes_and_properties():
-    # Kalker (1990) Table E.3: circle, nu = 0.25: C11 = 4.12, C22 = 3.67, C23 = 1.47.
-    c = kalker.creep_coefficients(1.0, 0.25)
-    assert (float(c.c11), float(c.c22), float(c.c23)) == pytest.approx((4.12, 3.67, 1.47), abs=1e-12)
-    # nu = 0: C11 = C22 for every ellipse (both reduce to the same half-space problem).
-    ratios = np.geomspace(0.1, 10, 37)
-    c0 = kalker.creep_coefficients(ratios, 0.0)
-    np.testing.assert_allclose(c0.c11, c0.c22, rtol=1e-12)
-    # C22 grows with a/b and with nu.
-    assert np.all(np.diff(kalker.creep_coefficients(ratios, 0.28).c22) > 0)
-    assert np.all(np.diff(kalker.creep_coefficients(1.4, np.linspace(0, 0.5, 11)).c22) > 0)
-    with pytest.raises(ValueError):
-        kalker.creep_coefficients(20.0, 0.28)
-
-
-# --- the seed's rig ------------------------------------------------------------------------
+# --- the UQ paper's rig ------------------------------------------------------------------------
 
 
 def test_k3_conventions_for_the_rig():
-    # MODELS.md: the literal recipe G a b C22 / mu0 gives about 5.5e5 N; the seed's results need
+    # docs/models.md: the literal recipe G a b C22 / mu0 gives about 5.5e5 N; the UQ paper's results need
     # about 1.4e5 N (zeta_c ~ 0.007). kalker_unit (G a b C22) is within 6 % of that.
     assert rig_k3("kalker_peak") == pytest.approx(5.5e5, rel=0.02)
     assert rig_k3("kalker_unit") == pytest.approx(1.4e5, rel=0.06)
     assert RIG["load"] / rig_k3("kalker_unit") == pytest.approx(0.007, rel=0.05)
 
 
-def test_rig_closed_form_reproduces_the_seed():
-    # Seed section 3.3: analytical A w = 0.33 m/s at Vc = 0.39 m/s (tolerance 3 %); a 34 % cut of
+def test_rig_closed_form_reproduces_the_paper():
+    # The UQ paper's section 3.3: analytical A w = 0.33 m/s at Vc = 0.39 m/s (tolerance 3 %); a 34 % cut of
     # Vc halves A w (tolerance 5 %).
     lc = rig_amplitude(np.array([0.39, 0.39 * (1 - 0.34)]))
     assert np.all(lc.regime == squeal.REGIME_LIMIT_CYCLE)
@@ -105,14 +55,14 @@ def test_rig_closed_form_reproduces_the_seed():
     assert lc.amplitude[0] < 0.39
 
 
-def test_rig_literal_k3_does_not_reproduce_the_seed():
+def test_rig_literal_k3_does_not_reproduce_the_paper():
     # The literal reading pushes the closed form past its no-reverse-slip limit at Vc = 0.39.
     lc = rig_amplitude(0.39, "kalker_peak")
     assert int(lc.regime) == squeal.REGIME_STICK_SLIP_BOUND
 
 
 def test_rig_squeal_fades_toward_the_onset():
-    # Seed Figure 7a: the squeal trend holds above about 0.15 m/s; below, no squeal. With
+    # The UQ paper's Figure 7a: the squeal trend holds above about 0.15 m/s; below, no squeal. With
     # kalker_unit the onset Vc = u_s = 0.12 m/s: the amplitude at 0.15 m/s is already small
     # and falls to zero (stable) at 0.10 m/s.
     lc = rig_amplitude(np.array([0.10, 0.15, 0.39]))
@@ -124,8 +74,8 @@ def test_rig_squeal_fades_toward_the_onset():
     assert np.all(np.diff(rig_amplitude(vc).amplitude) / np.diff(vc) > 1.0)
 
 
-def test_rig_time_domain_matches_seed_and_closed_form():
-    # Seed Figure 6a: simulation settles near 0.35 m/s (10 %); the ODE with the same
+def test_rig_time_domain_matches_the_paper_and_closed_form():
+    # The UQ paper's Figure 6a: simulation settles near 0.35 m/s (10 %); the ODE with the same
     # piecewise-linear curve agrees with the closed form within 1 %.
     ode = rig_ode(0.39)
     assert ode.settled
@@ -134,7 +84,7 @@ def test_rig_time_domain_matches_seed_and_closed_form():
 
 
 def test_spl_trend_follows_20_lg_amplitude():
-    # Seed section 3.3: sound power ~ velocity squared, so the level change is 20 lg of the
+    # The UQ paper's section 3.3: sound power ~ velocity squared, so the level change is 20 lg of the
     # amplitude ratio: halving A w (the 34 % cut) lowers the level by 6.0 dB (0.5 dB).
     lc = rig_amplitude(np.array([0.39, 0.39 * 0.66]))
     rel = squeal.relative_level(lc.amplitude, lc.amplitude[0])
@@ -218,13 +168,6 @@ def test_stable_cases_give_no_squeal(what, vc, c, k2):
 
 
 # --- acoustics ------------------------------------------------------------------------------
-
-
-def test_a_weighting_matches_iec_61672_table():
-    # IEC 61672-1:2013 Table 3 (0.1 dB resolution), which is evaluated at the exact base-ten
-    # frequencies 1 kHz x 10^(n/10), n = -15, -10, 0, 6, 10 (nominal 31.5, 100, 1k, 4k, 10k Hz).
-    f = 1000.0 * 10.0 ** (np.array([-15, -10, 0, 6, 10]) / 10)
-    np.testing.assert_allclose(iec61672.a_weighting_db(f), [-39.4, -19.1, 0.0, 1.0, -2.5], atol=0.051)
 
 
 def test_radiated_power_is_conserved_over_the_hemisphere():

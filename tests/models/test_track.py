@@ -1,6 +1,6 @@
-"""Track receptance: limits, resonance structure and convergence (MODELS.md section 2).
+"""Track receptance: limits, resonance structure and convergence (docs/models.md).
 
-Reference values: MODELS.md section 2 (UIC60 on a typical ballasted track; static stiffness
+Reference values: docs/models.md (UIC60 on a typical ballasted track; static stiffness
 about 110 MN/m; full-track resonance 50-150 Hz, rail-on-pad 300-1000 Hz, pinned-pinned
 900-1100 Hz with a peak at mid-span and a dip above a sleeper); Knothe & Grassie, Vehicle
 System Dynamics 22 (1993) for the structure.

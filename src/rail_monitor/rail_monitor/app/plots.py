@@ -15,7 +15,7 @@ from rail_monitor.models.squeal import REGIME_STICK_SLIP_BOUND
 
 
 def squeal_sweep(rows: dict[str, np.ndarray], path: str | Path, title: str = "") -> Path:
-    """Amplitude and relative level against crabbing velocity (the shape of the seed's Figure 7a)."""
+    """Amplitude and relative level against crabbing velocity (the shape of the UQ paper's Figure 7a)."""
     vc = rows["crabbing_velocity_mps"]
     amp = rows["velocity_amplitude_mps"]
     fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.0), constrained_layout=True)
@@ -83,7 +83,7 @@ def corrugation_growth(wavelength: np.ndarray, curves: dict[str, np.ndarray], pa
 def noise_spectra(band_hz: np.ndarray, panels: dict[str, dict[str, np.ndarray]], path: str | Path,
                   title: str = "") -> Path:
     """A-weighted 1/3-octave Lp [dB(A)] against band centre [Hz], one panel per group of spectra (the
-    shapes of the seed's Figure 3: spectra at several speeds; after roughness growth of various times)."""
+    shapes of the UQ paper's Figure 3: spectra at several speeds; after roughness growth of various times)."""
     fig, axes = plt.subplots(len(panels), 1, sharex=True, figsize=(6.4, 3.2 * len(panels)), constrained_layout=True,
                              squeeze=False)
     for ax, (heading, curves) in zip(axes[:, 0], panels.items(), strict=True):

@@ -22,67 +22,10 @@ from typing import Any
 import yaml
 from mcap.writer import CompressionType, Writer
 
+from rail_monitor.bagio.direct_file import DirectFile
+from rail_monitor.bagio.topics import qos_dict
 from rail_monitor.bagio.typestore import schema_text, type_hash
 from rail_monitor.core.errors import RailMonitorError
-
-# rosbag2's "infinite" duration in QoS (deadline, lifespan, lease) as written by Jazzy.
-_INFINITE = {"sec": 9223372036, "nsec": 854775807}
-
-
-def qos_dict(reliable: bool = True, transient_local: bool = False, depth: int = 1000,
-             history: str = "keep_last") -> dict[str, Any]:
-    """One offered QoS profile in the metadata.yaml version 9 layout.
-
-    history: keep_last, keep_all, or unknown (what discovery reports for a remote publisher).
-    """
-    return {
-        "history": history,
-        "depth": depth,
-        "reliability": "reliable" if reliable else "best_effort",
-        "durability": "transient_local" if transient_local else "volatile",
-        "deadline": dict(_INFINITE),
-        "lifespan": dict(_INFINITE),
-        "liveliness": "automatic",
-        "liveliness_lease_duration": dict(_INFINITE),
-        "avoid_ros_namespace_conventions": False,
-    }
-
-
-class _DirectFile:
-    """A write-only file whose every write reaches the OS at once (no user-space buffer), so a
-    killed writer leaves on disk everything it wrote. Not a RawIOBase, which mcap would wrap in
-    a BufferedWriter."""
-
-    def __init__(self, path: Path) -> None:
-        self._fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
-        self._pos = 0
-
-    def write(self, data: bytes | memoryview) -> int:
-        view = memoryview(data)
-        try:
-            while view:
-                view = view[os.write(self._fd, view):]
-        except OSError:
-            # A full disk or a write error: cut off what got out of this write, so the file stays
-            # the records written before it (a salvage reads them all), then report.
-            with contextlib.suppress(OSError):
-                os.ftruncate(self._fd, self._pos)
-                os.lseek(self._fd, self._pos, os.SEEK_SET)
-            raise
-        self._pos += len(data)
-        return len(data)
-
-    def tell(self) -> int:
-        return self._pos
-
-    def flush(self) -> None:
-        pass
-
-    def fileno(self) -> int:
-        return self._fd
-
-    def close(self) -> None:
-        os.close(self._fd)
 
 
 def _dump(obj: Any) -> str:
@@ -163,7 +106,7 @@ class McapBagWriter:
 
     def _open_file(self) -> _File:
         path = self.folder / f"{self.folder.name}_{len(self._files)}.mcap"
-        stream = _DirectFile(path)
+        stream = DirectFile(path)
         writer = Writer(stream, chunk_size=self._chunk_size, compression=self._compression)
         writer.start(profile="ros2", library="rail_monitor")
         f = _File(path, writer, stream)

@@ -7,7 +7,28 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from rail_monitor.bagio.mcap_bag import qos_dict
+# rosbag2's "infinite" duration in QoS (deadline, lifespan, lease) as written by Jazzy.
+_INFINITE = {"sec": 9223372036, "nsec": 854775807}
+
+
+def qos_dict(reliable: bool = True, transient_local: bool = False, depth: int = 1000,
+             history: str = "keep_last") -> dict[str, Any]:
+    """One offered QoS profile in the metadata.yaml version 9 layout.
+
+    history: keep_last, keep_all, or unknown (what discovery reports for a remote publisher).
+    """
+    return {
+        "history": history,
+        "depth": depth,
+        "reliability": "reliable" if reliable else "best_effort",
+        "durability": "transient_local" if transient_local else "volatile",
+        "deadline": dict(_INFINITE),
+        "lifespan": dict(_INFINITE),
+        "liveliness": "automatic",
+        "liveliness_lease_duration": dict(_INFINITE),
+        "avoid_ros_namespace_conventions": False,
+    }
+
 
 
 @dataclass(frozen=True)

@@ -2,9 +2,23 @@
 
 One module per piece of physics or per standard:
 
-- :mod:`hertz`: elliptical Hertz contact (semi-axes, pressure, approach, contact stiffness).
-- :mod:`kalker`: Kalker's linear creep coefficients (Kalker 1990, Table E.3).
-- :mod:`squeal`: wheel squeal on a falling creep curve: stability, limit-cycle amplitude,
+- :mod:`.hertz`: elliptical Hertz contact (semi-axes, pressure, approach, contact stiffness).
+- :mod:`.kalker`: Kalker's linear creep coefficients (Kalker 1990, Table E.3).
+- :mod:`.squeal`: wheel squeal on a falling creep curve: stability, limit-cycle amplitude,
   time-domain check, radiated level.
-- :mod:`iec61672`: frequency weighting A (IEC 61672-1).
+- :mod:`.track`: vertical track receptance (Euler or Timoshenko rail on a two-layer support,
+  continuous and discrete), wheel receptance, track decay rate.
+- :mod:`.contact_filter`: the Hertzian contact filter of short-wavelength roughness.
+- :mod:`.corrugation`: wear-type corrugation growth per wheel pass, wavelength bands, the
+  grinding limits of Grassie et al. (1999), the speed-distribution optimiser.
+- :mod:`.cnossos`: the CNOSSOS-EU railway source model and its Appendix G tables.
+- :mod:`.wheel_rail_noise`: the mechanics rolling-noise model (roughness to radiated power).
+- :mod:`.radiation`: radiation efficiencies and radiated power.
+- :mod:`.passby`: pass-by levels of a moving line source at a wayside receiver.
+- :mod:`.levels`: level arithmetic, energy sums, A-weighted totals, octaves.
+- :mod:`.iec61260`: one-third-octave bands (IEC 61260-1).
+- :mod:`.iec61672`: frequency weighting A (IEC 61672-1).
+
+The equations as implemented, their conventions and the known errors of the source paper are
+in docs/models.md.
 """

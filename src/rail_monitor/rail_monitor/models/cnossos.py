@@ -29,6 +29,15 @@ for 300 m < R <= 500 m (2.3.2, "squeal"). Directivity: horizontal 10 lg(0.01 + 0
 (2.3.15); vertical, for source A (h = 1) above the source, 40/3 [2/3 sin(2 psi) - sin psi]
 lg((f + 600) / 200) (2.3.16). Sound power per metre of line for a flow of Q
 vehicles per hour at v km/h: L_W',eq,line = L_W,0,dir + 10 lg(Q / (1000 v)) (2.3.1).
+
+References
+----------
+.. [1] Commission Directive (EU) 2015/996 of 19 May 2015 establishing common noise assessment methods
+   according to Directive 2002/49/EC, *Official Journal of the European Union* L 168, 1.7.2015,
+   Annex II section 2.3; corrigendum, OJ L 5, 10.1.2018.
+.. [2] Commission Delegated Directive (EU) 2021/1226 of 21 December 2020 amending, for the purposes of
+   adapting to scientific and technical progress, Annex II to Directive 2002/49/EC as regards common
+   noise assessment methods, *Official Journal of the European Union* L 269, 28.7.2021.
 """
 
 from __future__ import annotations

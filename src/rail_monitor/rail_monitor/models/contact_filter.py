@@ -14,6 +14,13 @@ Thompson, J. Sound Vib. 293 (2006) 807-818, who find a 2-D line model within 3 d
 Boussinesq analysis in 1/3-octave bands). The same averaging acts on wear: material removed at a
 point is the average of the frictional work over the patch passing it (Hempelmann & Knothe,
 Wear 191 (1996) 161-169), so corrugation growth sees the filter twice (models.corrugation).
+
+References
+----------
+.. [1] P. J. Remington, "Wheel/rail rolling noise, I: Theoretical analysis", *Journal of the Acoustical
+   Society of America* 81(6) (1987) 1805-1823.
+.. [2] R. A. J. Ford and D. J. Thompson, "Simplified contact filters in wheel/rail noise prediction",
+   *Journal of Sound and Vibration* 293(3-5) (2006) 807-818.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Wear-type corrugation growth per wheel pass (seed section 2.1, eqs. 1-2; MODELS.md section 2).
+"""Wear-type corrugation growth per wheel pass (UQ paper section 2.1, eqs. 1-2; docs/models.md).
 
 A rail roughness harmonic of wavelength lambda [m], passed at speed V [m/s] (frequency
 f = V / lambda), grows per wheel pass by
@@ -8,15 +8,15 @@ f = V / lambda), grows per wheel pass by
 with k_c the linearised Hertz contact stiffness [N/m] (models.hertz), R_r and R_w the complex
 vertical receptances of rail and wheel [m/N] (models.track) and K_b the wear sensitivity [-]
 (order 1e-5 per pass; the field-tuning parameter). Over a distribution p(V) of pass speeds the
-expected log growth per pass is (seed eq. 2, kept in its ln|.| form, not linearised)
+expected log growth per pass is (UQ paper eq. 2, kept in its ln|.| form, not linearised)
 
     g(lambda) = integral ln|1 + K_b H(V / lambda)| p(V) dV,      Z_n ~ Z_0 exp(n g).
 
-The seed's eq. (1) is a single-mode approximation, G_r = K_b (1 + K_c / (4 zeta (1 + zeta))),
+The UQ paper's eq. (1) is a single-mode approximation, G_r = K_b (1 + K_c / (4 zeta (1 + zeta))),
 valid only as K_c -> 0; :func:`single_mode_growth_max` is the exact maximum of K_b Re H for one
-mode (MODELS.md), and the tests check both against the full kernel.
+mode (docs/models.md), and the tests check both against the full kernel.
 
-Two additions to the seed's kernel, both cited where they are defined:
+Two additions to the UQ paper's kernel, both cited where they are defined:
 - the contact filter F (models.contact_filter) acts twice, on the roughness the contact sees and
   on the wear it leaves, so the growth term is K_b F^2 H; without it every wavelength shorter than
   the contact patch would grow at K_b at least (H -> 1 as the receptances vanish);
@@ -27,6 +27,15 @@ Two additions to the seed's kernel, both cited where they are defined:
 
 Grinding limits (Grassie, Saxon & Smith, J. Sound Vib. 227 (1999) 949-964) and the speed-
 distribution optimiser (a linear programme) are here too.
+
+References
+----------
+.. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and acoustic
+   phenomena", seminar paper, section 2.1 (eqs. 1-2, Figure 2).
+.. [2] S. L. Grassie, M. J. Saxon and J. D. Smith, "Measurement of longitudinal rail irregularities and
+   criteria for acceptable grinding", *Journal of Sound and Vibration* 227(5) (1999) 949-964.
+.. [3] A. Hempelmann and K. Knothe, "An extended linear model for the prediction of short pitch
+   corrugation", *Wear* 191 (1996) 161-169.
 """
 
 from __future__ import annotations
@@ -61,7 +70,7 @@ def band_sub_wavelengths(centres: ArrayLike, per_band: int = 5) -> FloatArray:
 
 
 def growth_kernel(contact_stiffness: ArrayLike, receptance_sum: ArrayLike) -> ComplexArray:
-    """H = 1 / (1 + k_c (R_r + R_w)) [-] from k_c [N/m] and R_r + R_w [m/N] (seed eq. 2)."""
+    """H = 1 / (1 + k_c (R_r + R_w)) [-] from k_c [N/m] and R_r + R_w [m/N] (UQ paper eq. 2)."""
     return 1.0 / (1.0 + np.asarray(contact_stiffness) * np.asarray(receptance_sum))
 
 
@@ -77,7 +86,7 @@ def expected_log_growth(
     speeds: ArrayLike,
     weights: ArrayLike,
 ) -> FloatArray:
-    """g(lambda) [-/pass] (seed eq. 2) for a discrete speed distribution.
+    """g(lambda) [-/pass] (UQ paper eq. 2) for a discrete speed distribution.
 
     kernel_at(f) returns H at frequencies f [Hz] (any shape); speeds [m/s] with weights (summing
     to 1) stand for p(V). Returns one value per wavelength [m].
@@ -99,16 +108,16 @@ def single_mode_kernel(frequency_ratio: ArrayLike, contact_ratio: ArrayLike, dam
     return 1.0 / (1.0 + np.asarray(contact_ratio) / (1.0 - r * r + 2j * np.asarray(damping_ratio) * r))
 
 
-def single_mode_growth_seed(wear_sensitivity: ArrayLike, contact_ratio: ArrayLike,
+def single_mode_growth_approx(wear_sensitivity: ArrayLike, contact_ratio: ArrayLike,
                             damping_ratio: ArrayLike) -> FloatArray:
-    """The seed's eq. (1): G_r = K_b (1 + K_c / (4 zeta (1 + zeta))), the K_c -> 0 limit."""
+    """The UQ paper's eq. (1): G_r = K_b (1 + K_c / (4 zeta (1 + zeta))), the K_c -> 0 limit."""
     z = np.asarray(damping_ratio, float)
     return np.asarray(wear_sensitivity) * (1.0 + np.asarray(contact_ratio) / (4.0 * z * (1.0 + z)))
 
 
 def single_mode_growth_max(wear_sensitivity: ArrayLike, contact_ratio: ArrayLike,
                            damping_ratio: ArrayLike) -> FloatArray:
-    """Exact maximum over frequency of K_b Re H for one mode (MODELS.md section 2):
+    """Exact maximum over frequency of K_b Re H for one mode (docs/models.md):
     K_b [1 + K_c / (4 z (1 + z) (1 + K_c))], z = zeta / sqrt(1 + K_c)."""
     kc = np.asarray(contact_ratio, float)
     z = np.asarray(damping_ratio, float) / np.sqrt(1.0 + kc)
@@ -207,7 +216,7 @@ def optimise_speed_distribution(growth: ArrayLike, speeds: ArrayLike, mean_speed
 
     growth G: per-pass log growth of each wavelength (rows) at each speed bin (columns) [1/pass],
     e.g. from :func:`filtered_log_growth`; speeds [m/s], the bins allowed (within the speed limits). Because g is
-    linear in p (seed eq. 2), the minimax is the linear programme min t s.t. G p <= t, solved
+    linear in p (UQ paper eq. 2), the minimax is the linear programme min t s.t. G p <= t, solved
     exactly (HiGHS, scipy.optimize.linprog). max_share caps any one bin so the advice is a spread,
     not a single speed. Raises ValueError when no distribution meets the constraints.
     """

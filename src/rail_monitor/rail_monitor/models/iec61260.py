@@ -4,6 +4,11 @@ filters - Part 1), base ten.
 Exact mid-band frequencies f_m = f_r G^(x/3), G = 10^(3/10), f_r = 1000 Hz, x integer (eq. 2,
 b = 3); band edges f_m G^(-1/6) and f_m G^(1/6) (eqs. 4-5). Nominal mid-band frequencies are the
 labels of Annex E (they name the bands; calculations use the exact values).
+
+References
+----------
+.. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters - Part 1:
+   Specifications*, International Electrotechnical Commission, Geneva, 2014.
 """
 
 from __future__ import annotations

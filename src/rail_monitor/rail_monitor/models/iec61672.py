@@ -4,6 +4,11 @@ A(f) = 20 lg[ f4^2 f^4 / ((f^2 + f1^2) (f^2 + f2^2)^(1/2) (f^2 + f3^2)^(1/2) (f^
 
 with the pole frequencies and the normalisation of Annex E (eqs. E.1-E.6): f1 = 20.598997 Hz,
 f2 = 107.65265 Hz, f3 = 737.86223 Hz, f4 = 12194.217 Hz, A1000 = -2.000 dB, so that A(1 kHz) = 0.
+
+References
+----------
+.. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, International
+   Electrotechnical Commission, Geneva, 2013, Annex E.
 """
 
 from __future__ import annotations

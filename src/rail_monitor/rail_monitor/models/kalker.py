@@ -11,6 +11,12 @@ for Poisson's ratio 0, 0.25, 0.5 and g = a/b (a <= b) or g = b/a (a > b) from 0.
 Interpolation (our choice, documented): linear in ln(a/b) between table rows, then a quadratic
 through the three Poisson's ratios. Outside 0.1 <= a/b <= 10 a ValueError is raised rather
 than extrapolating.
+
+References
+----------
+.. [1] J. J. Kalker, *Three-Dimensional Elastic Bodies in Rolling Contact*, Kluwer Academic Publishers,
+   Dordrecht, 1990, Appendix E, Table E.3.
+.. [2] K. L. Johnson, *Contact Mechanics*, Cambridge University Press, Cambridge, 1985, Table 8.1.
 """
 
 from __future__ import annotations

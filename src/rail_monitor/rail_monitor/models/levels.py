@@ -4,6 +4,13 @@ Levels are 10 lg of a power-like quantity over its reference (sound power re 1 p
 pressure re (20 uPa)^2, squared roughness re (1 um)^2). Band levels are 1/3-octave bands named
 by their IEC 61260-1 band number x (models.iec61260); the A-weighting is IEC 61672-1's at the
 exact mid-band frequency (models.iec61672).
+
+References
+----------
+.. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters - Part 1:
+   Specifications*, International Electrotechnical Commission, Geneva, 2014.
+.. [2] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, International
+   Electrotechnical Commission, Geneva, 2013.
 """
 
 from __future__ import annotations

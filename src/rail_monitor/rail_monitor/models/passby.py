@@ -24,6 +24,14 @@ and every metric follows in closed form from its first and second antiderivative
   integral of g over all x: [0.01 / R + 0.99 d / (R (d + R))] / 4;
 * LpAFmax: the largest time-weighted level with IEC 61672-1's F time constant (0.125 s), from
   the time history G(vt) - G(vt - L) filtered around its peak.
+
+References
+----------
+.. [1] Commission Directive (EU) 2015/996 of 19 May 2015 establishing common noise assessment methods
+   according to Directive 2002/49/EC, *Official Journal of the European Union* L 168, 1.7.2015,
+   Annex II sections 2.3 and 2.5.
+.. [2] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by railbound
+   vehicles*, International Organization for Standardization, Geneva, 2013.
 """
 
 from __future__ import annotations

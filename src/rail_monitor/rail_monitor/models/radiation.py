@@ -3,6 +3,14 @@
 W = rho0 c0 sigma S <v^2>: sound power [W] of a surface of area S [m2] whose normal velocity has
 the mean square <v^2> [m2/s2] (spatial and time average), with radiation efficiency sigma [-].
 Air: rho0 c0 = 1.204 kg/m3 x 343.2 m/s = 413 rayl at 20 degC and 101.325 kPa (ISO 9613-1:1993).
+
+References
+----------
+.. [1] ISO 9613-1:1993, *Acoustics - Attenuation of sound during propagation outdoors - Part 1:
+   Calculation of the absorption of sound by the atmosphere*, International Organization for
+   Standardization, Geneva, 1993.
+.. [2] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+   Elsevier, Oxford, 2009, chapter 2 (radiation efficiency).
 """
 
 from __future__ import annotations

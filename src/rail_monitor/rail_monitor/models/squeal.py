@@ -1,16 +1,16 @@
 """Wheel squeal: one lateral wheel mode driven by a falling lateral creep curve.
 
-Model (seed, section 2.3, eqs. 3-5; ../shared/MODELS.md section 1)::
+Model (the UQ paper [1]_, section 2.3, eqs. 3-5; docs/models.md, "Wheel squeal")::
 
     m y'' + c y' + k y = -mu(xi') W,      xi' = (Vc + y') k3 / (V0 W),      Vc = V0 sin(theta)
     mu = k1 xi'                 for xi' <= 1    (adhesion branch,  slope s1 = k1 k3 / V0 [N s/m])
     mu = k1 + k2 (xi' - 1)      for xi' > 1     (falling branch,   slope s2 = k2 k3 / V0 [N s/m])
 
 The critical creepage is zeta_c = W / k3 and the critical slip velocity u_s = zeta_c V0. Small
-oscillations about the sliding state see the damping c + s2 (seed eq. 5): squeal needs
+oscillations about the sliding state see the damping c + s2 (UQ paper eq. 5): squeal needs
 c + s2 < 0 and Vc > u_s.
 
-Limit cycle (our derivation; it corrects the sign of the k2 k3 term of the seed's eq. 7).
+Limit cycle (our derivation; it corrects the sign of the k2 k3 term of the UQ paper's eq. 7).
 Take y' = A w cos(wt) and require that the friction force does no net work against the
 damper over one cycle. With D = Vc - u_s, the contact adheres (xi' <= 1) on the arc where
 A w cos(wt) < -D, of half-angle phi with cos(phi) = D / (A w). The work of the adhesion
@@ -25,7 +25,16 @@ past that limit (or when no root exists) the amplitude is bounded by stick-slip,
 and the regime is flagged rather than reporting the closed form.
 
 k3 conventions (the lateral creep stiffness of the normalised curve) are in
-:data:`K3_CONVENTIONS`; see :func:`lateral_creep_stiffness` for which one reproduces the seed.
+:data:`K3_CONVENTIONS`; see :func:`lateral_creep_stiffness` for which one reproduces the UQ paper.
+
+References
+----------
+.. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and acoustic
+   phenomena", seminar paper, sections 2.3 and 3 (eqs. 3-7, Figures 5-7).
+.. [2] J. J. Kalker, *Three-Dimensional Elastic Bodies in Rolling Contact*, Kluwer Academic Publishers,
+   Dordrecht, 1990.
+.. [3] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+   Elsevier, Oxford, 2009, chapter 9 (curve squeal).
 """
 
 from __future__ import annotations
@@ -76,15 +85,15 @@ def lateral_creep_stiffness(kalker_stiffness: ArrayLike, mu0: ArrayLike, convent
     (:func:`kalker_lateral_stiffness`); mu0 the friction peak k1 [-]. Conventions:
 
     ``kalker_peak``
-        The seed's eq. (4) read literally, xi' = zeta G a b C22 / (mu0 W): k3 = G a b C22 / mu0.
-        The adhesion branch then has Kalker's slope. For the seed's rig this gives
-        k3 = 5.5e5 N (zeta_c = 0.0018) and does not reproduce the seed's Figures 6-7.
+        The UQ paper's eq. (4) read literally, xi' = zeta G a b C22 / (mu0 W): k3 = G a b C22 / mu0.
+        The adhesion branch then has Kalker's slope. For the UQ paper's rig this gives
+        k3 = 5.5e5 N (zeta_c = 0.0018) and does not reproduce the UQ paper's Figures 6-7.
     ``kalker_unit`` (default)
         k3 = G a b C22, i.e. the creepage normalised by W rather than mu0 W: the adhesion
         slope is k1 times Kalker's. This is equivalent to a creep-force reduction factor
         equal to the friction peak, in the range of the reductions needed to match measured
         creep curves (Kalker's linear theory overestimates measured slopes, e.g. O. Polach,
-        Wear 258 (2005) 992-1000). For the rig: k3 = 1.48e5 N, zeta_c = 0.0068, and the seed's
+        Wear 258 (2005) 992-1000). For the rig: k3 = 1.48e5 N, zeta_c = 0.0068, and the UQ paper's
         A w = 0.33 m/s at Vc = 0.39 m/s, halving at -34 % Vc, are reproduced (tests). For
         full-size wheels it puts the squeal onset at 5-10 mrad angle of attack, as observed.
     ``saturation_3x``
@@ -107,7 +116,7 @@ def critical_slip_velocity(speed: ArrayLike, load: ArrayLike, k3: ArrayLike) -> 
 
 
 def effective_damping(damping: ArrayLike, k2: ArrayLike, k3: ArrayLike, speed: ArrayLike) -> FloatArray:
-    """c + k2 k3 / V0 [N s/m] (seed eq. 5) on the falling branch; negative means unstable."""
+    """c + k2 k3 / V0 [N s/m] (UQ paper eq. 5) on the falling branch; negative means unstable."""
     return np.asarray(damping, float) + np.asarray(k2, float) * np.asarray(k3, float) / np.asarray(speed, float)
 
 
@@ -115,7 +124,7 @@ def creep_force(slip_velocity: ArrayLike, speed: ArrayLike, load: ArrayLike,
                 k1: ArrayLike, k2: ArrayLike, k3: ArrayLike) -> FloatArray:
     """Lateral friction force mu(xi') W [N] at slip velocity Vc + y' [m/s].
 
-    The seed's piecewise-linear curve, extended as an odd function of the creepage (reverse
+    The UQ paper's piecewise-linear curve, extended as an odd function of the creepage (reverse
     slip saturates at -k1 and falls with the same slope) and floored at mu = 0 (a falling
     branch never turns friction into propulsion), so that it stays physical where the closed
     form's assumptions fail.
@@ -135,7 +144,7 @@ class LimitCycle(NamedTuple):
     a root exists (NaN elsewhere); phi: half the adhesion angle [rad] (NaN without a root);
     regime: REGIME_*; unstable: squeal conditions met; effective_damping: c + s2 [N s/m];
     critical_slip: u_s [m/s]; friction_positive: the falling branch stays above mu = 0 up to
-    the largest creepage of the cycle (where it does not, the seed's curve is being
+    the largest creepage of the cycle (where it does not, the UQ paper's curve is being
     extrapolated past zero friction and the amplitude is outside the model's domain).
     """
 
@@ -173,7 +182,7 @@ def limit_cycle_amplitude(
     k2: ArrayLike,
     k3: ArrayLike,
 ) -> LimitCycle:
-    """Closed-form squeal velocity amplitude by energy balance (module docstring; seed eq. 7 corrected).
+    """Closed-form squeal velocity amplitude by energy balance (module docstring; UQ paper eq. 7 corrected).
 
     Parameters
     ----------
@@ -313,7 +322,7 @@ def radiated_level(
     a reflecting ground): p^2 = rho0 c0 W / (solid_angle r^2), so
     Lp = Lw - 10 lg(solid_angle r^2 / 1 m2) + 10 lg(rho0 c0 / 400), the last term 0.14 dB. The squeal is a tone at the
     mode's frequency; the A-weighted level adds A(f) (IEC 61672-1). Level changes follow
-    20 lg(A w / A w_ref), as in the seed's Figure 7a.
+    20 lg(A w / A w_ref), as in the UQ paper's Figure 7a.
     """
     amp = np.asarray(amplitude, float)
     mean_square = np.asarray(spatial_average, float) * amp**2 / 2.0
@@ -326,6 +335,6 @@ def radiated_level(
 
 
 def relative_level(amplitude: ArrayLike, reference: ArrayLike = REFERENCE_VELOCITY_MPS) -> FloatArray:
-    """Level change 20 lg(A w / A w_ref) [dB] (sound power ~ velocity squared; seed section 3.3)."""
+    """Level change 20 lg(A w / A w_ref) [dB] (sound power ~ velocity squared; UQ paper section 3.3)."""
     with np.errstate(divide="ignore"):
         return 20.0 * np.log10(np.asarray(amplitude, float) / np.asarray(reference, float))

@@ -26,6 +26,13 @@ mid-span, dip above a sleeper, near 1 kHz for UIC60 on 0.6 m bays).
 
 Loss factors enter as complex moduli: E (1 + i eta_r), G (1 + i eta_r). Time dependence
 exp(+i w t); a receptance is displacement over force in the force's direction (static > 0).
+
+References
+----------
+.. [1] K. Knothe and S. L. Grassie, "Modelling of railway track and vehicle/track interaction at high
+   frequencies", *Vehicle System Dynamics* 22(3-4) (1993) 209-262.
+.. [2] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+   Elsevier, Oxford, 2009, chapter 3 (track vibration).
 """
 
 from __future__ import annotations
@@ -42,7 +49,7 @@ BEAMS = ("timoshenko", "euler")
 
 @dataclass(frozen=True)
 class Track:
-    """Track parameters (SI). Defaults: UIC60 rail on a typical ballasted track (MODELS.md
+    """Track parameters (SI). Defaults: UIC60 rail on a typical ballasted track (docs/models.md
     section 2: E = 210 GPa, A = 7.69e-3 m2, I = 30.55e-6 m4, m' = 60.4 kg/m, kappa = 0.4,
     eta_r = 0.02; pad 350 MN/m, eta 0.25; half sleeper 150 kg; ballast 50 MN/m, eta 1.0; d = 0.6 m).
     """

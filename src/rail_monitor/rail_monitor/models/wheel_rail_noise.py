@@ -1,4 +1,4 @@
-"""Rolling noise from roughness: a mechanics model in the spirit of TWINS and the seed's RRNPS.
+"""Rolling noise from roughness: a mechanics model in the spirit of TWINS and the UQ paper's RRNPS.
 
 Chain per 1/3-octave band (Remington, J. Acoust. Soc. Am. 81 (1987) 1805-1823; Thompson,
 J. Sound Vib. 161 (1993) 387-482; Thompson, Railway Noise and Vibration, Elsevier 2009, ch. 5-6):
@@ -30,6 +30,17 @@ transfer over ``points`` log-spaced frequencies per band (resonances narrower th
 Not modelled (and why the wheel component is a lower bound): the wheel's own modes (for
 0.84-0.92 m wheels, the axial and radial modes above about 1.5 kHz that dominate TWINS's wheel
 noise), lateral rail and wheel motion, and shielding by the vehicle body.
+
+References
+----------
+.. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and acoustic
+   phenomena", seminar paper, section 2.2.
+.. [2] P. J. Remington, "Wheel/rail rolling noise, I: Theoretical analysis", *Journal of the Acoustical
+   Society of America* 81(6) (1987) 1805-1823.
+.. [3] D. J. Thompson, "Wheel-rail noise generation, parts I-V", *Journal of Sound and Vibration* 161(3)
+   (1993) 387-482.
+.. [4] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+   Elsevier, Oxford, 2009, chapters 5-6.
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ from typing import Any
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from rail_monitor.bagio import topics
-from rail_monitor.bagio.mcap_bag import qos_dict
+from rail_monitor.bagio.topics import qos_dict
 
 
 def profile(q: topics.Qos) -> QoSProfile:
