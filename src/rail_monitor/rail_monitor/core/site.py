@@ -144,7 +144,7 @@ def site_from_values(values: Mapping[str, Any]) -> Site:
     vehicles = {}
     for name in top["vehicle_classes"]:
         prefix = f"vehicle.{name}."
-        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, section(values, prefix), where=prefix))
+        v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, section(values, prefix), where=prefix, strict=True))
         if v.vehicles_min > v.vehicles_max or v.speed_min_mps > v.speed_max_mps:
             raise ConfigError(f"vehicle class {name!r}: a minimum exceeds its maximum (vehicles or speed)")
         vehicles[name] = v

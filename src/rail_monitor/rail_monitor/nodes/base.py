@@ -63,6 +63,15 @@ def declare(node: Node, specs: Sequence[ParamSpec], prefix: str = "") -> dict[st
     return values
 
 
+def refuse_unknown_parameters(node: Node) -> None:
+    """ConfigError naming a parameter given to the node (a params file, -p) that no section of a
+    site file knows, with the nearest known name: the site file's one strict check
+    (:func:`rail_monitor.site_file.check_names`), applied to what rclpy was given."""
+    from rail_monitor.site_file import check_names
+
+    check_names({name: p.value for name, p in node._parameter_overrides.items()}, f"node {node.get_name()}: ")
+
+
 def declare_site(node: Node) -> Site:
     """Declare the site parameters, the contact geometry, the track and the rolling-stock table, and build the Site."""
     flat = declare(node, SITE_SPECS)

@@ -29,7 +29,15 @@ from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import RECORDER_SPECS
 from rail_monitor.core.timeutil import NS_PER_S
-from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, run_node, subscribe_batched, wall_timer
+from rail_monitor.nodes.base import (
+    Diagnostics,
+    RateMeter,
+    declare,
+    refuse_unknown_parameters,
+    run_node,
+    subscribe_batched,
+    wall_timer,
+)
 from rail_monitor.nodes.qos import qos_to_dict, subscription_qos
 
 DEFAULT_TYPES_PREFIX = "rail_msgs/"
@@ -42,6 +50,7 @@ class McapRecorder(Node):
 
     def __init__(self, **kwargs) -> None:
         super().__init__("mcap_recorder", **kwargs)
+        refuse_unknown_parameters(self)
         self.cfg = declare(self, RECORDER_SPECS)
         out = self.cfg["output"] or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
         self.writer = McapBagWriter(

@@ -29,6 +29,7 @@ from rail_monitor.nodes.base import (
     declare,
     declare_site,
     isolate_failures,
+    refuse_unknown_parameters,
     runs,
     subscribe_batched,
 )
@@ -41,6 +42,7 @@ class PassModelNode(Node):
 
     def __init__(self, name: str, **kwargs: Any) -> None:
         super().__init__(name, **kwargs)
+        refuse_unknown_parameters(self)
         self.site = declare_site(self)
         self.taken = 0  # train_pass messages handled (the pass source's flow control reads it)
         self.accepted = RateMeter()

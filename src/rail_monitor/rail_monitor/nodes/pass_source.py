@@ -21,7 +21,7 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import PUBLISH_SPECS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_S
-from rail_monitor.nodes.base import Diagnostics, RateMeter, declare
+from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, refuse_unknown_parameters
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.qos import CLOCK_QOS, STREAM_QOS
 from rail_msgs.msg import TrainPass
@@ -32,6 +32,7 @@ class PassSourceNode(Node):
 
     def __init__(self, name: str, **kwargs) -> None:
         super().__init__(name, **kwargs)
+        refuse_unknown_parameters(self)
         self.cfg = declare(self, PUBLISH_SPECS)
         self.pub = self.create_publisher(TrainPass, "train_pass", STREAM_QOS)
         self.clock_pub = self.create_publisher(Clock, "/clock", CLOCK_QOS) if self.cfg["publish_clock"] else None

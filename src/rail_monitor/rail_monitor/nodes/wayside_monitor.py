@@ -21,7 +21,7 @@ from rclpy.node import Node
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE
 from rail_monitor.nodes.alert_manager import AlertManagerNode
-from rail_monitor.nodes.base import declare, exit_code, ros_session
+from rail_monitor.nodes.base import declare, exit_code, refuse_unknown_parameters, ros_session
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_model import PassModelNode
@@ -46,6 +46,7 @@ class _Settings(Node):
 
     def __init__(self) -> None:
         super().__init__("wayside_monitor")
+        refuse_unknown_parameters(self)
         self.cfg = declare(self, (*MONITOR_SPECS, SOURCE))
 
 
