@@ -20,7 +20,15 @@ from rail_monitor.app.simulator import SIMULATOR_SPECS
 from rail_monitor.core import node_params
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, flatten, refuse_unknown
-from rail_monitor.core.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
+from rail_monitor.core.site import (
+    CONTACT_SPECS,
+    SITE_SPECS,
+    TRACK_SPECS,
+    VEHICLE_CLASSES,
+    VEHICLE_SPECS,
+    Site,
+    site_from_values,
+)
 from rail_monitor.corrugation.config import CORRUGATION_SPECS
 from rail_monitor.noise.config import NOISE_SPECS
 from rail_monitor.squeal.config import SQUEAL_SPECS
@@ -39,13 +47,14 @@ ROS_PARAMETERS = ("use_sim_time", "start_type_description_service")
 
 
 def known_names(values: Mapping[str, Any]) -> set[str]:
-    """Every parameter name a site file with these values may hold (vehicle classes from its
-    ``vehicle_classes``, or the default)."""
+    """Every parameter name a site file with these values may hold. Vehicle sections are those of
+    its ``vehicle_classes`` (the default's without it); where that is not a list of names (an error
+    its own check reports), every ``vehicle.<class>.`` section present is taken as a class."""
     names = {prefix + s.name for prefix, specs in SECTIONS for s in specs} | set(ROS_PARAMETERS)
-    classes = values.get("vehicle_classes", SITE_SPECS[2].default)
-    if isinstance(classes, list):
-        names |= {f"vehicle.{c}.{s.name}" for c in classes if isinstance(c, str) for s in VEHICLE_SPECS}
-    return names
+    classes = values.get(VEHICLE_CLASSES.name, VEHICLE_CLASSES.default)
+    if not (isinstance(classes, list) and all(isinstance(c, str) for c in classes)):
+        classes = {k.split(".")[1] for k in values if k.startswith("vehicle.") and k.count(".") >= 2}
+    return names | {f"vehicle.{c}.{s.name}" for c in classes for s in VEHICLE_SPECS}
 
 
 def check_names(values: Mapping[str, Any], where: str = "") -> None:

@@ -20,10 +20,11 @@ from rail_monitor.models.cnossos import BRAKE_TYPES
 from rail_monitor.models.track import Track
 
 SITE_ID = ParamSpec("site_id", "site", "Site identifier, written to header.frame_id of every message.")
+VEHICLE_CLASSES = ParamSpec("vehicle_classes", ["emu"], "Names of the vehicle classes of the rolling-stock table.")
 SITE_SPECS: tuple[ParamSpec, ...] = (
     SITE_ID,
     ParamSpec("curve_radius_m", 250.0, "Radius of the curve at the site [m].", 10.0, 1.0e5),
-    ParamSpec("vehicle_classes", ["emu"], "Names of the vehicle classes of the rolling-stock table."),
+    VEHICLE_CLASSES,
 )
 
 # Wheel-rail contact, under contact.: one geometry for every model (squeal's k3, the corrugation

@@ -30,12 +30,12 @@ from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import LEAD_TIME
 from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched
 from rail_monitor.nodes.convert import to_msg
-from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
 from rail_msgs.msg import CorrugationState, RollingNoise, SquealPrediction, WaysideAlert, WaysideAlertArray
 
 
-class AlertManagerNode(PassModelNode):
+class AlertManagerNode(PassConsumerNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("alert_manager", **kwargs)
         lead = declare(self, (LEAD_TIME,), prefix="corrugation.")["lead_time_days"]

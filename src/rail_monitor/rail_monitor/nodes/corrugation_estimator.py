@@ -27,13 +27,13 @@ from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_confi
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
 from rail_monitor.nodes.convert import to_msg
-from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS
 from rail_msgs.msg import CorrugationState, RoughnessSurvey, SpeedAdvisory, TrainPass
 from rail_msgs.srv import EvaluateSpeedDistribution
 
 
-class CorrugationEstimatorNode(PassModelNode):
+class CorrugationEstimatorNode(PassConsumerNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("corrugation_estimator", **kwargs)
         self.params = declare(self, ESTIMATOR_SPECS)

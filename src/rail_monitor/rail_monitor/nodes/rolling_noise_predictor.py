@@ -30,7 +30,7 @@ from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.nodes.base import Sent, declare, isolate_failures, run_node, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.convert import to_msg
-from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
@@ -48,7 +48,7 @@ class _Pending:
     deadline: float   # monotonic [s]; -inf: do not wait
 
 
-class RollingNoisePredictor(PassModelNode):
+class RollingNoisePredictor(PassConsumerNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("rolling_noise_predictor", **kwargs)
         cfg = noise_config(declare(self, NOISE_SPECS, prefix="noise."), prefix="")

@@ -15,14 +15,14 @@ from rail_monitor.bagio.messages import header_of, squeal_prediction_fields
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Sent, declare, run_node
 from rail_monitor.nodes.convert import to_msg
-from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.qos import STREAM_QOS
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
 from rail_monitor.squeal.predict import predict
 from rail_msgs.msg import SquealPrediction, TrainPass
 
 
-class SquealRiskNode(PassModelNode):
+class SquealRiskNode(PassConsumerNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("squeal_risk_model", **kwargs)
         self.cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")

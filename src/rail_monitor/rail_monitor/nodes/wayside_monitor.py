@@ -24,7 +24,7 @@ from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.base import declare, exit_code, refuse_unknown_parameters, ros_session
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
-from rail_monitor.nodes.pass_model import PassModelNode
+from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.pass_replayer import PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
@@ -50,7 +50,7 @@ class _Settings(Node):
         self.cfg = declare(self, (*MONITOR_SPECS, SOURCE))
 
 
-def _real_models() -> list[PassModelNode]:
+def _real_models() -> list[PassConsumerNode]:
     return [CorrugationEstimatorNode(), RollingNoisePredictor(), SquealRiskNode(), AlertManagerNode()]
 
 
@@ -96,7 +96,7 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
                 n.destroy_node()
 
 
-def _replay(source: PassReplayer | PassSimulator, models: list[PassModelNode], recorder: McapRecorder | None,
+def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode], recorder: McapRecorder | None,
             timeout: float, stop: threading.Event, t0: float) -> MonitorResult:
     """Replay every pass, wait until every model and the recorder took what was published, and
     publish the advice on the final state."""
@@ -131,7 +131,7 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassModelNode], r
     return MonitorResult(published, recorded, bag, time.monotonic() - t0, rejected, replay_s)
 
 
-def _passes_through(models: list[PassModelNode], recorder: McapRecorder | None, topic: str) -> Callable[[], int]:
+def _passes_through(models: list[PassConsumerNode], recorder: McapRecorder | None, topic: str) -> Callable[[], int]:
     """Passes the slowest hosted consumer has taken, downstream queues included: the pass source
     keeps its backlog below their depth, so no queue overflows (model outputs per pass: one squeal
     prediction, one rolling-noise message per source model)."""
@@ -150,7 +150,7 @@ def _passes_through(models: list[PassModelNode], recorder: McapRecorder | None, 
     return taken
 
 
-def _outputs(models: list[PassModelNode]) -> set[str]:
+def _outputs(models: list[PassConsumerNode]) -> set[str]:
     """The topics the model nodes publish (resolved), but /diagnostics and /rosout."""
     return {p.topic_name for m in models for p in m.publishers
             if not p.topic_name.startswith(("/diagnostics", "/rosout", "/parameter_events"))}

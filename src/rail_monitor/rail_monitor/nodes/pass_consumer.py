@@ -37,7 +37,7 @@ from rail_monitor.nodes.qos import STREAM_SUB_QOS
 from rail_msgs.msg import TrainPass
 
 
-class PassModelNode(Node):
+class PassConsumerNode(Node):
     """Subscribes ``train_pass``; subclasses implement :meth:`on_passes` for accepted passes."""
 
     def __init__(self, name: str, **kwargs: Any) -> None:
