@@ -31,6 +31,7 @@ from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.records import Advice, Trajectory
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
+from rail_monitor.noise.state_of_pass import state_index
 from rail_monitor.squeal.config import squeal_config
 from rail_monitor.squeal.predict import predict as predict_squeal
 
@@ -70,8 +71,7 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     est = estimator or CorrugationEstimator(site, corrugation_config(values))
     squeal = predict_squeal(squeal_config(values), site, accepted)
     traj = _history(est, accepted)
-    # A pass is predicted on the state that includes it, or for a pass not counted the latest before it.
-    state_of_pass = np.searchsorted(traj.index, np.arange(len(accepted)), side="right") - 1
+    state_of_pass = state_index(traj.stamp_ns, traj.train_id.tolist(), accepted.stamp_ns, accepted.train_id.tolist())
     model = RollingNoiseModel(site, noise_config(values))
     noise = {name: _noise_on_states(model, name, accepted, traj, state_of_pass) for name in model.models}
     alerts = AlertManager(alert_config(values, est.cfg["lead_time_days"]))

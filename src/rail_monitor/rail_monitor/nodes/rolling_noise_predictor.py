@@ -34,6 +34,7 @@ from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.noise.state_of_pass import state_arrived, state_index
 from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
 
 STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass queue is as deep)
@@ -80,42 +81,34 @@ class RollingNoisePredictor(PassConsumerNode):
         self.pending.extend(_Pending(table, i, msg, time_ns(msg.header.stamp), deadline) for i, msg in enumerate(msgs))
         self._flush()
 
-    def _ready(self, p: _Pending) -> bool:
-        """Whether the state including the pass, or a later one, has come (states come in time order)."""
-        for stamp, last, _ in reversed(self.states):
-            if stamp != p.stamp_ns:
-                return stamp > p.stamp_ns
-            if last == p.msg.train_id:
-                return True
-        return False
-
-    def _state_for(self, p: _Pending) -> Corrugation | None:
-        """The latest state not newer than the pass (its own, when it was counted)."""
-        for stamp, last, corrugation in reversed(self.states):
-            if stamp < p.stamp_ns or (stamp == p.stamp_ns and last == p.msg.train_id):
-                return corrugation
-        same = [c for stamp, _, c in self.states if stamp == p.stamp_ns]  # equal stamps, another train
-        return same[-1] if same else None
-
     def _flush(self) -> None:
         """Predict the pending passes, in order, that have their state (or waited long enough)."""
+        if not self.pending:
+            return
         now = time.monotonic()
-        ready: list[_Pending] = []
-        while self.pending:
-            p = self.pending[0]
-            if not self._ready(p):
+        stamps = np.fromiter((st for st, _, _ in self.states), np.int64, len(self.states))
+        trains = [last for _, last, _ in self.states]
+        pending = list(self.pending)
+        arrived = state_arrived(stamps, trains, np.array([p.stamp_ns for p in pending], np.int64),
+                                [p.msg.train_id for p in pending])
+        n = 0
+        for p, has_state in zip(pending, arrived.tolist(), strict=True):
+            if not has_state:
                 if now < p.deadline:
                     break
                 if p.deadline > float("-inf"):
                     self.counts["predicted on the latest state (waited too long)"] += 1
-            ready.append(self.pending.popleft())
-        if ready:
-            self._predict(ready)
+            n += 1
+        if not n:
+            return
+        ready = [self.pending.popleft() for _ in range(n)]
+        index = state_index(stamps, trains, np.array([p.stamp_ns for p in ready], np.int64),
+                            [p.msg.train_id for p in ready])
+        self._predict(ready, [self.states[k][2] if k >= 0 else None for k in index.tolist()])
 
-    def _predict(self, ready: list[_Pending]) -> None:
+    def _predict(self, ready: list[_Pending], states: list[Corrugation | None]) -> None:
         """Both models over the ready passes in one call per run of passes whose states share their
         bands (each pass on its own state's amplitudes); published pass by pass, models in order."""
-        states = [self._state_for(p) for p in ready]
         for run in runs(states, _same_bands):
             self._predict_run(ready[run], states[run])
 
