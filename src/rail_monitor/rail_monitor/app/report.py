@@ -22,7 +22,7 @@ from rail_monitor.alerts.manager import Alert, describe
 from rail_monitor.bagio.messages import alert_from_msg, pass_row, time_ns
 from rail_monitor.bagio.reader import read_messages
 from rail_monitor.core.errors import InputError
-from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns
 
@@ -154,15 +154,15 @@ def build_report(run: RunData, values: Mapping[str, Any], out_dir: str | Path) -
 
 
 def _reference_pass(run: RunData, values: Mapping[str, Any]) -> PassTable:
-    """The most common class at its median recorded speed, with its nominal consist."""
+    """The most common class at its median recorded speed, in the consist of its first pass."""
+    from rail_monitor.noise.whatif import synthetic_passes
+
     site = site_from_values(values)
     names, counts = np.unique(run.passes.vehicle_class.astype(str), return_counts=True)
     cls = str(names[np.argmax(counts)])
     rows = run.passes.vehicle_class == cls
-    row = run.passes.take(np.flatnonzero(rows)[:1]).row(0)
-    row.update(speed_mps=float(np.median(run.passes.speed_mps[rows])), axle_count=0, train_length_m=0.0,
-               wheel_load_n=0.0, train_id="reference")
-    return with_class_defaults(PassTable.from_rows([row]), site)
+    return synthetic_passes(site, site.vehicle(cls), np.array([np.median(run.passes.speed_mps[rows])]),
+                            int(run.passes.vehicle_count[np.flatnonzero(rows)[0]]))
 
 
 def _spectra(run: RunData, values: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
