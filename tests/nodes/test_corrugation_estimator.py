@@ -149,6 +149,6 @@ def test_the_site_file_configures_the_node_through_its_own_section(ros_context, 
     f.write_text(text)
     node = CorrugationEstimatorNode(context=ros_context, namespace="/curve_250",
                                     cli_args=["--ros-args", "--params-file", str(f)])
-    assert node.params["advisory_period_s"] == 7.5 and node.est.cfg["lead_time_days"] == 30.0
+    assert node.params.advisory_period_s == 7.5 and node.est.cfg.lead_time_days == 30.0
     assert node.site.site_id == "curve_250"
     node.destroy_node()

@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, ParamValues, resolve, section
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 
 # WaysideAlert.KIND_* and SEVERITY_* values.
 KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED = range(1, 6)
@@ -41,9 +40,9 @@ ALERT_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
-@dataclass(frozen=True)
-class AlertConfig(ParamValues):
-    """The site's alert parameters (names and units as in ALERT_SPECS), with the corrugation lead time."""
+AlertConfig = values_type("AlertConfig", ALERT_SPECS, "The site's alert parameters (names and units as in "
+                          "ALERT_SPECS), with the corrugation lead time [day].", __name__,
+                          extra=(("lead_time_days", float),))
 
 
 def alert_config(values: Mapping[str, Any], lead_time_days: float, prefix: str = "alerts.") -> AlertConfig:
@@ -58,4 +57,4 @@ def alert_config(values: Mapping[str, Any], lead_time_days: float, prefix: str =
     if out["noise_raise_count"] > out["noise_window_passes"]:
         raise ConfigError(f"parameter '{prefix}noise_raise_count' exceeds '{prefix}noise_window_passes'")
     out["lead_time_days"] = float(lead_time_days)
-    return AlertConfig(out)
+    return values_of(AlertConfig, out)

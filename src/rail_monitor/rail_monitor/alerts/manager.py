@@ -53,9 +53,9 @@ class AlertManager:
         self.standing: dict[tuple[int, str], Alert] = {}
         self.events: list[Alert] = []
         self._noise: dict[str, Window] = {}
-        self._squeal = Window(cfg["squeal_window_passes"])
-        self._rejected = Window(cfg["rejected_window_passes"])
-        self._min_risk = RISK_NAMES.index(cfg["squeal_min_risk"])
+        self._squeal = Window(cfg.squeal_window_passes)
+        self._rejected = Window(cfg.rejected_window_passes)
+        self._min_risk = RISK_NAMES.index(cfg.squeal_min_risk)
         self._keys: dict[bytes, list[str]] = {}
 
     # -- raise / clear ----------------------------------------------------------------------------
@@ -106,7 +106,7 @@ class AlertManager:
 
     def _forecast_change(self, active: bool, stamp_ns: int, days: float, due_standing: bool,
                          due_ns: int) -> Alert | None:
-        lead = self.cfg["lead_time_days"]
+        lead = self.cfg.lead_time_days
         if active:
             return self._set(True, KIND_GRINDING_FORECAST, "forecast", stamp_ns, SEVERITY_WARNING,
                              f"grinding forecast in {days:.1f} days, inside the {lead:g}-day lead time",
@@ -128,7 +128,7 @@ class AlertManager:
         due_ns = np.asarray(grinding_due_ns, np.int64)
         keys = self._band_keys(wl)
         over = amp >= thr
-        under = ~over & (amp < self.cfg["grinding_clear_fraction"] * thr)
+        under = ~over & (amp < self.cfg.grinding_clear_fraction * thr)
         changes: list[tuple[int, int, bool]] = []  # (state, band; len(keys) for the forecast, active)
         up = np.empty(amp.shape, bool)  # band's alert standing after each state
         for b, key in enumerate(keys):
@@ -142,7 +142,7 @@ class AlertManager:
         due_standing = up.any(axis=1) | others
         fkey = (KIND_GRINDING_FORECAST, "forecast")
         can_raise = due & ~due_standing
-        beyond = days > self.cfg["forecast_clear_factor"] * self.cfg["lead_time_days"]
+        beyond = days > self.cfg.forecast_clear_factor * self.cfg.lead_time_days
         can_clear = ~can_raise & (due_standing | beyond)
         forecast = hysteresis_changes(fkey in self.standing, can_raise, can_clear)
         changes += [(i, len(keys), active) for i, active in forecast]
@@ -182,18 +182,18 @@ class AlertManager:
         return keys
 
     def _noise_what(self, model: str) -> str:
-        return f"{model} {self.cfg['noise_metric'][:-4]} above {self.cfg['noise_limit_dba']:g} dB(A)"
+        return f"{model} {self.cfg.noise_metric[:-4]} above {self.cfg.noise_limit_dba:g} dB(A)"
 
     def on_noise(self, stamp_ns: np.ndarray, model: str, values: Mapping[str, np.ndarray]) -> list[Alert]:
         """RollingNoise predictions of one source model in order (values: arrays of their single-number
         fields, at least ``noise_metric``)."""
-        metric, limit = self.cfg["noise_metric"], self.cfg["noise_limit_dba"]
+        metric, limit = self.cfg.noise_metric, self.cfg.noise_limit_dba
         level = np.asarray(values[metric], float)
-        w = self._noise.setdefault(model, Window(self.cfg["noise_window_passes"]))
-        over, near, _ = w.push(level > limit, level > limit - self.cfg["noise_hysteresis_db"])
-        n = self.cfg["noise_window_passes"]
-        return self._windowed(KIND_NOISE_LIMIT, model, stamp_ns, over >= self.cfg["noise_raise_count"],
-                              near <= self.cfg["noise_clear_count"], self._noise_what(model),
+        w = self._noise.setdefault(model, Window(self.cfg.noise_window_passes))
+        over, near, _ = w.push(level > limit, level > limit - self.cfg.noise_hysteresis_db)
+        n = self.cfg.noise_window_passes
+        return self._windowed(KIND_NOISE_LIMIT, model, stamp_ns, over >= self.cfg.noise_raise_count,
+                              near <= self.cfg.noise_clear_count, self._noise_what(model),
                               lambda i: f"{over[i]} of the last {n} passes, this one {level[i]:.1f} dB(A)",
                               "dB(A)", level, limit)
 
@@ -203,15 +203,15 @@ class AlertManager:
         window (only once the window is full, with full_window), cleared at or below
         ``<name>_clear_share`` of what it holds."""
         over, near, n = w.push(hits, hits)
-        raise_share, share = self.cfg[f"{name}_raise_share"], over / n
+        raise_share, share = getattr(self.cfg, f"{name}_raise_share"), over / n
         raise_at = np.where((n == w.flags.maxlen) | (not full_window), w.flags.maxlen * raise_share, np.inf)
         return self._windowed(kind, key, stamp_ns, over >= np.maximum(raise_at, 1),
-                              near <= self.cfg[f"{name}_clear_share"] * n, what,
+                              near <= getattr(self.cfg, f"{name}_clear_share") * n, what,
                               lambda i: f"{over[i]} of the last {n[i]}, {share[i]:.0%}", "-", share,
                               raise_share)
 
     def _squeal_what(self) -> str:
-        return f"squeal risk {self.cfg['squeal_min_risk']} or above"
+        return f"squeal risk {self.cfg.squeal_min_risk} or above"
 
     def on_squeal(self, stamp_ns: np.ndarray, risk: np.ndarray) -> list[Alert]:
         """SquealPredictions' risks (RISK_*) in order. The window must be full: a share over the

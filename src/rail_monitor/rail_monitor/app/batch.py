@@ -74,7 +74,7 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     state_of_pass = state_index(traj.stamp_ns, traj.train_id.tolist(), accepted.stamp_ns, accepted.train_id.tolist())
     model = RollingNoiseModel(site, noise_config(values))
     noise = {name: _noise_on_states(model, name, accepted, traj, state_of_pass) for name in model.models}
-    alerts = AlertManager(alert_config(values, est.cfg["lead_time_days"]))
+    alerts = AlertManager(alert_config(values, est.cfg.lead_time_days))
     events = _feed_alerts(alerts, table, reasons, accepted, squeal, traj, noise)
     return BatchResult(site, table, reasons, accepted, squeal, traj, state_of_pass, noise, events,
                        sorted(alerts.standing.values(), key=_alert_key), advise_or_none(est), est, model.receiver)

@@ -7,7 +7,7 @@ line's options and the nodes share one list of names, units and ranges.
 
 from __future__ import annotations
 
-from rail_monitor.core.params import ParamSpec
+from rail_monitor.core.params import ParamSpec, values_type
 from rail_monitor.core.site import SITE_ID
 
 # Pass sources (pass_replayer, pass_simulator): what they publish and how fast.
@@ -104,3 +104,14 @@ PREDICTOR_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("state_wait_s", 5.0, "Longest wall time a pass waits for the corrugation state that includes it; "
               "0: take the latest state at once [s].", 0.0, 3600.0),
 )
+
+
+# Their checked values, by attribute (rail_monitor.core.params.values_type).
+PublishParams = values_type("PublishParams", PUBLISH_SPECS, "A pass source's publishing parameters.", __name__)
+ReplayerParams = values_type("ReplayerParams", REPLAYER_SPECS, "pass_replayer's history parameters.", __name__)
+ModeParams = values_type("ModeParams", MODE_SPECS, "pass_simulator's mode parameters.", __name__)
+RecorderParams = values_type("RecorderParams", RECORDER_SPECS, "mcap_recorder's parameters.", __name__)
+MonitorParams = values_type("MonitorParams", (*MONITOR_SPECS, SOURCE), "wayside_monitor's process parameters.",
+                            __name__)
+EstimatorParams = values_type("EstimatorParams", ESTIMATOR_SPECS, "corrugation_estimator's own parameters.",
+                              __name__)

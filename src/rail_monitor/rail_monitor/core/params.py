@@ -7,6 +7,7 @@ the command line and batch mode agree on every default and every range.
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import math
 from collections.abc import Collection, Mapping, Sequence
@@ -28,6 +29,11 @@ class ParamSpec:
     low: float | None = None
     high: float | None = None
     choices: tuple[str, ...] = ()
+
+    @property
+    def annotation(self) -> Any:
+        """The field type of the value (list[element] for arrays)."""
+        return list[self.kind] if isinstance(self.default, list) else self.kind
 
     @property
     def kind(self) -> type:
@@ -104,14 +110,24 @@ def section(values: Mapping[str, Any], prefix: str) -> dict[str, Any]:
     return {k[len(prefix):]: v for k, v in values.items() if k.startswith(prefix)}
 
 
-@dataclass(frozen=True)
-class ParamValues:
-    """Checked values of one parameter section, by spec name (``cfg["name"]``)."""
+def attribute(name: str) -> str:
+    """The attribute of a dotted parameter name in a values type (k_b.dry -> k_b_dry)."""
+    return name.replace(".", "_")
 
-    values: Mapping[str, Any]
 
-    def __getitem__(self, key: str) -> Any:
-        return self.values[key]
+def values_type(name: str, specs: Sequence[ParamSpec], doc: str, module: str,
+                extra: Sequence[tuple[str, type]] = (), **members: Any) -> type:
+    """A frozen dataclass with one typed field per spec (in spec order, dots as underscores) and
+    the extra fields, for a section's checked values; members are its methods and properties.
+    Build an instance from resolved values with :func:`values_of`."""
+    fields = [(attribute(s.name), s.annotation) for s in specs] + list(extra)
+    return dataclasses.make_dataclass(name, fields, frozen=True, namespace={"__doc__": doc, "__module__": module,
+                                                                             **members})
+
+
+def values_of(cls: type, values: Mapping[str, Any]) -> Any:
+    """An instance of a values type from values by dotted name."""
+    return cls(**{attribute(k): v for k, v in values.items()})
 
 
 def flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:

@@ -83,16 +83,16 @@ def advise(est: CorrugationEstimator, speeds: np.ndarray | None = None, weights:
     v = np.asarray(speeds, float)
     w = np.ones_like(v) if weights is None else np.asarray(weights, float)
     classes = est.site.vehicles.values()
-    lo = est.cfg["advice_min_speed_mps"] or min(c.speed_min_mps for c in classes)
-    hi = est.cfg["advice_max_speed_mps"] or max(c.speed_max_mps for c in classes)
-    width = est.cfg["advice_bin_mps"]
+    lo = est.cfg.advice_min_speed_mps or min(c.speed_min_mps for c in classes)
+    hi = est.cfg.advice_max_speed_mps or max(c.speed_max_mps for c in classes)
+    width = est.cfg.advice_bin_mps
     edges = np.arange(lo, hi + 0.5 * width, width)
     centres = 0.5 * (edges[:-1] + edges[1:])
     current_p = np.histogram(np.clip(v, lo, hi), edges, weights=w)[0]
     current_p /= current_p.sum()
     mean = float(np.clip(np.average(v, weights=w), centres[0], centres[-1]))
     grid = growth_at_speeds(est, centres, friction_state)
-    best = cg.optimise_speed_distribution(grid.reshape(-1, len(centres)), centres, mean, est.cfg["advice_max_share"])
+    best = cg.optimise_speed_distribution(grid.reshape(-1, len(centres)), centres, mean, est.cfg.advice_max_share)
     # Each kept pass with its own class and friction; a given distribution with the mix.
     g_now = (est.recent_growth() if recent and not friction_state
              else growth_at_speeds(est, v, friction_state) @ (w / w.sum())).max(axis=1)

@@ -12,13 +12,12 @@ contamination less still. They are starting values: a pair of roughness surveys 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, ParamValues, resolve, section
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 from rail_monitor.core.passes import FRICTION_NAMES, MAX_SPEED_MPS
 
 SPEED_STEP_MPS = 0.1          # speed grid of the growth tables [m/s]
@@ -56,14 +55,14 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
-@dataclass(frozen=True)
-class CorrugationConfig(ParamValues):
-    """The site's corrugation parameters (names and units as in CORRUGATION_SPECS)."""
+def _k_b(self) -> np.ndarray:
+    """K_b per friction state, index TrainPass.FRICTION_* - 1 [-/axle pass]."""
+    return np.array([getattr(self, f"k_b_{name}") for name in FRICTION_NAMES.values()])
 
-    @property
-    def k_b(self) -> np.ndarray:
-        """K_b per friction state, index TrainPass.FRICTION_* - 1 [-/axle pass]."""
-        return np.array([self[f"k_b.{name}"] for name in FRICTION_NAMES.values()])
+
+CorrugationConfig = values_type(
+    "CorrugationConfig", CORRUGATION_SPECS, "The site's corrugation parameters (names and units as in "
+    "CORRUGATION_SPECS; k_b.dry is k_b_dry), and k_b, the K_b of every friction state.", __name__, k_b=property(_k_b))
 
 
 def corrugation_config(values: Mapping[str, Any], prefix: str = "corrugation.") -> CorrugationConfig:
@@ -75,5 +74,5 @@ def corrugation_config(values: Mapping[str, Any], prefix: str = "corrugation.") 
         raise ConfigError(f"parameter '{prefix}min_traffic_days' exceeds '{prefix}history_days'")
     if out["advice_max_speed_mps"] and out["advice_min_speed_mps"] >= out["advice_max_speed_mps"]:
         raise ConfigError(f"parameter '{prefix}advice_min_speed_mps' must be below '{prefix}advice_max_speed_mps'")
-    return CorrugationConfig(out)
+    return values_of(CorrugationConfig, out)
 

@@ -37,13 +37,13 @@ class CorrugationEstimator:
         self.tables = tables or GrowthTables(site, cfg)
         self.tables.set_k_b(cfg.k_b)
         self.bands = self.tables.bands
-        acceptance = cg.band_limits(self.bands) * cfg["acceptance_factor"]
+        acceptance = cg.band_limits(self.bands) * cfg.acceptance_factor
         if np.any(np.isnan(acceptance)):
             raise ConfigError("corrugation bands reach outside the 10-3000 mm of the Grassie et al. (1999) limits")
-        self.threshold = acceptance * cfg["intervention_factor"]
-        self.post_grinding = acceptance * cfg["post_grinding_fraction"]
-        self.history_ns = int(cfg["history_days"] * NS_PER_DAY)
-        self.points = cfg["points_per_band"]
+        self.threshold = acceptance * cfg.intervention_factor
+        self.post_grinding = acceptance * cfg.post_grinding_fraction
+        self.history_ns = int(cfg.history_days * NS_PER_DAY)
+        self.points = cfg.points_per_band
         self.log_components = self.flat(self.post_grinding)
         self.grinding_amplitude = self.post_grinding.copy()             # r.m.s. after the last grinding
         self.pass_count = self.axle_pass_count = self.total_pass_count = 0
@@ -134,7 +134,7 @@ class CorrugationEstimator:
         growth = (g_prefix[end] - g_prefix[start]) / axles[:, None, None]
         span_days = (new.stamp_ns - all_stamps[start]) / NS_PER_DAY
         with np.errstate(divide="ignore", invalid="ignore"):
-            rate = np.where((span_days > 0) & (span_days >= self.cfg["min_traffic_days"]),
+            rate = np.where((span_days > 0) & (span_days >= self.cfg.min_traffic_days),
                             (end - start - 1) / span_days, np.nan)
         fc = self._forecasts(steps, growth, rate, axles / (end - start), new.stamp_ns)
         ordinal = np.arange(1, m + 1)
@@ -204,7 +204,7 @@ class CorrugationEstimator:
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic (see :func:`.forecast.traffic`)."""
-        return fcst.traffic(self.kept, self.cfg["min_traffic_days"])
+        return fcst.traffic(self.kept, self.cfg.min_traffic_days)
 
     def forecast(self, growth: np.ndarray | None = None, passes_per_day: float | None = None) -> Forecast:
         """Time to the intervention threshold per band at growth g and the traffic.
@@ -223,4 +223,4 @@ class CorrugationEstimator:
                    newest_ns: np.ndarray) -> Forecast:
         fallback = float(np.mean([v.mean_axles_per_train for v in self.site.vehicles.values()]))
         return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
-                              self.cfg["lead_time_days"], fallback)
+                              self.cfg.lead_time_days, fallback)

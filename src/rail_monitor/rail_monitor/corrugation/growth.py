@@ -42,10 +42,10 @@ class GrowthTables:
     """
 
     def __init__(self, site: Site, cfg: CorrugationConfig) -> None:
-        self.bands = cg.wavelength_bands(cfg["shortest_wavelength_m"], cfg["longest_wavelength_m"])
+        self.bands = cg.wavelength_bands(cfg.shortest_wavelength_m, cfg.longest_wavelength_m)
         self.classes = list(site.vehicles)
         self.speeds = np.arange(1, round(MAX_SPEED_MPS / SPEED_STEP_MPS) + 1) * SPEED_STEP_MPS
-        sub = cg.band_sub_wavelengths(self.bands, cfg["points_per_band"])
+        sub = cg.band_sub_wavelengths(self.bands, cfg.points_per_band)
         f_rail, r_rail = _rail_receptance(site.track)
         kernels = []
         for name in self.classes:

@@ -19,7 +19,8 @@ from typing import Any
 from diagnostic_msgs.msg import DiagnosticStatus
 
 from rail_monitor.bagio.messages import corrugation_state_fields, speed_advisory_fields, time_ns
-from rail_monitor.core.node_params import ESTIMATOR_SPECS
+from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
+from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.corrugation import advice, checkpoint, surveys
@@ -36,10 +37,10 @@ from rail_msgs.srv import EvaluateSpeedDistribution
 class CorrugationEstimatorNode(PassConsumerNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("corrugation_estimator", **kwargs)
-        self.params = declare(self, ESTIMATOR_SPECS)
+        self.params = values_of(EstimatorParams, declare(self, ESTIMATOR_SPECS))
         cfg = corrugation_config(declare(self, CORRUGATION_SPECS, prefix="corrugation."), prefix="")
         self.est = CorrugationEstimator(self.site, cfg)
-        self.checkpoint = self.params["checkpoint_path"]
+        self.checkpoint = self.params.checkpoint_path
         self.counts: Counter[str] = Counter()
         self.sent = Sent()
         self.surveys_rejected: Counter[str] = Counter()
@@ -58,7 +59,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
         self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
-        wall_timer(self, self.params["advisory_period_s"], self.publish_advisory)
+        wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         # The state and forecast after each counted pass, as advancing one pass at a time gives them.
@@ -69,14 +70,14 @@ class CorrugationEstimatorNode(PassConsumerNode):
             return
         self.counts["counted"] += len(traj)
         self._since_checkpoint += len(traj)
-        if self._since_checkpoint >= self.params["checkpoint_every_passes"]:
+        if self._since_checkpoint >= self.params.checkpoint_every_passes:
             self.save()
         now = time.monotonic()
-        if self.params["state_period_s"] == 0.0:
+        if self.params.state_period_s == 0.0:
             for k in range(len(traj)):
                 self.sent.publish(self.state_pub, to_msg(CorrugationState, corrugation_state_fields(
                     *traj.state(k), self.site.site_id)))
-        elif now - self._last_state_t >= self.params["state_period_s"]:
+        elif now - self._last_state_t >= self.params.state_period_s:
             self.publish_state()
             self._last_state_t = now
 

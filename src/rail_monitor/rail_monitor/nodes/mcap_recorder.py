@@ -27,7 +27,8 @@ from rclpy.qos import QoSProfile
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.node_params import RECORDER_SPECS
+from rail_monitor.core.node_params import RECORDER_SPECS, RecorderParams
+from rail_monitor.core.params import values_of
 from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import (
     Diagnostics,
@@ -51,14 +52,14 @@ class McapRecorder(Node):
     def __init__(self, **kwargs) -> None:
         super().__init__("mcap_recorder", **kwargs)
         refuse_unknown_parameters(self)
-        self.cfg = declare(self, RECORDER_SPECS)
-        out = self.cfg["output"] or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
+        self.cfg = values_of(RecorderParams, declare(self, RECORDER_SPECS))
+        out = self.cfg.output or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
         self.writer = McapBagWriter(
-            Path(out), compression=self.cfg["compression"], chunk_size=self.cfg["chunk_size"],
-            max_file_bytes=self.cfg["max_bag_size"],
-            max_file_duration_ns=int(self.cfg["max_bag_duration_s"] * NS_PER_S),
-            flush_wall_period_s=self.cfg["flush_period_s"])
-        wanted = [t for t in self.cfg["topics"] if t]
+            Path(out), compression=self.cfg.compression, chunk_size=self.cfg.chunk_size,
+            max_file_bytes=self.cfg.max_bag_size,
+            max_file_duration_ns=int(self.cfg.max_bag_duration_s * NS_PER_S),
+            flush_wall_period_s=self.cfg.flush_period_s)
+        wanted = [t for t in self.cfg.topics if t]
         self._wanted = {self.resolve_topic_name(t) for t in wanted} if wanted else None
         self._lock = threading.Lock()
         self._group = MutuallyExclusiveCallbackGroup()
@@ -66,8 +67,8 @@ class McapRecorder(Node):
         self._stamped: dict[str, bool] = {}
         self.counts: dict[str, int] = {}
         self.meter = RateMeter()
-        wall_timer(self, self.cfg["discovery_period_s"], self.discover, callback_group=self._group)
-        wall_timer(self, max(self.cfg["flush_period_s"], 0.05), self._flush, callback_group=self._group)
+        wall_timer(self, self.cfg.discovery_period_s, self.discover, callback_group=self._group)
+        wall_timer(self, max(self.cfg.flush_period_s, 0.05), self._flush, callback_group=self._group)
         self.dropped = 0  # messages not recorded after a write error
         self.diagnostics = Diagnostics(
             self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
@@ -99,7 +100,7 @@ class McapRecorder(Node):
             with self._lock:
                 self.writer.add_topic(topic, typename, [qos_to_dict(q) for q in offered])
                 self.counts[topic] = 0
-                self._stamped[topic] = self.cfg["log_time"] == "header" and starts_with_header(typename)
+                self._stamped[topic] = self.cfg.log_time == "header" and starts_with_header(typename)
             self._subs[topic] = subscribe_batched(
                 self, msg_type, topic, lambda msgs, t=topic: self._on_messages(t, msgs), subscription_qos(offered),
                 self.take_at_once, raw=True, callback_group=self._group)

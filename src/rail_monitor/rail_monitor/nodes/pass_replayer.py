@@ -10,7 +10,8 @@ import sys
 
 from rail_monitor.bagio.reader import read_passes
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.node_params import REPLAYER_SPECS
+from rail_monitor.core.node_params import REPLAYER_SPECS, ReplayerParams
+from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import declare, run_node
 from rail_monitor.nodes.pass_source import PassSourceNode
@@ -19,20 +20,20 @@ from rail_monitor.nodes.pass_source import PassSourceNode
 class PassReplayer(PassSourceNode):
     def __init__(self, **kwargs) -> None:
         super().__init__("pass_replayer", **kwargs)
-        self.src = declare(self, REPLAYER_SPECS)
-        if not self.src["source"]:
+        self.src = values_of(ReplayerParams, declare(self, REPLAYER_SPECS))
+        if not self.src.source:
             raise RailMonitorError("parameter 'source' is empty: give a bag or CSV path (-p source:=PATH)")
         self.skipped = 0
         self._table = self._load()  # read up front: a bad file fails before anything is published
 
     def _load(self) -> PassTable:
-        table = read_passes(self.src["source"], self.src["source_topic"] or None, self.src["skip_bad_rows"],
-                            salvage=self.src["salvage"])
-        if self.src["salvage"]:
-            self.get_logger().info(table.salvage.line(self.src["source"]))
+        table = read_passes(self.src.source, self.src.source_topic or None, self.src.skip_bad_rows,
+                            salvage=self.src.salvage)
+        if self.src.salvage:
+            self.get_logger().info(table.salvage.line(self.src.source))
         self.skipped = getattr(table, "skipped", 0)
         if self.skipped:
-            self.get_logger().warning(f"{self.src['source']}: {self.skipped} malformed row(s) left out")
+            self.get_logger().warning(f"{self.src.source}: {self.skipped} malformed row(s) left out")
         return table
 
     def passes(self) -> PassTable:

@@ -12,7 +12,8 @@ from collections.abc import Callable
 from rail_monitor.app.simulator import SIMULATOR_SPECS, simulate, simulator_config
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.node_params import MODE_SPECS
+from rail_monitor.core.node_params import MODE_SPECS, ModeParams
+from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import declare, declare_site, run_node
 from rail_monitor.nodes.pass_source import PassSourceNode
@@ -23,19 +24,19 @@ class PassSimulator(PassSourceNode):
         super().__init__("pass_simulator", **kwargs)
         self.site = declare_site(self)
         self.sim_cfg = simulator_config(declare(self, SIMULATOR_SPECS))
-        self.mode = declare(self, MODE_SPECS)
+        self.mode = values_of(ModeParams, declare(self, MODE_SPECS))
         self._table = simulate(self.site, self.sim_cfg)
 
     def passes(self) -> PassTable:
         return self._table
 
     def run(self, ok: Callable[[], bool] | None = None) -> int:
-        if self.mode["mode"] == "publish":
+        if self.mode.mode == "publish":
             return super().run(ok)
-        if not self.mode["output"]:
+        if not self.mode.output:
             raise RailMonitorError("mode 'bag' needs parameter 'output' (a bag folder to create)")
-        write_passes_bag(self._window(self._table), self.mode["output"], self.site.site_id)
-        self.get_logger().info(f"wrote {len(self._table)} passes to {self.mode['output']}")
+        write_passes_bag(self._window(self._table), self.mode.output, self.site.site_id)
+        self.get_logger().info(f"wrote {len(self._table)} passes to {self.mode.output}")
         self.done.set()
         return len(self._table)
 

@@ -18,7 +18,8 @@ from tqdm import tqdm
 
 from rail_monitor.bagio.messages import train_pass_fields
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.node_params import PUBLISH_SPECS
+from rail_monitor.core.node_params import PUBLISH_SPECS, PublishParams
+from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, refuse_unknown_parameters
@@ -33,9 +34,9 @@ class PassSourceNode(Node):
     def __init__(self, name: str, **kwargs) -> None:
         super().__init__(name, **kwargs)
         refuse_unknown_parameters(self)
-        self.cfg = declare(self, PUBLISH_SPECS)
+        self.cfg = values_of(PublishParams, declare(self, PUBLISH_SPECS))
         self.pub = self.create_publisher(TrainPass, "train_pass", STREAM_QOS)
-        self.clock_pub = self.create_publisher(Clock, "/clock", CLOCK_QOS) if self.cfg["publish_clock"] else None
+        self.clock_pub = self.create_publisher(Clock, "/clock", CLOCK_QOS) if self.cfg.publish_clock else None
         self.meter = RateMeter()
         self.total = 0
         self.last_stamp_ns = 0
@@ -55,9 +56,9 @@ class PassSourceNode(Node):
         if len(table) == 0:
             return table
         t0 = int(table.stamp_ns[0])
-        keep = table.stamp_ns >= t0 + int(self.cfg["start_offset_s"] * NS_PER_S)
-        if self.cfg["end_offset_s"] > 0.0:
-            keep &= table.stamp_ns <= t0 + int(self.cfg["end_offset_s"] * NS_PER_S)
+        keep = table.stamp_ns >= t0 + int(self.cfg.start_offset_s * NS_PER_S)
+        if self.cfg.end_offset_s > 0.0:
+            keep &= table.stamp_ns <= t0 + int(self.cfg.end_offset_s * NS_PER_S)
         return table.take(keep)
 
     def _publish_clock(self, ns: int) -> None:
@@ -65,12 +66,12 @@ class PassSourceNode(Node):
             self.clock_pub.publish(Clock(clock=time_msg(ns)))
 
     def _wait_for_subscribers(self, ok: Callable[[], bool]) -> None:
-        want = self.cfg["wait_for_subscribers"]
-        deadline = time.monotonic() + self.cfg["wait_timeout_s"]
+        want = self.cfg.wait_for_subscribers
+        deadline = time.monotonic() + self.cfg.wait_timeout_s
         while self.pub.get_subscription_count() < want and ok():
             if time.monotonic() > deadline:
                 raise RailMonitorError(f"only {self.pub.get_subscription_count()} of {want} subscribers "
-                                       f"on {self.pub.topic_name} after {self.cfg['wait_timeout_s']:g} s")
+                                       f"on {self.pub.topic_name} after {self.cfg.wait_timeout_s:g} s")
             time.sleep(0.02)
 
     def _throttle(self, published: int, ok: Callable[[], bool]) -> None:
@@ -83,9 +84,9 @@ class PassSourceNode(Node):
         we use short blocking waits: zero-timeout polls do not prompt Fast DDS's heartbeat, and
         the acknowledgement then takes seconds (measured: about 3.6 s per batch of 100).
         """
-        deadline = time.monotonic() + self.cfg["ack_timeout_s"]
+        deadline = time.monotonic() + self.cfg.ack_timeout_s
         slice_ = Duration(seconds=0.05)
-        backlog = self.cfg["max_backlog"]
+        backlog = self.cfg.max_backlog
 
         def behind() -> bool:
             if self.consumed is not None:  # exact, and cheaper than a DDS acknowledgement round
@@ -95,7 +96,7 @@ class PassSourceNode(Node):
         while ok() and behind():
             if time.monotonic() > deadline:
                 raise RailMonitorError(f"subscribers of {self.pub.topic_name} did not keep up within "
-                                       f"{self.cfg['ack_timeout_s']:g} s")
+                                       f"{self.cfg.ack_timeout_s:g} s")
             time.sleep(0.0005)
 
     def run(self, ok: Callable[[], bool] | None = None) -> int:
@@ -104,12 +105,12 @@ class PassSourceNode(Node):
         table = self._window(self.passes())
         self.total = len(table)
         self._wait_for_subscribers(ok)
-        rate, frame = self.cfg["rate"], self.cfg["site_id"]
-        batch, period = self.cfg["ack_batch"], self.cfg["clock_period_s"]
+        rate, frame = self.cfg.rate, self.cfg.site_id
+        batch, period = self.cfg.ack_batch, self.cfg.clock_period_s
         stamps = table.stamp_ns
         t0 = int(stamps[0]) if len(table) else 0
         wall0 = time.monotonic()
-        bar = tqdm(total=len(table), unit="pass", file=sys.stderr, disable=not self.cfg["progress"],
+        bar = tqdm(total=len(table), unit="pass", file=sys.stderr, disable=not self.cfg.progress,
                    mininterval=0.5, desc=self.get_name())
         try:
             for i in range(len(table)):

@@ -13,13 +13,14 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from rclpy.executors import Executor, MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.node import Node
 
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE
+from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE, MonitorParams
+from rail_monitor.core.params import values_of
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.base import declare, exit_code, refuse_unknown_parameters, ros_session
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
@@ -47,7 +48,7 @@ class _Settings(Node):
     def __init__(self) -> None:
         super().__init__("wayside_monitor")
         refuse_unknown_parameters(self)
-        self.cfg = declare(self, (*MONITOR_SPECS, SOURCE))
+        self.cfg = values_of(MonitorParams, declare(self, (*MONITOR_SPECS, SOURCE)))
 
 
 def _real_models() -> list[PassConsumerNode]:
@@ -69,20 +70,20 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
         try:
             settings = _Settings()
             nodes.append(settings)
-            recorder = make_recorder() if settings.cfg["record"] else None
+            recorder = make_recorder() if settings.cfg.record else None
             models = make_models()
             nodes += ([recorder] if recorder is not None else []) + models
-            source = PassReplayer() if settings.cfg["source"] else PassSimulator()
+            source = PassReplayer() if settings.cfg.source else PassSimulator()
             nodes.append(source)
-            source.cfg["wait_for_subscribers"] = max(source.cfg["wait_for_subscribers"],
-                                                     len(models) + (recorder is not None))
+            wanted = max(source.cfg.wait_for_subscribers, len(models) + (recorder is not None))
+            source.cfg = replace(source.cfg, wait_for_subscribers=wanted)
             source.consumed = _passes_through(models, recorder, source.pub.topic_name)
-            executor = _make_executor(settings.cfg["executor"], settings.cfg["threads"])
+            executor = _make_executor(settings.cfg.executor, settings.cfg.threads)
             for n in nodes:
                 executor.add_node(n)
             spinner = threading.Thread(target=executor.spin, daemon=True)
             spinner.start()
-            return _replay(source, models, recorder, settings.cfg["drain_timeout_s"], stop, t0)
+            return _replay(source, models, recorder, settings.cfg.drain_timeout_s, stop, t0)
         finally:
             if executor is not None:
                 executor.shutdown(timeout_sec=2.0)

@@ -4,13 +4,12 @@ CNOSSOS-EU track terms, receiver and ground, mechanics radiators."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, ParamValues, resolve, section
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.passby import Receiver
@@ -54,18 +53,19 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
-@dataclass(frozen=True)
-class NoiseConfig(ParamValues):
-    """The site's noise parameters (names and units as in NOISE_SPECS)."""
+def _receiver(self) -> Receiver:
+    return Receiver(self.receiver_distance_m, self.receiver_height_m, self.source_height_m, self.ground_depth_m,
+                    self.ground_reflection)
 
-    @property
-    def receiver(self) -> Receiver:
-        return Receiver(self["receiver_distance_m"], self["receiver_height_m"], self["source_height_m"],
-                        self["ground_depth_m"], self["ground_reflection"])
 
-    @property
-    def radiators(self) -> wrn.Radiators:
-        return wrn.Radiators(self["rail_radius_m"], self["sleeper_area_m2"], self["wheel_rim_width_m"])
+def _radiators(self) -> wrn.Radiators:
+    return wrn.Radiators(self.rail_radius_m, self.sleeper_area_m2, self.wheel_rim_width_m)
+
+
+NoiseConfig = values_type(
+    "NoiseConfig", NOISE_SPECS, "The site's noise parameters (names and units as in NOISE_SPECS), with the "
+    "receiver and the mechanics model's radiators they describe.", __name__, receiver=property(_receiver),
+    radiators=property(_radiators))
 
 
 def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConfig:
@@ -75,4 +75,4 @@ def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConf
     if len(wl) != len(db) or len(wl) < 2 or np.any(np.diff(wl) <= 0):
         raise ConfigError(f"parameters '{prefix}rail_roughness_wavelength_m' and '{prefix}rail_roughness_db' must "
                           "have the same length (at least 2), wavelengths strictly ascending")
-    return NoiseConfig(values)
+    return values_of(NoiseConfig, values)

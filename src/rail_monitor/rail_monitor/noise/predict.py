@@ -118,10 +118,10 @@ class RollingNoiseModel:
         (_, psi), _ = self.receiver.paths()
         self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz)
         self.baseline_db = self._baseline()
-        self.impact_db = cn.impact_roughness(cfg["joints_per_100m"] / 100.0) if cfg["joints_per_100m"] > 0 else None
-        self.track_name, track_db = cn.track_transfer(cfg["sleeper_type"], site.track.pad_stiffness_npm)
-        self.bridge_db = cn.bridge_transfer(cfg["bridge"])
-        self.squeal_db = cn.curve_squeal_db(site.curve_radius_m) if cfg["curve_squeal"] else 0.0
+        self.impact_db = cn.impact_roughness(cfg.joints_per_100m / 100.0) if cfg.joints_per_100m > 0 else None
+        self.track_name, track_db = cn.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm)
+        self.bridge_db = cn.bridge_transfer(cfg.bridge)
+        self.squeal_db = cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0
         self.classes: dict[str, _ClassTerms] = {}
         for name, v in site.vehicles.items():
             contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
@@ -132,20 +132,20 @@ class RollingNoiseModel:
             if self.bridge_db is not None:
                 cnossos["bridge"] = self.bridge_db
             mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
-                                     v.wheel_diameter_m, cfg.radiators, cfg["band_points"])
+                                     v.wheel_diameter_m, cfg.radiators, cfg.band_points)
             self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type), a3, float(contact.a), cnossos, mech)
 
     @property
     def models(self) -> tuple[str, ...]:
         """The source models the site's ``noise.model`` selects."""
-        return MODELS if self.cfg["model"] == "both" else (self.cfg["model"],)
+        return MODELS if self.cfg.model == "both" else (self.cfg.model,)
 
     def _baseline(self) -> np.ndarray:
-        source = self.cfg["rail_roughness"]
+        source = self.cfg.rail_roughness
         if source != "measured":
             return cn.rail_roughness(source)
-        wl = np.asarray(self.cfg["rail_roughness_wavelength_m"], float)
-        return np.interp(self.grid, wl, np.asarray(self.cfg["rail_roughness_db"], float))
+        wl = np.asarray(self.cfg.rail_roughness_wavelength_m, float)
+        return np.interp(self.grid, wl, np.asarray(self.cfg.rail_roughness_db, float))
 
     def rail_roughness_db(self, corrugation: Corrugation | None = None, post_grinding: bool = False) -> np.ndarray:
         """Rail roughness on the CNOSSOS wavelength grid [dB re 1 um]: baseline plus the corrugation
@@ -213,12 +213,12 @@ class RollingNoiseModel:
     def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray,
                    model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
-        rule = self.cfg["interpolation"]
+        rule = self.cfg.interpolation
         if model == "cnossos":
             lr = cn.total_roughness(rail_db, terms.wheel_db, terms.a3_db, self.impact_db)
             return cn.at_band_frequencies(lr, speed, self.band_hz, rule), terms.cnossos
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
-        filt = wrn.contact_filter_power(speed, self.band, terms.semi_length_m, self.cfg["band_points"])
+        filt = wrn.contact_filter_power(speed, self.band, terms.semi_length_m, self.cfg.band_points)
         lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + level(filt)
         return lr, terms.mechanics
 

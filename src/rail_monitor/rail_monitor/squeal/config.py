@@ -4,13 +4,12 @@ state, the receiver and the risk thresholds."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, ParamValues, resolve, section
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 from rail_monitor.core.passes import FRICTION_NAMES
 from rail_monitor.models import squeal
 
@@ -60,18 +59,20 @@ SQUEAL_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
-@dataclass(frozen=True)
-class SquealConfig(ParamValues):
-    """The site's squeal parameters (names and units as in SQUEAL_SPECS)."""
+def _creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """k1, k2 [-] per pass for TrainPass.FRICTION_* values."""
+    k1 = np.full(friction_state.shape, np.nan)
+    k2 = np.full(friction_state.shape, np.nan)
+    for code, name in FRICTION_NAMES.items():
+        sel = friction_state == code
+        k1[sel], k2[sel] = getattr(self, f"creep_{name}_k1"), getattr(self, f"creep_{name}_k2")
+    return k1, k2
 
-    def creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """k1, k2 [-] per pass for TrainPass.FRICTION_* values."""
-        k1 = np.full(friction_state.shape, np.nan)
-        k2 = np.full(friction_state.shape, np.nan)
-        for code, name in FRICTION_NAMES.items():
-            sel = friction_state == code
-            k1[sel], k2[sel] = self[f"creep.{name}.k1"], self[f"creep.{name}.k2"]
-        return k1, k2
+
+SquealConfig = values_type(
+    "SquealConfig", SQUEAL_SPECS, "The site's squeal parameters (names and units as in SQUEAL_SPECS; "
+    "creep.dry.k1 is creep_dry_k1), and creep(friction_state), the creep curve of each pass.", __name__,
+    creep=_creep)
 
 
 def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealConfig:
@@ -79,4 +80,4 @@ def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealC
     values = resolve(SQUEAL_SPECS, section(values, prefix), where=prefix, strict=True)
     if values["risk_high_dba"] < values["risk_medium_dba"]:
         raise ConfigError(f"parameter '{prefix}risk_high_dba' must not be below '{prefix}risk_medium_dba'")
-    return SquealConfig(values)
+    return values_of(SquealConfig, values)

@@ -22,9 +22,9 @@ from rail_monitor.squeal.config import RISK_HIGH, RISK_LOW, RISK_MEDIUM, RISK_NO
 
 def _levels(cfg: SquealConfig, amplitude: np.ndarray, frequency: np.ndarray) -> squeal.RadiatedLevel:
     return squeal.radiated_level(
-        amplitude, frequency, radiating_area=cfg["radiating_area_m2"],
-        radiation_efficiency=cfg["radiation_efficiency"], spatial_average=cfg["spatial_average"],
-        distance=cfg["receiver_distance_m"])
+        amplitude, frequency, radiating_area=cfg.radiating_area_m2,
+        radiation_efficiency=cfg.radiation_efficiency, spatial_average=cfg.spatial_average,
+        distance=cfg.receiver_distance_m)
 
 
 def _with_background(level_dba: np.ndarray, background_dba: float) -> np.ndarray:
@@ -45,7 +45,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     wheel_radius = np.array([site.vehicle(c).wheel_diameter_m / 2.0 for c in passes.vehicle_class])
     kalker_force = kalker_lateral_force(cfg, site, wheel_radius, load)
     k3 = creep_stiffness(cfg, kalker_force, k1)
-    mass, damping, stiffness = cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"]
+    mass, damping, stiffness = cfg.modal_mass_kg, cfg.modal_damping_nspm, cfg.modal_stiffness_npm
     lc = squeal.limit_cycle_amplitude(v0, vc, load, damping, k1, k2, k3)
     freq = np.broadcast_to(squeal.squeal_frequency(mass, stiffness), v0.shape)
     lev = _levels(cfg, lc.amplitude, freq)
@@ -54,12 +54,12 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     fm_k1, fm_k2 = cfg.creep(np.full_like(passes.friction_state, FRICTION_MODIFIER))
     fm = squeal.limit_cycle_amplitude(v0, vc, load, damping, fm_k1, fm_k2, creep_stiffness(cfg, kalker_force, fm_k1))
     fm_lev = _levels(cfg, fm.amplitude, freq)
-    bg = cfg["background_level_dba"]
+    bg = cfg.background_level_dba
     benefit = _with_background(lev.level_dba, bg) - _with_background(fm_lev.level_dba, bg)
 
     risk = np.where(~lc.unstable, RISK_NONE,
-                    np.where(lev.level_dba >= cfg["risk_high_dba"], RISK_HIGH,
-                             np.where(lev.level_dba >= cfg["risk_medium_dba"], RISK_MEDIUM, RISK_LOW)))
+                    np.where(lev.level_dba >= cfg.risk_high_dba, RISK_HIGH,
+                             np.where(lev.level_dba >= cfg.risk_medium_dba, RISK_MEDIUM, RISK_LOW)))
     return {
         "friction_state": passes.friction_state,
         "speed_mps": v0,
@@ -72,7 +72,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
         "frequency_hz": freq,
         "level_db": lev.level_db,
         "level_dba": lev.level_dba,
-        "relative_level_db": squeal.relative_level(lc.amplitude, cfg["reference_amplitude_mps"]),
+        "relative_level_db": squeal.relative_level(lc.amplitude, cfg.reference_amplitude_mps),
         "friction_modifier_benefit_db": benefit,
         "risk": risk.astype(np.int8),
     }
@@ -81,7 +81,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
 def kalker_lateral_force(cfg: SquealConfig, site: Site, wheel_radius_m: np.ndarray,
                           load_n: np.ndarray) -> np.ndarray | None:
     """G a b C22 [N] of the site's wheel-rail contact (None when k3 is given directly)."""
-    if cfg["k3_n"] > 0.0:
+    if cfg.k3_n > 0.0:
         return None
     c = site.contact
     return squeal.kalker_lateral_stiffness(site.contact_patch(wheel_radius_m, load_n), c.young_modulus_pa,
@@ -91,5 +91,5 @@ def kalker_lateral_force(cfg: SquealConfig, site: Site, wheel_radius_m: np.ndarr
 def creep_stiffness(cfg: SquealConfig, kalker_force: np.ndarray | None, mu0: np.ndarray) -> np.ndarray:
     """k3 [N] per pass: given directly, or from G a b C22 under the configured convention."""
     if kalker_force is None:
-        return np.full(mu0.shape, cfg["k3_n"])
-    return squeal.lateral_creep_stiffness(kalker_force, mu0, cfg["k3_convention"])
+        return np.full(mu0.shape, cfg.k3_n)
+    return squeal.lateral_creep_stiffness(kalker_force, mu0, cfg.k3_convention)

@@ -57,7 +57,7 @@ def site_case(cfg: SquealConfig, site: Site, vehicle_class: str, friction_state:
     k1, k2 = (float(x[0]) for x in cfg.creep(np.array([friction_state])))
     kalker_force = kalker_lateral_force(cfg, site, np.array([vehicle.wheel_diameter_m / 2.0]), np.array([load]))
     k3 = float(creep_stiffness(cfg, kalker_force, np.array([k1]))[0])
-    return SquealCase(speed_mps, load, cfg["modal_mass_kg"], cfg["modal_damping_nspm"], cfg["modal_stiffness_npm"],
+    return SquealCase(speed_mps, load, cfg.modal_mass_kg, cfg.modal_damping_nspm, cfg.modal_stiffness_npm,
                       k1, k2, k3)
 
 
