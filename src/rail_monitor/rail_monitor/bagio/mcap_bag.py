@@ -6,7 +6,7 @@ and metadata ``offered_qos_profiles`` (YAML text) and ``topic_type_hash`` (RIHS0
 ``rosbag2`` metadata record; zstd-compressed chunks. Chunks are
 closed at least every ``flush_period_ns`` of log time or wall time, and every write goes to the
 OS at once, so a killed process leaves every complete chunk readable
-(see :func:`rail_monitor.bagio.reader.salvage_mcap`).
+(see :func:`rail_monitor.bagio.integrity.scan_mcap`).
 """
 
 from __future__ import annotations

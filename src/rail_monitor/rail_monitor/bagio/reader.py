@@ -6,15 +6,15 @@ file and the cause; front ends print it without a traceback and exit non-zero.
 
 from __future__ import annotations
 
-from collections.abc import Collection, Iterator
+from collections import Counter
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from mcap.records import Channel, Message, Schema
-from mcap.stream_reader import StreamReader
 from rosbags.highlevel import AnyReader
 
+from rail_monitor.bagio.integrity import Claims, ScannedMessage, check_bag, scan_mcap
 from rail_monitor.bagio.messages import pass_row
 from rail_monitor.bagio.typestore import TRAIN_PASS, typestore
 from rail_monitor.core.errors import InputError, RailMonitorError
@@ -28,6 +28,15 @@ def _one_line(exc: BaseException) -> str:
 
 def is_csv(path: Path) -> bool:
     return path.suffix.lower() == ".csv"
+
+
+def _checked(path: Path, reader: AnyReader) -> Claims:
+    """The bag's claims once it is found consistent with itself (closing the reader if it is not)."""
+    try:
+        return check_bag(path)
+    except BaseException:
+        reader.close()
+        raise
 
 
 def _open_bag(path: Path) -> AnyReader:
@@ -66,6 +75,7 @@ def bag_info(path: str | Path) -> BagInfo:
     """Storage, time span and per-topic counts of a bag (folder, .mcap or .db3)."""
     path = Path(path)
     reader = _open_bag(path)
+    claims = _checked(path, reader)
     try:
         topics: dict[str, TopicInfo] = {}
         for c in reader.connections:
@@ -73,12 +83,17 @@ def bag_info(path: str | Path) -> BagInfo:
             topics[c.topic] = TopicInfo(c.topic, c.msgtype, c.msgcount + (prev.count if prev else 0))
         files = [p for p in ([path] if path.is_file() else path.iterdir())]
         storage = "sqlite3" if any(p.suffix == ".db3" for p in files) else "mcap"
-        return BagInfo(path, storage, reader.start_time, reader.end_time, reader.message_count,
+        info = BagInfo(path, storage, reader.start_time, reader.end_time, reader.message_count,
                        sorted(topics.values(), key=lambda t: t.name))
     except Exception as exc:
         raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
     finally:
         reader.close()
+    claims.check_read({t.name: t.count for t in info.topics})
+    if info.message_count != sum(t.count for t in info.topics):
+        raise InputError(f"{path}: the bag counts {info.message_count} messages in all but "
+                         f"{sum(t.count for t in info.topics)} over its topics")
+    return info
 
 
 def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
@@ -86,6 +101,7 @@ def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
     TrainPass topic; more than one is an error that lists them)."""
     path = Path(path)
     reader = _open_bag(path)
+    claims = _checked(path, reader)
     try:
         conns = [c for c in reader.connections if (c.topic == topic if topic else c.msgtype == TRAIN_PASS)]
         if not conns:
@@ -105,6 +121,7 @@ def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
         raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
     finally:
         reader.close()
+    claims.check_read({names[0]: len(rows)})
     return PassTable.from_rows(rows)
 
 
@@ -112,15 +129,20 @@ def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, lis
     """Every message of the given types in a bag (any topic), deserialised, by type, in log-time order."""
     path = Path(path)
     reader = _open_bag(path)
+    claims = _checked(path, reader)
     out: dict[str, list[Any]] = {t: [] for t in typenames}
+    read: Counter[str] = Counter()
     try:
         conns = [c for c in reader.connections if c.msgtype in out]
         for c, _, raw in reader.messages(connections=conns):
             out[c.msgtype].append(reader.deserialize(raw, c.msgtype))
+            read[c.topic] += 1
+        topics = {c.topic for c in conns}
     except Exception as exc:
         raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
     finally:
         reader.close()
+    claims.check_read({t: read[t] for t in topics})
     return out
 
 
@@ -139,57 +161,31 @@ def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool 
     return read_bag_passes(path, topic)
 
 
-@dataclass(frozen=True)
-class SalvagedMessage:
-    topic: str
-    typename: str
-    log_time_ns: int
-    data: bytes
-
-
-def salvage_mcap(path: str | Path) -> Iterator[SalvagedMessage]:
-    """Every message of every complete chunk of an MCAP file, even one cut off mid-write.
-
-    Reads records in file order with mcap's StreamReader (no summary section needed; chunk
-    CRCs checked) and stops quietly at the first incomplete or corrupt record (the end of a
-    killed writer's output). mcap's NonSeekingReader gives up on such a file altogether.
-    """
-    path = Path(path)
-    schemas: dict[int, Schema] = {}
-    channels: dict[int, Channel] = {}
-    with open(path, "rb") as stream:
-        records = iter(StreamReader(stream, validate_crcs=True).records)
-        while True:
-            try:
-                rec = next(records)
-            except StopIteration:
-                return
-            except Exception:  # truncated or corrupt tail: everything before it was yielded
-                return
-            if isinstance(rec, Schema):
-                schemas[rec.id] = rec
-            elif isinstance(rec, Channel):
-                channels[rec.id] = rec
-            elif isinstance(rec, Message) and rec.channel_id in channels:
-                ch = channels[rec.channel_id]
-                schema = schemas.get(ch.schema_id)
-                yield SalvagedMessage(ch.topic, schema.name if schema else "", rec.log_time, rec.data)
+def salvage_mcap(path: str | Path) -> list[ScannedMessage]:
+    """Every message of the intact records of an MCAP file, in file order, even one cut off
+    mid-write or with damaged chunks (skipped; bagio.integrity.scan_mcap counts them)."""
+    return scan_mcap(path, keep=True)[1]
 
 
 @dataclass(frozen=True)
 class SalvageReport:
     files: int          # .mcap files read
-    messages: int       # messages in their complete chunks (every topic)
+    messages: int       # messages in their intact records (every topic)
     passes: int         # TrainPass messages among them (of the chosen topic)
+    damaged_chunks: int = 0   # chunks skipped (failed CRC or decompression)
+    cut_off: int = 0          # files whose framing ends before the footer
 
     def line(self, path: str | Path) -> str:
-        return (f"salvaged {self.messages} messages ({self.passes} TrainPass) from the complete chunks of "
-                f"{self.files} MCAP file(s) in {path}")
+        skipped = (f"; skipped {self.damaged_chunks} damaged chunk(s)" if self.damaged_chunks else "") + (
+            f"; {self.cut_off} file(s) cut off before the footer" if self.cut_off else "")
+        return (f"salvaged {self.messages} messages ({self.passes} TrainPass) from the intact chunks of "
+                f"{self.files} MCAP file(s) in {path}{skipped}")
 
 
 def salvage_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
-    """Every TrainPass in the complete chunks of a bag's MCAP files (a folder or one .mcap file),
-    even files cut off mid-write with no summary or metadata.yaml (a killed recorder, a full disk).
+    """Every TrainPass in the intact chunks of a bag's MCAP files (a folder or one .mcap file), even
+    files cut off mid-write with no summary or metadata.yaml (a killed recorder, a full disk) or with
+    damaged chunks between intact ones (skipped and counted; see bagio.integrity.scan_mcap).
 
     The table's ``salvage`` attribute (SalvageReport) says what was recovered. Passes are in
     log-time order (stable across split files). topic: as in read_bag_passes.
@@ -200,12 +196,15 @@ def salvage_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
     files = sorted(path.glob("*.mcap"), key=_split_index) if path.is_dir() else [path]
     if not files:
         raise InputError(f"{path}: no .mcap files to salvage")
-    rows, total = [], 0
+    rows, total, damaged, cut_off = [], 0, 0, 0
     store = typestore()
     try:
         for f in files:
-            for m in salvage_mcap(f):
-                total += 1
+            scan, messages = scan_mcap(f, keep=True)
+            total += len(messages)
+            damaged += scan.damaged_chunks
+            cut_off += scan.cut_off
+            for m in messages:
                 if (m.topic == topic) if topic else (m.typename == TRAIN_PASS):
                     if m.typename != TRAIN_PASS:
                         raise InputError(f"{path}: topic {m.topic} is {m.typename}, not {TRAIN_PASS}")
@@ -216,7 +215,7 @@ def salvage_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
         raise InputError(f"{path}: cannot salvage: {_one_line(exc)}") from None
     rows.sort(key=lambda r: r[0])
     table = PassTable.from_rows([r for _, r in rows])
-    table.salvage = SalvageReport(len(files), total, len(rows))  # type: ignore[attr-defined]
+    table.salvage = SalvageReport(len(files), total, len(rows), damaged, cut_off)  # type: ignore[attr-defined]
     return table
 
 

@@ -1,0 +1,139 @@
+"""A bag that disagrees with its own index or metadata is refused, never read as fewer passes with
+exit 0; --salvage reads every intact chunk, past damaged ones (rail_monitor.bagio.integrity and
+the readers that use it)."""
+
+from __future__ import annotations
+
+import shutil
+import struct
+from pathlib import Path
+
+import pytest
+import yaml
+
+from rail_monitor.bagio.passes_bag import write_passes_bag
+from rail_monitor.bagio.reader import bag_info, read_bag_passes, read_passes
+from rail_monitor.cli import main
+from rail_monitor.core.errors import InputError
+
+from conftest import SAMPLE, run_cmd
+
+CHUNK, CHUNK_INDEX, FOOTER, DATA_END = 0x06, 0x08, 0x02, 0x0F
+
+
+def _frames(data: bytes) -> list[tuple[int, int, int]]:
+    """(opcode, record start, content length) of each MCAP record, read from the framing alone."""
+    out, pos = [], 8
+    while pos + 9 <= len(data):
+        opcode, length = struct.unpack_from("<BQ", data, pos)
+        out.append((opcode, pos, length))
+        if opcode == FOOTER:
+            break
+        pos += 9 + length
+    return out
+
+
+@pytest.fixture(scope="module")
+def small(tmp_path_factory, sample_passes) -> Path:
+    """400 passes of the sample in 16 KiB chunks (several chunks, several chunk indexes)."""
+    return write_passes_bag(sample_passes.take(slice(0, 400)), tmp_path_factory.mktemp("b") / "small", "curve_250",
+                            chunk_size=16 * 1024)
+
+
+def _copy(bag: Path, tmp_path: Path) -> tuple[Path, Path]:
+    out = tmp_path / bag.name
+    shutil.copytree(bag, out)
+    return out, next(out.glob("*.mcap"))
+
+
+def _flip(path: Path, offset: int) -> None:
+    data = bytearray(path.read_bytes())
+    data[offset] ^= 0x5A
+    path.write_bytes(bytes(data))
+
+
+def test_no_flipped_byte_of_the_summary_reads_as_other_passes(small, tmp_path):
+    """Every 5th byte from the end of the data section to the end of the file, flipped alone: the
+    passes read are the original ones or the read is refused with one line, never fewer or others."""
+    whole = read_bag_passes(small)
+    mcap = next(small.glob("*.mcap"))
+    data = mcap.read_bytes()
+    data_end = next(start for opcode, start, _ in _frames(data) if opcode == DATA_END)
+    outcomes = {"same": 0, "refused": 0}
+    for offset in range(data_end, len(data), 5):
+        bag, f = _copy(small, tmp_path / str(offset))
+        _flip(f, offset)
+        try:
+            got = read_bag_passes(bag)
+        except InputError as exc:
+            assert "\n" not in str(exc)
+            outcomes["refused"] += 1
+            continue
+        assert got.equals(whole), offset
+        outcomes["same"] += 1
+    assert outcomes["refused"] > 0
+
+
+def test_a_damaged_chunk_index_or_channel_is_refused_by_every_front_end(small, tmp_path, capsys):
+    data = next(small.glob("*.mcap")).read_bytes()
+    index = next(start for opcode, start, _ in _frames(data) if opcode == CHUNK_INDEX)
+    bag, f = _copy(small, tmp_path)
+    _flip(f, index + 9 + 16)  # the chunk's start offset
+    with pytest.raises(InputError, match="disagrees with itself"):
+        read_bag_passes(bag)
+    for argv in (["info", str(bag)], ["batch", str(bag), "--output", str(tmp_path / "out"), "--no-report"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(bag) in err
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+    r = run_cmd("pass_replayer", "--ros-args", "-p", f"source:={bag}", "-p", "progress:=false", timeout=60)
+    assert r.returncode == 2 and "disagrees with itself" in r.stderr and "Traceback" not in r.stderr
+
+
+def _meta(bag: Path, edit) -> None:
+    path = bag / "metadata.yaml"
+    doc = yaml.safe_load(path.read_text())
+    edit(doc["rosbag2_bagfile_information"])
+    path.write_text(yaml.safe_dump(doc))
+
+
+@pytest.mark.parametrize(("what", "edit", "match"), [
+    ("no files listed", lambda m: m.update(relative_file_paths=[]), "lists 0 file"),
+    ("a file listed twice", lambda m: m.update(relative_file_paths=m["relative_file_paths"] * 2),
+     "lists a file more than once"),
+    ("a renamed topic", lambda m: m["topics_with_message_count"][0]["topic_metadata"].update(name="/train_pazz"),
+     "on /train_pa"),
+    ("a lying topic count", lambda m: m["topics_with_message_count"][0].update(message_count=9999), "9999"),
+    ("a lying total", lambda m: m.update(message_count=9999), "9999"),
+])
+def test_a_lying_metadata_file_is_refused(small, tmp_path, what, edit, match):
+    bag, _ = _copy(small, tmp_path)
+    _meta(bag, edit)
+    for read in (read_bag_passes, bag_info):
+        with pytest.raises(InputError, match=match):
+            read(bag)
+
+
+def test_salvage_skips_a_damaged_chunk_and_reads_every_intact_one(small, tmp_path):
+    whole = read_bag_passes(small)
+    bag, f = _copy(small, tmp_path)
+    data = f.read_bytes()
+    chunks = [(start, length) for opcode, start, length in _frames(data) if opcode == CHUNK]
+    assert len(chunks) >= 4
+    start, length = chunks[1]
+    _flip(f, start + 9 + length - 50)  # inside the second chunk's compressed records
+    with pytest.raises(InputError, match=r"1 of \d+ chunks damaged"):
+        read_bag_passes(bag)
+    salvaged = read_passes(bag, salvage=True)
+    report = salvaged.salvage
+    assert report.damaged_chunks == 1 and "skipped 1 damaged chunk" in report.line(bag)
+    lost = len(whole) - len(salvaged)
+    assert 0 < lost < len(whole) / 2                      # the chunks after the damaged one are read
+    kept = set(zip(salvaged.stamp_ns.tolist(), salvaged.train_id.tolist(), strict=True))
+    assert kept <= set(zip(whole.stamp_ns.tolist(), whole.train_id.tolist(), strict=True))
+    assert int(salvaged.stamp_ns.max()) == int(whole.stamp_ns.max())  # the last chunk is intact
+
+
+def test_the_sample_and_a_recorded_bag_pass_the_checks():
+    assert len(read_bag_passes(SAMPLE)) == 8638
+    assert bag_info(SAMPLE).message_count == 8638
