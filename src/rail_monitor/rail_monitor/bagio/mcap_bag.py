@@ -27,6 +27,14 @@ from rail_monitor.bagio.topics import qos_dict
 from rail_monitor.bagio.typestore import schema_text, type_hash
 from rail_monitor.core.errors import RailMonitorError
 
+# A file the program leaves in every folder it creates: --overwrite replaces only such folders.
+MARKER = ".rail_monitor"
+
+
+def mark_output(folder: Path) -> None:
+    """Mark a folder as created by rail_monitor (see :data:`MARKER`)."""
+    (folder / MARKER).write_text("created by rail_monitor; --overwrite may replace this folder\n", encoding="utf-8")
+
 
 def _dump(obj: Any) -> str:
     return yaml.safe_dump(obj, sort_keys=False, default_flow_style=False)
@@ -70,6 +78,7 @@ class McapBagWriter:
         if compression not in ("zstd", "none"):
             raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
         self.folder.mkdir(parents=True, exist_ok=True)
+        mark_output(self.folder)
         self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
         self._chunk_size = chunk_size
         self._max_bytes = max_file_bytes

@@ -178,7 +178,7 @@ class SalvageReport:
     def line(self, path: str | Path) -> str:
         skipped = (f"; skipped {self.damaged_chunks} damaged chunk(s)" if self.damaged_chunks else "") + (
             f"; {self.cut_off} file(s) cut off before the footer" if self.cut_off else "")
-        return (f"salvaged {self.messages} messages ({self.passes} TrainPass) from the intact chunks of "
+        return (f"salvaged {self.messages} messages ({self.passes} TrainPass) from the complete chunks of "
                 f"{self.files} MCAP file(s) in {path}{skipped}")
 
 

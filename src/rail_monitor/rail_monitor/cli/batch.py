@@ -19,7 +19,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--namespace", help="topic namespace in the bag (default: the site_id)")
     s.add_argument("--report", help="report folder (default: <output>_report)")
     s.add_argument("--no-report", action="store_true", help="write the bag only")
-    s.add_argument("--overwrite", action="store_true", help="replace an existing output folder")
+    s.add_argument("--overwrite", action="store_true",
+                   help="replace an existing output folder that rail_monitor created")
     s.add_argument("--salvage", action="store_true", help=SALVAGE_HELP)
     s.set_defaults(func=run)
 
@@ -34,7 +35,7 @@ def run(ns: argparse.Namespace) -> int:
     if ns.salvage:
         print(passes.salvage.line(ns.source))
     out = Path(ns.output or f"{Path(ns.source).stem}_batch")
-    fresh_output(out, ns.overwrite)
+    fresh_output(out, ns.overwrite, [ns.source])
     result = run_models(passes, values)
     t_models = time.monotonic() - t0
     write_bag(result, out, ns.namespace if ns.namespace is not None else str(values.get("site_id", "")))

@@ -81,12 +81,29 @@ def ros_args(ns: argparse.Namespace, site: Path | None, extra: dict[str, object]
     return args
 
 
-def fresh_output(path: Path, overwrite: bool) -> None:
-    """Make room for an output folder: remove it with overwrite, else refuse to touch it."""
-    if path.exists():
-        if not overwrite:
-            raise RailMonitorError(f"{path} exists; remove it or pass --overwrite")
-        shutil.rmtree(path)
+def fresh_output(path: Path, overwrite: bool, inputs: Sequence[str | Path] = ()) -> None:
+    """Make room for an output folder. Without overwrite an existing path is refused; with it, only
+    a folder this program created (it holds the marker file of bagio.mcap_bag) is removed, and never
+    the working folder, a folder holding an input, or a symbolic link."""
+    from rail_monitor.bagio.mcap_bag import MARKER
+
+    if not (path.exists() or path.is_symlink()):
+        return
+    if not overwrite:
+        raise RailMonitorError(f"{path} exists; remove it or pass --overwrite")
+    if path.is_symlink():
+        raise RailMonitorError(f"{path} is a symbolic link: --overwrite replaces only folders rail_monitor created")
+    real = path.resolve()
+    if real == Path.cwd().resolve() or real in Path.cwd().resolve().parents:
+        raise RailMonitorError(f"{path} is the working folder or holds it: give another output folder")
+    for source in inputs:
+        src = Path(source).resolve()
+        if real == src or real in src.parents:
+            raise RailMonitorError(f"{path} holds the input {source}: give another output folder")
+    if not path.is_dir() or not (path / MARKER).is_file():
+        raise RailMonitorError(f"{path} exists and was not created by rail_monitor (no {MARKER} file): "
+                               "remove it yourself or give another output folder")
+    shutil.rmtree(path)
 
 
 def report_dir(bag: str, report: str | None) -> Path:

@@ -48,7 +48,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         s.add_argument("--report", help="report folder (default: <output>_report)")
         s.add_argument("--no-report", action="store_true", help="record only: no summary or report")
         s.add_argument("--overwrite", action="store_true", default=name == "demo",
-                       help="replace an existing output folder")
+                       help="replace an existing output folder that rail_monitor created")
         add_specs(s, MONITOR_SPECS + PUBLISH_SPECS, skip=("site_id", "wait_for_subscribers", "wait_timeout_s"))
         s.set_defaults(func=demo if name == "demo" else monitor)
 
@@ -79,7 +79,7 @@ def _monitor_and_report(ns: argparse.Namespace, source: str) -> int:
     from rail_monitor.nodes.wayside_monitor import main
 
     output = ns.output or f"rail_monitor_{Path(source).stem}"
-    fresh_output(Path(output), ns.overwrite)
+    fresh_output(Path(output), ns.overwrite, [source])
     if not ns.namespace:
         ns.namespace = str(site_values(ns.site).get("site_id", ""))
     rc = main(ros_args(ns, site_file(ns.site), {"source": source, "output": output, "use_sim_time": True}))

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import shutil
 from pathlib import Path
 
-from rail_monitor.cli.common import add_site_option, site_values
+from rail_monitor.cli.common import add_site_option, fresh_output, site_values
 from rail_monitor.core.errors import RailMonitorError
 
 
@@ -17,7 +16,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--csv", help="CSV file to write")
     s.add_argument("--days", type=float, help="override simulator.days [day]")
     s.add_argument("--seed", type=int, help="override simulator.seed [-]")
-    s.add_argument("--force", action="store_true", help="replace an existing bag folder")
+    s.add_argument("--force", action="store_true", help="replace an existing bag folder that rail_monitor created")
     s.set_defaults(func=run)
 
 
@@ -37,8 +36,7 @@ def run(ns: argparse.Namespace) -> int:
     if not ns.out and not ns.csv:
         raise RailMonitorError("give --out BAG and/or --csv FILE")
     if ns.out:
-        if ns.force and Path(ns.out).exists():
-            shutil.rmtree(ns.out)
+        fresh_output(Path(ns.out), ns.force)
         write_passes_bag(table, ns.out, site.site_id)
         print(f"wrote {len(table)} passes to bag {ns.out}")
     if ns.csv:
