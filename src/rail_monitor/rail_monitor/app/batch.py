@@ -25,6 +25,7 @@ from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
 from rail_monitor.core.site import Site, site_from_values
+from rail_monitor.core.timeutil import fits_time_msg
 from rail_monitor.corrugation.advice import advise_or_none
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
@@ -56,6 +57,7 @@ class BatchResult:
     advice: Advice | None
     estimator: CorrugationEstimator   # the final state
     receiver: Any
+    left_out: int = 0                 # passes whose stamps builtin_interfaces/Time cannot hold
 
 
 def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None
@@ -65,7 +67,9 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     estimator: a state to continue from (e.g. a checkpoint); default the post-grinding state.
     """
     site = site_from_values(values)
-    table = passes.sorted()
+    # What the replayer can publish: a stamp builtin_interfaces/Time cannot hold is left out, counted.
+    fits = np.array([fits_time_msg(s) for s in passes.stamp_ns.tolist()], bool)
+    table = passes.take(fits).sorted()
     reasons = rejection_reasons(table, site)
     accepted = with_class_defaults(table.take(reasons == ""), site)
     est = estimator or CorrugationEstimator(site, corrugation_config(values))
@@ -77,7 +81,8 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     alerts = AlertManager(alert_config(values, est.cfg.lead_time_days))
     events = _feed_alerts(alerts, table, reasons, accepted, squeal, traj, noise)
     return BatchResult(site, table, reasons, accepted, squeal, traj, state_of_pass, noise, events,
-                       sorted(alerts.standing.values(), key=_alert_key), advise_or_none(est), est, model.receiver)
+                       sorted(alerts.standing.values(), key=_alert_key), advise_or_none(est), est, model.receiver,
+                       int((~fits).sum()))
 
 
 def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:
@@ -147,7 +152,7 @@ def write_bag(result: BatchResult, folder: str | Path, namespace: str, compressi
         sent = [fields.train_pass_fields(result.passes.row(i), frame) for i in range(len(result.passes))]
         by_accepted = [m for m, why in zip(sent, result.reasons, strict=True) if not why]
         for msg, stamp in zip(sent, result.passes.stamp_ns.tolist(), strict=True):
-            put("train_pass", msg, stamp)
+            put("train_pass", msg, max(stamp, 0))  # a log time cannot be before 1970
         for i, msg in enumerate(by_accepted):
             put("noise/squeal", fields.squeal_prediction_fields(result.squeal, i, msg["header"], msg["train_id"]),
                 int(result.accepted.stamp_ns[i]))

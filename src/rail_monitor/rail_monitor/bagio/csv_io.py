@@ -21,12 +21,13 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from collections.abc import Callable
 from pathlib import Path
 
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import FRICTION_BY_NAME, FRICTION_NAMES, PassTable
-from rail_monitor.core.timeutil import NS_PER_S, format_iso_ns, parse_iso_ns
+from rail_monitor.core.timeutil import NS_PER_S, checked_ns, format_iso_ns, parse_iso_ns
 
 
 def _time_utc(text: str) -> int:
@@ -34,7 +35,14 @@ def _time_utc(text: str) -> int:
 
 
 def _time_unix_s(text: str) -> int:
-    return round(float(text) * NS_PER_S)
+    seconds = float(text)
+    if not math.isfinite(seconds):
+        raise ValueError(f"{text!r} is not a finite time")
+    return checked_ns(round(seconds * NS_PER_S))
+
+
+def _time_unix_ns(text: str) -> int:
+    return checked_ns(int(text))
 
 
 def _friction(text: str) -> int:
@@ -57,7 +65,7 @@ def _scaled(factor: float) -> Callable[[str], float]:
 
 # quantity -> {column name: parser to the PassTable column's SI value}; None marks "optional".
 _QUANTITIES: dict[str, tuple[str, dict[str, Callable[[str], object]], object]] = {
-    "time": ("stamp_ns", {"time_utc": _time_utc, "time_unix_s": _time_unix_s, "time_unix_ns": int}, None),
+    "time": ("stamp_ns", {"time_utc": _time_utc, "time_unix_s": _time_unix_s, "time_unix_ns": _time_unix_ns}, None),
     "train_id": ("train_id", {"train_id": str}, None),
     "vehicle_class": ("vehicle_class", {"vehicle_class": str}, None),
     "vehicle_count": ("vehicle_count", {"vehicle_count": _count}, 0),

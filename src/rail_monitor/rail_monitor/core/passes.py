@@ -14,6 +14,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from rail_monitor.core.site import Site
+from rail_monitor.core.timeutil import TIME_MSG_END_NS
 
 # TrainPass.FRICTION_* values and their names in CSV files and site parameters.
 FRICTION_UNSET, FRICTION_DRY, FRICTION_WET, FRICTION_MODIFIER, FRICTION_CONTAMINATED = range(5)
@@ -127,7 +128,9 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
         reasons[(reasons == "") & bad] = why
 
     stripped = np.array([s.strip() for s in table.train_id], dtype=object)
-    flag(table.stamp_ns <= 0, "stamp not set")
+    flag(table.stamp_ns == 0, "stamp not set")
+    flag(table.stamp_ns < 0, "stamp before 1970")
+    flag(table.stamp_ns >= TIME_MSG_END_NS, "stamp past 2038-01-19 (builtin_interfaces/Time seconds are int32)")
     flag(stripped == "", "empty train_id")
     flag(np.array([len(s) > 64 for s in table.train_id], dtype=bool), "train_id longer than 64 characters")
     flag(~np.isfinite(table.speed_mps), "speed_mps not finite")

@@ -10,6 +10,9 @@ from rail_monitor.core.errors import RailMonitorError
 NS_PER_S = 1_000_000_000
 NS_PER_HOUR = 3600 * NS_PER_S
 NS_PER_DAY = 86400 * NS_PER_S
+# builtin_interfaces/Time holds int32 seconds: the first instant it cannot hold (2038-01-19T03:14:08Z).
+TIME_MSG_END_NS = 2**31 * NS_PER_S
+INT64_MAX = 2**63 - 1
 _ISO = re.compile(r"^(\d{4}-\d\d-\d\d[T ]\d\d:\d\d:\d\d)(?:\.(\d{1,9}))?(Z|[+-]\d\d:?\d\d)?$")
 
 
@@ -23,7 +26,19 @@ def parse_iso_ns(text: str) -> int:
         t = datetime.fromisoformat(whole + ("+00:00" if zone in (None, "Z") else zone))
     except ValueError:
         raise RailMonitorError(f"not a valid time: {text!r}") from None
-    return int(t.timestamp()) * NS_PER_S + int((frac or "0").ljust(9, "0"))
+    return checked_ns(int(t.timestamp()) * NS_PER_S + int((frac or "0").ljust(9, "0")))
+
+
+def checked_ns(ns: int) -> int:
+    """ns since the epoch, refused (RailMonitorError) where an int64 cannot hold it."""
+    if not -INT64_MAX <= ns <= INT64_MAX:
+        raise RailMonitorError(f"time {ns} ns is out of range (int64 nanoseconds since 1970)")
+    return ns
+
+
+def fits_time_msg(ns: int) -> bool:
+    """Whether builtin_interfaces/Time (int32 seconds) can hold ns since the epoch."""
+    return -TIME_MSG_END_NS <= ns < TIME_MSG_END_NS
 
 
 def format_iso_ns(ns: int) -> str:

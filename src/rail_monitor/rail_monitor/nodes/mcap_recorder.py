@@ -15,6 +15,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
+from collections import Counter
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -70,10 +71,12 @@ class McapRecorder(Node):
         wall_timer(self, self.cfg.discovery_period_s, self.discover, callback_group=self._group)
         wall_timer(self, max(self.cfg.flush_period_s, 0.05), self._flush, callback_group=self._group)
         self.dropped = 0  # messages not recorded after a write error
+        self.refused: Counter[str] = Counter()  # messages that could not be written, by cause
         self.diagnostics = Diagnostics(
             self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
                            "topics": len(self._subs), "bag": str(self.writer.folder),
-                           "not recorded (write failed)": self.dropped, "write error": self.writer.error},
+                           "not recorded (write failed)": self.dropped, "write error": self.writer.error,
+                           **{f"refused: {why}": n for why, n in sorted(self.refused.items())}},
             level=lambda: (DiagnosticStatus.ERROR, self.writer.error) if self.writer.error
             else (DiagnosticStatus.OK, "ok"))
         self.discover()
@@ -116,9 +119,13 @@ class McapRecorder(Node):
                 return
             stamp = header_stamp_ns(data) if self._stamped[topic] else None
             try:
-                self.writer.write(topic, data, stamp if stamp else self.get_clock().now().nanoseconds)
+                # A stamp before 1970 (or unset) cannot be an MCAP log time: the receive time stands in.
+                self.writer.write(topic, data, stamp if stamp and stamp > 0 else self.get_clock().now().nanoseconds)
             except RailMonitorError as exc:
                 self._write_failed(exc)
+                return
+            except Exception as exc:  # one malformed message must not stop the recording
+                self.refused[f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"] += 1
                 return
             self.counts[topic] += 1
         self.meter.tick()

@@ -10,6 +10,7 @@ import threading
 import time
 from collections.abc import Callable
 
+import numpy as np
 import rclpy
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -21,7 +22,7 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import PUBLISH_SPECS, PublishParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
-from rail_monitor.core.timeutil import NS_PER_S
+from rail_monitor.core.timeutil import NS_PER_S, fits_time_msg
 from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, refuse_unknown_parameters
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.qos import CLOCK_QOS, STREAM_QOS
@@ -43,7 +44,9 @@ class PassSourceNode(Node):
         self.done = threading.Event()
         # Passes taken by the slowest subscriber hosted in this process (set by wayside_monitor).
         self.consumed: Callable[[], int] | None = None
+        self.unpublishable = 0
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
+                                   "left out (stamp not representable)": self.unpublishable,
                                    "rate_per_s": f"{self.meter.rate():.1f}",
                                    "pass_time_ns": self.last_stamp_ns, "done": self.done.is_set()})
 
@@ -52,7 +55,14 @@ class PassSourceNode(Node):
         raise NotImplementedError
 
     def _window(self, table: PassTable) -> PassTable:
-        table = table.sorted()
+        """The passes to publish: in time order, inside the offsets, and representable as a
+        TrainPass (a stamp builtin_interfaces/Time cannot hold is left out and counted)."""
+        fits = np.array([fits_time_msg(s) for s in table.stamp_ns.tolist()], bool)
+        self.unpublishable = int((~fits).sum())
+        if self.unpublishable:
+            self.get_logger().warning(f"{self.unpublishable} pass(es) left out: their stamps do not fit "
+                                      "builtin_interfaces/Time (int32 seconds)")
+        table = table.take(fits).sorted()
         if len(table) == 0:
             return table
         t0 = int(table.stamp_ns[0])
@@ -62,8 +72,8 @@ class PassSourceNode(Node):
         return table.take(keep)
 
     def _publish_clock(self, ns: int) -> None:
-        if self.clock_pub is not None:
-            self.clock_pub.publish(Clock(clock=time_msg(ns)))
+        if self.clock_pub is not None:  # a ROS clock cannot run before 1970
+            self.clock_pub.publish(Clock(clock=time_msg(max(ns, 0))))
 
     def _wait_for_subscribers(self, ok: Callable[[], bool]) -> None:
         want = self.cfg.wait_for_subscribers
