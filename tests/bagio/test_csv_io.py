@@ -72,3 +72,28 @@ def test_skip_bad_rows_counts_them(tmp_path: Path):
     p.write_text(HEADER + ROW + ROW.replace("19.0", "x") + ROW.replace("T1", "T2"), encoding="utf-8")
     t = read_csv(p, skip_bad_rows=True)
     assert len(t) == 2 and t.skipped == 1 and list(t.train_id) == ["T1", "T2"]
+
+
+def test_separators_and_control_characters_in_a_field_stay_in_their_row(tmp_path):
+    """U+2028 is text inside a field, not a line break; a NUL or a line separator in a train id makes
+    the pass a rejection with its reason (a C string would cut it); a field past the csv module's
+    limit is a malformed row, not a traceback."""
+    from rail_monitor.core.passes import rejection_reasons
+    from rail_monitor.site_file import load_site
+
+    from conftest import SITE_FILE
+
+    path = tmp_path / "odd.csv"
+    head = "time_utc,train_id,vehicle_class,vehicle_count,speed_mps,angle_of_attack_rad,friction_state\n"
+    path.write_text(head + "2026-09-01T00:00:00Z,A\u2028B,emu,3,19,0.005,dry\n"
+                    + "2026-09-01T00:01:00Z,C\x00D,emu,3,19,0.005,dry\n"
+                    + "2026-09-01T00:02:00Z,OK,emu,3,19,0.005,dry\n", encoding="utf-8")
+    table = read_csv(path)
+    assert table.train_id.tolist() == ["A\u2028B", "C\x00D", "OK"]
+    reasons = rejection_reasons(table, load_site(SITE_FILE)).tolist()
+    assert reasons == ["train_id has control or separator characters"] * 2 + [""]
+    big = tmp_path / "big.csv"
+    big.write_text(head + "2026-09-01T00:00:00Z," + "X" * 2**20 + ",emu,3,19,0.005,dry\n")
+    with pytest.raises(InputError, match=r"line 2: .*field larger than field limit"):
+        read_csv(big)
+    assert len(read_csv(big, skip_bad_rows=True)) == 0

@@ -76,3 +76,36 @@ def test_an_unreadable_checkpoint_falls_back_to_the_previous_one(site_, tables, 
     assert checkpoint.resume(_estimator(site_, tables), tmp_path / "none.npz") == (None, [])
     tally("checkpoint", f"{len(faults)} corrupt newest checkpoints, both corrupt, crash between renames",
           "previous good state resumed; refusal when neither is readable", 0)
+
+
+def _crafted(est, path, change: dict) -> None:
+    """A checkpoint of est written normally, then rewritten as a valid .npz with some members changed."""
+    checkpoint.save(est, path)
+    with np.load(path, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files}
+    data.update(change)
+    with open(path, "wb") as fh:
+        np.savez(fh, **data)
+
+
+@pytest.mark.parametrize("change", [
+    lambda est: {"meta": np.array("[1, 2, 3]")},                              # a meta record that is no mapping
+    lambda est: {"k_b": np.zeros(3)},                                         # K_b of 3 friction states
+    lambda est: {"log_components": np.full(est.log_components.shape, np.nan)},  # not finite
+    lambda est: {"recent_speed": np.zeros(2)},                                # kept-pass columns of other lengths
+    lambda est: {"recent_class_idx": np.full(len(est.kept), 7)},             # a class the site does not have
+    lambda est: {"recent_stamp_ns": np.array(["x"] * len(est.kept))},         # strings for stamps
+    lambda est: {"grinding_amplitude": np.zeros(len(est.bands))},             # post-grinding amplitudes of zero
+])
+def test_a_crafted_checkpoint_is_refused_and_leaves_the_state_as_it_was(site_, tables, tmp_path, change):
+    est = _estimator(site_, tables)
+    est.advance(_passes(site_, [19.0] * 150))
+    path = tmp_path / "c.npz"
+    _crafted(est, path, change(est))
+    fresh = _estimator(site_, tables)
+    before = fresh.log_components.copy()
+    with pytest.raises(CorruptCheckpoint) as err:
+        checkpoint.load(fresh, path)
+    assert "\n" not in str(err.value) and str(path) in str(err.value)
+    np.testing.assert_array_equal(fresh.log_components, before)
+    assert fresh.total_pass_count == 0 and len(fresh.kept) == 0

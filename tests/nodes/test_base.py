@@ -43,3 +43,24 @@ def test_isolate_failures_runs_the_rest_when_one_item_fails():
     done.clear()
     isolate_failures(2, call, lambda i, exc: failed.append(i))
     assert done == [0, 1]
+
+
+@pytest.mark.parametrize("args", [["--params-file", "/no/such/site.yaml"], ["-p", "rate:="]])
+def test_a_params_file_or_value_rcl_refuses_is_one_line_and_exit_2(args):
+    r = run_cmd("pass_replayer", "--ros-args", *args, "-p", "source:=bags/sample", timeout=60)
+    assert r.returncode == 2, r.stderr[-2000:]
+    lines = [line for line in r.stderr.splitlines() if line.strip() and not line.startswith("[")]
+    assert len(lines) == 1 and lines[0].startswith("error: cannot start:") and "Traceback" not in r.stderr
+
+
+def test_a_recorder_output_that_is_a_file_or_a_dangling_link_is_one_line(tmp_path):
+    import os
+
+    a_file = tmp_path / "file"
+    a_file.write_text("mine")
+    link = tmp_path / "link"
+    os.symlink(tmp_path / "nowhere", link)
+    for out in (a_file, link):
+        r = run_cmd("mcap_recorder", "--ros-args", "-p", f"output:={out}", timeout=60)
+        assert r.returncode == 2 and "not a folder" in r.stderr and "Traceback" not in r.stderr, r.stderr[-1500:]
+    assert a_file.read_text() == "mine"

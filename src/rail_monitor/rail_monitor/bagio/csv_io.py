@@ -104,11 +104,15 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
     (then it is left out and counted in the returned table's ``skipped`` attribute)."""
     path = Path(path)
     text = _read_text(path)
-    lines = [(n, line) for n, line in enumerate(text.splitlines(), start=1)
+    # Lines end at \n alone (str.splitlines would also split at U+2028 and other separators inside a field).
+    lines = [(n, line.removesuffix("\r")) for n, line in enumerate(text.split("\n"), start=1)
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
         raise InputError(f"{path}: no header line (expected columns such as time_utc,train_id,...)")
-    header_line, header = lines[0][0], next(csv.reader([lines[0][1]]))
+    try:
+        header_line, header = lines[0][0], next(csv.reader([lines[0][1]]))
+    except csv.Error as exc:
+        raise InputError(f"{path}: line {lines[0][0]}: {exc}") from None
     header = [h.strip() for h in header]
     parsers: dict[int, tuple[str, Callable[[str], object]]] = {}
     seen: dict[str, str] = {}
@@ -133,8 +137,8 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
 
     rows, skipped = [], 0
     for n, line in lines[1:]:
-        cells = next(csv.reader([line]))
         try:
+            cells = next(csv.reader([line]))
             if len(cells) != len(header):
                 raise ValueError(f"{len(cells)} fields where the header has {len(header)}")
             row = {target: default for _, (target, _, default) in _QUANTITIES.items()}
@@ -144,7 +148,7 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
                 except (ValueError, RailMonitorError) as exc:
                     raise ValueError(f"column {header[i]!r}: {exc}") from None
             rows.append(row)
-        except ValueError as exc:
+        except (ValueError, csv.Error) as exc:
             if not skip_bad_rows:
                 raise InputError(f"{path}: line {n}: {exc}") from None
             skipped += 1

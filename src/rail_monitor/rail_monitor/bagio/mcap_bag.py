@@ -73,12 +73,17 @@ class McapBagWriter:
                  max_file_bytes: int = 0, max_file_duration_ns: int = 0, flush_period_ns: int = 0,
                  flush_wall_period_s: float = 0.0) -> None:
         self.folder = Path(folder)
+        if self.folder.is_symlink() or (self.folder.exists() and not self.folder.is_dir()):
+            raise RailMonitorError(f"{self.folder}: output exists and is not a folder (a file or a link)")
         if self.folder.exists() and any(self.folder.iterdir()):
             raise RailMonitorError(f"{self.folder}: output folder exists and is not empty")
         if compression not in ("zstd", "none"):
             raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
-        self.folder.mkdir(parents=True, exist_ok=True)
-        mark_output(self.folder)
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            mark_output(self.folder)
+        except OSError as exc:
+            raise RailMonitorError(f"{self.folder}: cannot create the output folder: {exc.strerror}") from None
         self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
         self._chunk_size = chunk_size
         self._max_bytes = max_file_bytes

@@ -133,6 +133,10 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     flag(table.stamp_ns >= TIME_MSG_END_NS, "stamp past 2038-01-19 (builtin_interfaces/Time seconds are int32)")
     flag(stripped == "", "empty train_id")
     flag(np.array([len(s) > 64 for s in table.train_id], dtype=bool), "train_id longer than 64 characters")
+    flag(np.array([not s.isprintable() for s in table.train_id], dtype=bool),
+         "train_id has control or separator characters")
+    flag(np.array([not s.isprintable() for s in table.vehicle_class], dtype=bool),
+         "vehicle_class has control or separator characters")
     flag(~np.isfinite(table.speed_mps), "speed_mps not finite")
     flag(table.speed_mps <= 0.0, "speed_mps not positive")
     flag(table.speed_mps < MIN_SPEED_MPS, f"speed_mps below {MIN_SPEED_MPS:g} m/s")

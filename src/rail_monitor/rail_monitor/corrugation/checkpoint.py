@@ -84,24 +84,61 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
 
 
 def load(est: CorrugationEstimator, path: str | Path) -> None:
-    """Resume est from a checkpoint of its site with the same bands (ConfigError otherwise)."""
+    """Resume est from a checkpoint of its site with the same bands (ConfigError otherwise; a file
+    that does not hold a whole, consistent state is CorruptCheckpoint). est is changed only once the
+    whole file has been read and checked."""
     meta, data = _read(path)
+    if not isinstance(meta, dict):
+        raise CorruptCheckpoint(f"{path}: not a readable corrugation checkpoint: its meta record is not a mapping")
     if meta.get("version") not in READABLE_VERSIONS or meta.get("site_id") != est.site.site_id:
         raise ConfigError(f"{path}: checkpoint of site {meta.get('site_id')!r} version {meta.get('version')}, "
                           f"not of site {est.site.site_id!r} version {VERSION}")
-    if data["bands"].shape != est.bands.shape or not np.allclose(data["bands"], est.bands) \
-            or data["log_components"].shape != est.log_components.shape:
+    try:
+        state = _state(est, meta, data)
+    except (TypeError, ValueError, KeyError, AttributeError, IndexError, OverflowError) as exc:
+        raise CorruptCheckpoint(f"{path}: not a readable corrugation checkpoint: {type(exc).__name__}: "
+                                f"{(str(exc).splitlines() or [''])[0]}") from None
+    if state is None:
         raise ConfigError(f"{path}: checkpoint bands differ from the configured ones")
-    est.log_components = data["log_components"].astype(float)
-    est.survey_log_amplitude = data["survey_log_amplitude"].astype(float)
-    est.grinding_amplitude = data.get("grinding_amplitude", est.post_grinding).astype(float)
-    for key in _COUNTS:
-        setattr(est, key, int(meta[key]))
-    est.newest_train_id = str(meta.get("newest_train_id", ""))
-    cols = {n: data[f"recent_{n}"] for n in COLUMNS}
-    cols["train_id"] = cols["train_id"].astype(object)
-    est.kept = KeptPasses(**cols)
-    est.set_k_b(data["k_b"])
+    k_b = state.pop("_k_b")
+    for key, value in state.items():
+        setattr(est, key, value)
+    est.set_k_b(k_b)
+
+
+def _state(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarray]) -> dict | None:
+    """The estimator's attributes from a checkpoint's records, every array checked (None: other bands)."""
+    bands = np.asarray(data["bands"], float)
+    log_components = np.asarray(data["log_components"], float)
+    if bands.shape != est.bands.shape or not np.allclose(bands, est.bands) \
+            or log_components.shape != est.log_components.shape:
+        return None
+    k_b = np.asarray(data["k_b"], float)
+    survey = np.asarray(data["survey_log_amplitude"], float)
+    grinding = np.asarray(data.get("grinding_amplitude", est.post_grinding), float)
+    nb = len(est.bands)
+    if k_b.shape != (4,) or survey.shape != (nb,) or grinding.shape != (nb,):
+        raise ValueError("K_b, survey or post-grinding arrays have the wrong shape")
+    if not (np.all(np.isfinite(log_components)) and np.all(np.isfinite(k_b)) and np.all(k_b >= 0)
+            and np.all(np.isfinite(grinding)) and np.all(grinding > 0)):
+        raise ValueError("state arrays not finite, or K_b negative, or post-grinding amplitudes not positive")
+    cols = {n: np.asarray(data[f"recent_{n}"]) for n in COLUMNS}
+    cols["train_id"] = cols["train_id"].astype(str).astype(object)
+    for n, dtype in (("stamp_ns", np.int64), ("class_idx", np.int64), ("friction", np.int64), ("axles", np.int64),
+                     ("speed", np.float64)):
+        cols[n] = cols[n].astype(dtype, casting="same_kind")
+    n = len(cols["stamp_ns"])
+    if any(c.ndim != 1 or len(c) != n for c in cols.values()):
+        raise ValueError("kept-pass columns differ in length")
+    if n and (cols["class_idx"].min() < 0 or cols["class_idx"].max() >= len(est.tables.classes)
+              or cols["friction"].min() < 1 or cols["friction"].max() > 4 or not np.all(np.isfinite(cols["speed"]))):
+        raise ValueError("kept passes hold an unknown class, friction state or speed")
+    counts = {key: int(meta[key]) for key in _COUNTS}
+    if any(v < 0 for v in counts.values()):
+        raise ValueError("negative counts")
+    return {"log_components": log_components, "survey_log_amplitude": survey, "grinding_amplitude": grinding,
+            **counts, "newest_train_id": str(meta.get("newest_train_id", "")), "kept": KeptPasses(**cols),
+            "_k_b": k_b}
 
 
 def resume(est: CorrugationEstimator, path: str | Path) -> tuple[Path | None, list[str]]:

@@ -217,7 +217,10 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False) -> It
     """
     if flow_control:
         use_flow_control_profile()
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except Exception as exc:  # rcl refuses unreadable params files and malformed -p values at init
+        raise ConfigError(f"cannot start: {(str(exc).strip().splitlines() or [type(exc).__name__])[-1]}") from None
     stop = threading.Event()
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
