@@ -51,6 +51,8 @@ _T0 = 1_790_000_000  # stamps of a stream start here [s], shifted past the previ
 
 # -- what the generator produces: a message's fields and the set of fields it broke ------------
 text = st.characters(blacklist_categories=("Cs",), blacklist_characters="\x00")  # DDS strings stop at NUL
+# A valid train id has no control characters and no line or paragraph separators (a rejection rule).
+id_text = st.characters(blacklist_categories=("Cs", "Cc", "Zl", "Zp"))
 nan_inf = st.sampled_from([math.nan, math.inf, -math.inf])
 huge = st.floats(min_value=1e6, max_value=1e308)
 
@@ -59,7 +61,7 @@ def _valid() -> st.SearchStrategy[dict[str, Any]]:
     counts = st.tuples(st.integers(0, 60), st.integers(0, 240)).filter(lambda c: c != (0, 0))
     return st.fixed_dictionaries({
         "sec": st.integers(1_600_000_000, 1_900_000_000), "nanosec": st.integers(0, 999_999_999),
-        "train_id": st.text(text, min_size=1, max_size=64).filter(str.strip),
+        "train_id": st.text(id_text, min_size=1, max_size=64).filter(str.strip),
         "vehicle_class": st.sampled_from(CLASSES), "counts": counts,
         "speed_mps": st.floats(1.0, 120.0),
         "angle_of_attack_rad": st.floats(-0.1, 0.1),
@@ -74,7 +76,9 @@ BREAK: dict[str, st.SearchStrategy[dict[str, Any]]] = {
     "stamp": st.one_of(st.just({"sec": 0, "nanosec": 0}),
                        st.builds(lambda s: {"sec": s}, st.integers(-2**31, -1))),
     "train_id": st.builds(lambda s: {"train_id": s}, st.one_of(
-        st.just(""), st.text(" \t\r\n\u00a0\u3000", min_size=1, max_size=8), st.text(text, min_size=65, max_size=100))),
+        st.just(""), st.text(" \t\r\n\u00a0\u3000", min_size=1, max_size=8), st.text(text, min_size=65, max_size=100),
+        st.builds(lambda a, c: a + c, st.text(id_text, min_size=1, max_size=8),
+                  st.sampled_from(["\x1b[2J", "\x07", "\u2028", "\x7f", "\x85"])))),
     "vehicle_class": st.builds(lambda s: {"vehicle_class": s},
                                st.text(text, max_size=80).filter(lambda s: s not in CLASSES)),
     "counts": st.builds(lambda c: {"counts": c}, st.one_of(

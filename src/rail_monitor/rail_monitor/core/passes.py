@@ -7,6 +7,7 @@ defaults. Field names, units and enumeration values mirror ``rail_msgs/msg/Train
 
 from __future__ import annotations
 
+import unicodedata
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
@@ -115,6 +116,12 @@ class PassTable:
         )
 
 
+def _has_control(text: str) -> bool:
+    """Whether text holds a control character (NUL, ESC, DEL, C1: a C string or a terminal would act
+    on it) or a line or paragraph separator."""
+    return any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text)
+
+
 def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     """Why each pass is unusable: an array of strings, '' where the pass is valid.
 
@@ -133,9 +140,9 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     flag(table.stamp_ns >= TIME_MSG_END_NS, "stamp past 2038-01-19 (builtin_interfaces/Time seconds are int32)")
     flag(stripped == "", "empty train_id")
     flag(np.array([len(s) > 64 for s in table.train_id], dtype=bool), "train_id longer than 64 characters")
-    flag(np.array([not s.isprintable() for s in table.train_id], dtype=bool),
+    flag(np.array([_has_control(s) for s in table.train_id], dtype=bool),
          "train_id has control or separator characters")
-    flag(np.array([not s.isprintable() for s in table.vehicle_class], dtype=bool),
+    flag(np.array([_has_control(s) for s in table.vehicle_class], dtype=bool),
          "vehicle_class has control or separator characters")
     flag(~np.isfinite(table.speed_mps), "speed_mps not finite")
     flag(table.speed_mps <= 0.0, "speed_mps not positive")
