@@ -88,6 +88,15 @@ def _records(data: bytes, start: int, scan: Scan) -> Iterator[tuple[int, bytes, 
     scan.cut_off = True
 
 
+def _per_topic(stats: Statistics, channel_ids: dict[str, set[int]]) -> dict[str, int]:
+    """A Statistics record's message counts per topic (and its total, where that disagrees)."""
+    by_channel = stats.channel_message_counts
+    out = {topic: sum(by_channel.get(i, 0) for i in ids) for topic, ids in channel_ids.items()}
+    if sum(by_channel.values()) != stats.message_count:  # the record disagrees with itself
+        out["(all topics)"] = stats.message_count
+    return {t: n for t, n in out.items() if n}
+
+
 def scan_mcap(path: str | Path, keep: bool = False) -> tuple[Scan, list[ScannedMessage]]:
     """Read an MCAP file in file order: the counts of what its intact records hold and, with keep,
     the messages themselves (log-time order is the caller's to impose)."""
@@ -148,11 +157,7 @@ def scan_mcap(path: str | Path, keep: bool = False) -> tuple[Scan, list[ScannedM
     if footer_at is None:
         scan.cut_off = True
     if stats_record is not None:
-        by_channel = stats_record.channel_message_counts
-        stats = {topic: sum(by_channel.get(i, 0) for i in ids) for topic, ids in channel_ids.items()}
-        if sum(by_channel.values()) != stats_record.message_count:  # the record disagrees with itself
-            stats["(all topics)"] = stats_record.message_count
-        scan.statistics = {t: n for t, n in stats.items() if n}
+        scan.statistics = _per_topic(stats_record, channel_ids)
     return scan, kept
 
 

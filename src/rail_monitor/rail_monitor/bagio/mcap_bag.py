@@ -36,6 +36,20 @@ def mark_output(folder: Path) -> None:
     (folder / MARKER).write_text("created by rail_monitor; --overwrite may replace this folder\n", encoding="utf-8")
 
 
+def new_output_folder(folder: Path) -> Path:
+    """Create (or take, if empty) an output folder and mark it; RailMonitorError for anything else."""
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        raise RailMonitorError(f"{folder}: output exists and is not a folder (a file or a link)")
+    if folder.exists() and any(folder.iterdir()):
+        raise RailMonitorError(f"{folder}: output folder exists and is not empty")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        mark_output(folder)
+    except OSError as exc:
+        raise RailMonitorError(f"{folder}: cannot create the output folder: {exc.strerror}") from None
+    return folder
+
+
 def _dump(obj: Any) -> str:
     return yaml.safe_dump(obj, sort_keys=False, default_flow_style=False)
 
@@ -72,18 +86,9 @@ class McapBagWriter:
     def __init__(self, folder: str | Path, *, compression: str = "zstd", chunk_size: int = 1 << 20,
                  max_file_bytes: int = 0, max_file_duration_ns: int = 0, flush_period_ns: int = 0,
                  flush_wall_period_s: float = 0.0) -> None:
-        self.folder = Path(folder)
-        if self.folder.is_symlink() or (self.folder.exists() and not self.folder.is_dir()):
-            raise RailMonitorError(f"{self.folder}: output exists and is not a folder (a file or a link)")
-        if self.folder.exists() and any(self.folder.iterdir()):
-            raise RailMonitorError(f"{self.folder}: output folder exists and is not empty")
         if compression not in ("zstd", "none"):
             raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
-        try:
-            self.folder.mkdir(parents=True, exist_ok=True)
-            mark_output(self.folder)
-        except OSError as exc:
-            raise RailMonitorError(f"{self.folder}: cannot create the output folder: {exc.strerror}") from None
+        self.folder = new_output_folder(Path(folder))
         self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
         self._chunk_size = chunk_size
         self._max_bytes = max_file_bytes
