@@ -68,7 +68,7 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     """
     site = site_from_values(values)
     # What the replayer can publish: a stamp builtin_interfaces/Time cannot hold is left out, counted.
-    fits = np.array([fits_time_msg(s) for s in passes.stamp_ns.tolist()], bool)
+    fits = fits_time_msg(passes.stamp_ns)
     table = passes.take(fits).sorted()
     reasons = rejection_reasons(table, site)
     accepted = with_class_defaults(table.take(reasons == ""), site)

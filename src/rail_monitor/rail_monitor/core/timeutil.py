@@ -36,9 +36,10 @@ def checked_ns(ns: int) -> int:
     return ns
 
 
-def fits_time_msg(ns: int) -> bool:
-    """Whether builtin_interfaces/Time (int32 seconds) can hold ns since the epoch."""
-    return -TIME_MSG_END_NS <= ns < TIME_MSG_END_NS
+def fits_time_msg(ns):
+    """Whether builtin_interfaces/Time (int32 seconds) can hold ns since the epoch (an int, or an
+    int64 array, element by element)."""
+    return (ns >= -TIME_MSG_END_NS) & (ns < TIME_MSG_END_NS)
 
 
 def format_iso_ns(ns: int) -> str:

@@ -10,7 +10,6 @@ import threading
 import time
 from collections.abc import Callable
 
-import numpy as np
 import rclpy
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -57,7 +56,7 @@ class PassSourceNode(Node):
     def _window(self, table: PassTable) -> PassTable:
         """The passes to publish: in time order, inside the offsets, and representable as a
         TrainPass (a stamp builtin_interfaces/Time cannot hold is left out and counted)."""
-        fits = np.array([fits_time_msg(s) for s in table.stamp_ns.tolist()], bool)
+        fits = fits_time_msg(table.stamp_ns)
         self.unpublishable = int((~fits).sum())
         if self.unpublishable:
             self.get_logger().warning(f"{self.unpublishable} pass(es) left out: their stamps do not fit "
