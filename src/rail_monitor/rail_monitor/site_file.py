@@ -37,7 +37,7 @@ from rail_monitor.squeal.config import SQUEAL_SPECS
 SECTIONS: tuple[tuple[str, tuple[ParamSpec, ...]], ...] = (
     ("", SITE_SPECS), ("contact.", CONTACT_SPECS), ("track.", TRACK_SPECS),
     ("corrugation.", CORRUGATION_SPECS), ("squeal.", SQUEAL_SPECS), ("noise.", NOISE_SPECS),
-    ("alerts.", ALERT_SPECS), ("", SIMULATOR_SPECS),
+    ("alerts.", ALERT_SPECS), ("stamps.", node_params.STAMP_SPECS), ("", SIMULATOR_SPECS),
     *(("", specs) for specs in (node_params.PUBLISH_SPECS, node_params.REPLAYER_SPECS, node_params.MODE_SPECS,
                                 node_params.RECORDER_SPECS, node_params.MONITOR_SPECS, node_params.BATCH_SPECS,
                                 node_params.ESTIMATOR_SPECS, node_params.PREDICTOR_SPECS)),

@@ -23,9 +23,10 @@ from rail_monitor.bagio import messages as fields
 from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.topics import GRAPH_TOPICS
-from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.node_params import STAMP_SPECS, StampParams
+from rail_monitor.core.params import resolve, section, values_of
+from rail_monitor.core.passes import PassTable, publishable, reject_ahead, rejection_reasons, with_class_defaults
 from rail_monitor.core.site import Site, site_from_values
-from rail_monitor.core.timeutil import fits_time_msg
 from rail_monitor.corrugation.advice import advise_or_none
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
@@ -57,7 +58,7 @@ class BatchResult:
     advice: Advice | None
     estimator: CorrugationEstimator   # the final state
     receiver: Any
-    left_out: int = 0                 # passes whose stamps builtin_interfaces/Time cannot hold
+    left_out: dict[str, int]          # passes the replayer would not send, by reason
 
 
 def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None
@@ -67,12 +68,12 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     estimator: a state to continue from (e.g. a checkpoint); default the post-grinding state.
     """
     site = site_from_values(values)
-    # What the replayer can publish: a stamp builtin_interfaces/Time cannot hold is left out, counted.
-    fits = fits_time_msg(passes.stamp_ns)
-    table = passes.take(fits).sorted()
+    margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
+    table, left_out = publishable(passes, margins)  # what the replayer sends
     reasons = rejection_reasons(table, site)
-    accepted = with_class_defaults(table.take(reasons == ""), site)
     est = estimator or CorrugationEstimator(site, corrugation_config(values))
+    reject_ahead(table.stamp_ns, reasons, est.newest_ns, margins)  # as every node of the graph does
+    accepted = with_class_defaults(table.take(reasons == ""), site)
     squeal = predict_squeal(squeal_config(values), site, accepted)
     traj = _history(est, accepted)
     state_of_pass = state_index(traj.stamp_ns, traj.train_id.tolist(), accepted.stamp_ns, accepted.train_id.tolist())
@@ -82,7 +83,7 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     events = _feed_alerts(alerts, table, reasons, accepted, squeal, traj, noise)
     return BatchResult(site, table, reasons, accepted, squeal, traj, state_of_pass, noise, events,
                        sorted(alerts.standing.values(), key=_alert_key), advise_or_none(est), est, model.receiver,
-                       int((~fits).sum()))
+                       left_out)
 
 
 def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:

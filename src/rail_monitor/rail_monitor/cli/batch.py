@@ -39,8 +39,8 @@ def run(ns: argparse.Namespace) -> int:
     result = run_models(passes, values)
     t_models = time.monotonic() - t0
     write_bag(result, out, ns.namespace if ns.namespace is not None else str(values.get("site_id", "")))
-    if result.left_out:
-        print(f"batch: {result.left_out} pass(es) left out: their stamps do not fit builtin_interfaces/Time")
+    for why, n in result.left_out.items():
+        print(f"batch: {n} pass(es) left out: {why}")
     print(f"batch: {len(passes)} passes through the models in {t_models:.2f} s "
           f"({len(passes) / max(t_models, 1e-9):.0f} passes/s); recorded to {out} in "
           f"{time.monotonic() - t0 - t_models:.1f} s")

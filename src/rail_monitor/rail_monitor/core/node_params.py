@@ -106,6 +106,17 @@ PREDICTOR_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
+# Every pass source and consumer, and batch: how far a pass may lie ahead. A pass past the margin
+# is rejected (a source leaves it out) and moves no state: one wrong stamp (a detector clock in
+# 2038) must not freeze the corrugation history, whose passes must come in time order.
+STAMP_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("max_ahead_of_stream_s", 366 * 86_400.0, "Reject a pass stamped more than this after the newest "
+              "pass taken before it (a longer outage needs a larger value) [s].", 1.0, 1.0e10),
+    ParamSpec("max_ahead_of_clock_s", 86_400.0, "Without use_sim_time: reject a pass stamped more than this after "
+              "the node's clock [s].", 1.0, 1.0e10),
+)
+
+
 # Their checked values, by attribute (rail_monitor.core.params.values_type).
 PublishParams = values_type("PublishParams", PUBLISH_SPECS, "A pass source's publishing parameters.", __name__)
 ReplayerParams = values_type("ReplayerParams", REPLAYER_SPECS, "pass_replayer's history parameters.", __name__)
@@ -113,5 +124,6 @@ ModeParams = values_type("ModeParams", MODE_SPECS, "pass_simulator's mode parame
 RecorderParams = values_type("RecorderParams", RECORDER_SPECS, "mcap_recorder's parameters.", __name__)
 MonitorParams = values_type("MonitorParams", (*MONITOR_SPECS, SOURCE), "wayside_monitor's process parameters.",
                             __name__)
+StampParams = values_type("StampParams", STAMP_SPECS, "The stamp plausibility margins.", __name__)
 EstimatorParams = values_type("EstimatorParams", ESTIMATOR_SPECS, "corrugation_estimator's own parameters.",
                               __name__)

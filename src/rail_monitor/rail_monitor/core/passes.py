@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from rail_monitor.core.site import Site
-from rail_monitor.core.timeutil import TIME_MSG_END_NS
+from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, fits_time_msg
 
 # TrainPass.FRICTION_* values and their names in CSV files and site parameters.
 FRICTION_UNSET, FRICTION_DRY, FRICTION_WET, FRICTION_MODIFIER, FRICTION_CONTAMINATED = range(5)
@@ -176,6 +176,71 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
         flag(implied > MAX_TRAIN_LENGTH_M,
              f"train length from vehicle_count and the class's vehicle length above {MAX_TRAIN_LENGTH_M:g} m")
     return reasons
+
+
+def ahead_of_stream(stamp_ns: np.ndarray, usable: np.ndarray, newest_ns: int, margin_ns: int
+                    ) -> tuple[np.ndarray, int]:
+    """Which passes are stamped more than margin_ns [ns] after the newest pass taken before them.
+
+    Passes are taken in the order given; a pass is taken when it is usable (valid otherwise) and
+    not ahead. The reference starts at newest_ns (0: none yet, so the first usable pass sets it)
+    and only a taken pass moves it: one far-future stamp is rejected, and every pass after it
+    is judged against the real stream, not against that stamp. Returns (ahead mask, newest taken).
+    """
+    t = np.asarray(stamp_ns, dtype=np.int64)
+    usable = np.asarray(usable, dtype=bool)
+    ahead = np.zeros(len(t), dtype=bool)
+    if not usable.any():
+        return ahead, int(newest_ns)
+    # Fast path (no pass ahead): the reference of pass i is the newest usable pass before it.
+    before = np.maximum.accumulate(np.concatenate(([newest_ns], np.where(usable, t, 0))))[:-1]
+    first = np.flatnonzero(usable & (before > 0) & (t - before > margin_ns))
+    if len(first) == 0:
+        return ahead, int(max(newest_ns, t[usable].max()))
+    k = int(first[0])
+    newest = int(before[k])
+    for i in range(k, len(t)):  # a pass ahead leaves the reference where it was: judge the rest one by one
+        if not usable[i]:
+            continue
+        if t[i] - newest > margin_ns:
+            ahead[i] = True
+        else:
+            newest = max(newest, int(t[i]))
+    return ahead, newest
+
+
+def ahead_reason(margin_s: float, of: str) -> str:
+    """The rejection reason of a pass stamped more than margin_s [s] after the stream or the clock."""
+    return f"stamp more than {margin_s:g} s ahead of the {of} (stamps.max_ahead_of_{of}_s)"
+
+
+def reject_ahead(stamp_ns: np.ndarray, reasons: np.ndarray, newest_ns: int, margins: Any,
+                 clock_ns: int | None = None) -> int:
+    """Mark, in ``reasons`` (in place), the otherwise valid passes stamped too far ahead: of the
+    clock (when clock_ns is given: a live node not on sim time) by ``margins.max_ahead_of_clock_s``,
+    then of the stream by ``margins.max_ahead_of_stream_s`` (:func:`ahead_of_stream`).
+
+    margins: a :class:`rail_monitor.core.node_params.StampParams`. Returns the newest pass taken.
+    """
+    t = np.asarray(stamp_ns, dtype=np.int64)
+    if clock_ns is not None and clock_ns > 0:
+        late = (reasons == "") & (t - clock_ns > int(margins.max_ahead_of_clock_s * NS_PER_S))
+        reasons[late] = ahead_reason(margins.max_ahead_of_clock_s, "clock")
+    ahead, newest = ahead_of_stream(t, reasons == "", newest_ns, int(margins.max_ahead_of_stream_s * NS_PER_S))
+    reasons[ahead] = ahead_reason(margins.max_ahead_of_stream_s, "stream")
+    return newest
+
+
+def publishable(table: PassTable, margins: Any) -> tuple[PassTable, dict[str, int]]:
+    """What a pass source sends, in time order, and how many it leaves out, by reason: a stamp
+    builtin_interfaces/Time cannot hold, or one too far ahead of the stream (margins as in
+    :func:`reject_ahead`; a replay at recorded timing would otherwise wait for it for years)."""
+    fits = fits_time_msg(table.stamp_ns)
+    table = table.take(fits).sorted()
+    ahead, _ = ahead_of_stream(table.stamp_ns, table.stamp_ns > 0, 0, int(margins.max_ahead_of_stream_s * NS_PER_S))
+    left_out = {"stamp not representable (builtin_interfaces/Time seconds are int32)": int((~fits).sum()),
+                ahead_reason(margins.max_ahead_of_stream_s, "stream"): int(ahead.sum())}
+    return table.take(~ahead), {why: n for why, n in left_out.items() if n}
 
 
 def with_class_defaults(table: PassTable, site: Site) -> PassTable:

@@ -53,6 +53,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
                 self.get_logger().error(f"checkpoint skipped: {why}")
             if used is not None:
                 self.get_logger().info(f"resumed from {used}: {self.est.total_pass_count} passes")
+        self.stream_ns = self.est.newest_ns  # the stamp margin counts from the resumed history
         self._since_checkpoint = 0
         self._last_state_t = float("-inf")
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)

@@ -20,8 +20,9 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from rclpy.node import Node
 
 from rail_monitor.bagio.messages import pass_row, time_ns
-from rail_monitor.core.node_params import BATCH_SPECS
-from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.node_params import BATCH_SPECS, STAMP_SPECS, StampParams
+from rail_monitor.core.params import values_of
+from rail_monitor.core.passes import PassTable, reject_ahead, rejection_reasons, with_class_defaults
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.nodes.base import (
     Diagnostics,
@@ -49,6 +50,8 @@ class PassConsumerNode(Node):
         self.rejected: Counter[str] = Counter()
         self.model_errors: Counter[str] = Counter()  # accepted passes a model raised on (a bug: ERROR)
         self.last_pass_ns = 0
+        self.margins = values_of(StampParams, declare(self, STAMP_SPECS, prefix="stamps."))
+        self.stream_ns = 0  # newest pass taken: the reference of the stamp margin (a resumed state sets it)
         self.max_batch = declare(self, BATCH_SPECS)["max_batch"]
         subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, self.max_batch)
         Diagnostics(self, self.diagnostic_values, level=self._level)
@@ -69,7 +72,11 @@ class PassConsumerNode(Node):
     def _handle(self, msgs: list[TrainPass]) -> None:
         """Rejections and runs of accepted passes, in message order."""
         table = PassTable.from_rows([pass_row(m) for m in msgs])
-        reasons = rejection_reasons(table, self.site).tolist()
+        reasons = rejection_reasons(table, self.site)
+        live = not self.get_parameter("use_sim_time").value
+        clock = self.get_clock().now().nanoseconds if live else None
+        self.stream_ns = reject_ahead(table.stamp_ns, reasons, self.stream_ns, self.margins, clock)
+        reasons = reasons.tolist()
         self.on_validated(table, reasons)
         for run in runs(reasons, lambda a, b: not a and not b):
             why = reasons[run.start]

@@ -18,10 +18,10 @@ from tqdm import tqdm
 
 from rail_monitor.bagio.messages import train_pass_fields
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.node_params import PUBLISH_SPECS, PublishParams
+from rail_monitor.core.node_params import PUBLISH_SPECS, STAMP_SPECS, PublishParams, StampParams
 from rail_monitor.core.params import values_of
-from rail_monitor.core.passes import PassTable
-from rail_monitor.core.timeutil import NS_PER_S, fits_time_msg
+from rail_monitor.core.passes import PassTable, publishable
+from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, refuse_unknown_parameters
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.qos import CLOCK_QOS, STREAM_QOS
@@ -35,6 +35,7 @@ class PassSourceNode(Node):
         super().__init__(name, **kwargs)
         refuse_unknown_parameters(self)
         self.cfg = values_of(PublishParams, declare(self, PUBLISH_SPECS))
+        self.margins = values_of(StampParams, declare(self, STAMP_SPECS, prefix="stamps."))
         self.pub = self.create_publisher(TrainPass, "train_pass", STREAM_QOS)
         self.clock_pub = self.create_publisher(Clock, "/clock", CLOCK_QOS) if self.cfg.publish_clock else None
         self.meter = RateMeter()
@@ -43,9 +44,10 @@ class PassSourceNode(Node):
         self.done = threading.Event()
         # Passes taken by the slowest subscriber hosted in this process (set by wayside_monitor).
         self.consumed: Callable[[], int] | None = None
-        self.unpublishable = 0
+        self.left_out: dict[str, int] = {}
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
-                                   "left out (stamp not representable)": self.unpublishable,
+                                   "left out": sum(self.left_out.values()),
+                                   **{f"left out: {why}": n for why, n in self.left_out.items()},
                                    "rate_per_s": f"{self.meter.rate():.1f}",
                                    "pass_time_ns": self.last_stamp_ns, "done": self.done.is_set()})
 
@@ -54,14 +56,11 @@ class PassSourceNode(Node):
         raise NotImplementedError
 
     def _window(self, table: PassTable) -> PassTable:
-        """The passes to publish: in time order, inside the offsets, and representable as a
-        TrainPass (a stamp builtin_interfaces/Time cannot hold is left out and counted)."""
-        fits = fits_time_msg(table.stamp_ns)
-        self.unpublishable = int((~fits).sum())
-        if self.unpublishable:
-            self.get_logger().warning(f"{self.unpublishable} pass(es) left out: their stamps do not fit "
-                                      "builtin_interfaces/Time (int32 seconds)")
-        table = table.take(fits).sorted()
+        """The passes to publish: in time order, inside the offsets, publishable
+        (:func:`rail_monitor.core.passes.publishable`: the others are left out and counted)."""
+        table, self.left_out = publishable(table, self.margins)
+        for why, n in self.left_out.items():
+            self.get_logger().warning(f"{n} pass(es) left out: {why}")
         if len(table) == 0:
             return table
         t0 = int(table.stamp_ns[0])
