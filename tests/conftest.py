@@ -77,14 +77,21 @@ def spinning(ctx, *nodes) -> Iterator[object]:
     """Spin nodes on a SingleThreadedExecutor in a background thread; shut it down on exit."""
     from rclpy.executors import SingleThreadedExecutor
 
+    from rail_monitor.nodes.base import spin_guarded
+
     ex = SingleThreadedExecutor(context=ctx)
     for node in nodes:
         ex.add_node(node)
-    threading.Thread(target=ex.spin, daemon=True).start()
+    done = threading.Event()
+    # As every executable spins: one callback's exception is counted and the executor goes on.
+    spinner = threading.Thread(target=spin_guarded, args=(ex, lambda: not done.is_set()), daemon=True)
+    spinner.start()
     try:
         yield ex
     finally:
+        done.set()
         ex.shutdown(timeout_sec=2)
+        spinner.join(timeout=5)
 
 
 def wait_until(condition, timeout_s: float = 10.0, period_s: float = 0.01) -> bool:

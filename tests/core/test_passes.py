@@ -105,7 +105,7 @@ def test_the_clock_margin_applies_only_with_a_clock():
     margins = StampParams(max_ahead_of_stream_s=366 * 86_400.0, max_ahead_of_clock_s=86_400.0)
     reasons = np.full(2, "", dtype=object)
     reject_ahead(stamps, reasons, 0, margins, clock_ns=now)
-    assert reasons.tolist() == ["", "stamp more than 86400 s ahead of the clock (stamps.max_ahead_of_clock_s)"]
+    assert reasons.tolist() == ["", "stamp more than 1 d ahead of the clock (stamps.max_ahead_of_clock_s)"]
     reasons = np.full(2, "", dtype=object)
     reject_ahead(stamps, reasons, 0, margins)           # sim time / batch: the stream only
     assert reasons.tolist() == ["", ""]

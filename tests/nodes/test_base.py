@@ -45,12 +45,33 @@ def test_isolate_failures_runs_the_rest_when_one_item_fails():
     assert done == [0, 1]
 
 
-@pytest.mark.parametrize("args", [["--params-file", "/no/such/site.yaml"], ["-p", "rate:="]])
-def test_a_params_file_or_value_rcl_refuses_is_one_line_and_exit_2(args):
+@pytest.mark.parametrize(("args", "start"), [(["--params-file", "/no/such/site.yaml"], "error: /no/such/site.yaml: "),
+                                             (["-p", "rate:="], "error: cannot start:")])
+def test_a_params_file_or_value_rcl_refuses_is_one_line_and_exit_2(args, start):
     r = run_cmd("pass_replayer", "--ros-args", *args, "-p", "source:=bags/sample", timeout=60)
     assert r.returncode == 2, r.stderr[-2000:]
     lines = [line for line in r.stderr.splitlines() if line.strip() and not line.startswith("[")]
-    assert len(lines) == 1 and lines[0].startswith("error: cannot start:") and "Traceback" not in r.stderr
+    assert len(lines) == 1 and lines[0].startswith(start) and "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize(("section", "value", "says"), [
+    ("/**", '"fast"', "parameter 'rate' must be float, got str 'fast'"),
+    ("/**/pass_replayer", "10", "parameter 'rate' must be a double: write 10 with a decimal point"),
+    ("/**", "-1.0", "parameter 'rate' = -1.0 is outside its range"),
+    ("/**", "{max_ahead_of_stream_s: true}", "parameter 'stamps.max_ahead_of_stream_s' must be float")])
+def test_a_later_params_file_of_the_wrong_type_is_refused_like_the_first(tmp_path, section, value, says):
+    # rcl keeps the first file's value when a later one's type differs, without a word: each
+    # file is checked on its own, and the later one is refused naming it and the parameter.
+    first = tmp_path / "first.yaml"
+    first.write_text("/**:\n  ros__parameters:\n    rate: 5.0\n")
+    later = tmp_path / "later.yaml"
+    name = "stamps" if "stamps" in says else "rate"
+    later.write_text(f"{section}:\n  ros__parameters:\n    {name}: {value}\n")
+    r = run_cmd("pass_replayer", "--ros-args", "--params-file", str(first), "--params-file", str(later),
+                "-p", "source:=bags/sample", timeout=60)
+    assert r.returncode == 2, r.stderr[-2000:]
+    lines = [line for line in r.stderr.splitlines() if line.strip() and not line.startswith("[")]
+    assert len(lines) == 1 and str(later) in lines[0] and says in lines[0], lines
 
 
 def test_a_recorder_output_that_is_a_file_or_a_dangling_link_is_one_line(tmp_path):

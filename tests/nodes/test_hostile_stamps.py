@@ -132,7 +132,7 @@ def test_one_pass_in_2037_does_not_freeze_the_corrugation_state(ros_context, sit
     t0 = 1_760_000_000  # 2025-10-09, in the past of any clock this runs on
     stamps = [t0 + 600 * k for k in range(6)]
     ids = [f"T{k}" for k in range(6)]
-    table = _stream(site, stamps[:3] + [2_130_000_000] + stamps[3:], ids[:3] + ["Y2037"] + ids[3:])
+    table = _stream(site, [*stamps[:3], 2_130_000_000, *stamps[3:]], [*ids[:3], "Y2037", *ids[3:]])
     ckpt = tmp_path / "state.npz"
     node = _estimator(ros_context, site_values, use_sim_time=True, checkpoint_path=str(ckpt))
     _send(ros_context, node, table)

@@ -46,15 +46,22 @@ SECTIONS: tuple[tuple[str, tuple[ParamSpec, ...]], ...] = (
 ROS_PARAMETERS = ("use_sim_time", "start_type_description_service")
 
 
-def known_names(values: Mapping[str, Any]) -> set[str]:
-    """Every parameter name a site file with these values may hold. Vehicle sections are those of
-    its ``vehicle_classes`` (the default's without it); where that is not a list of names (an error
-    its own check reports), every ``vehicle.<class>.`` section present is taken as a class."""
-    names = {prefix + s.name for prefix, specs in SECTIONS for s in specs} | set(ROS_PARAMETERS)
+def known_specs(values: Mapping[str, Any]) -> dict[str, ParamSpec]:
+    """The spec of every parameter a site file with these values may hold, by full name. Vehicle
+    sections are those of its ``vehicle_classes`` (the default's without it); where that is not a
+    list of names (an error its own check reports), every ``vehicle.<class>.`` section present is
+    taken as a class."""
+    specs = {prefix + s.name: s for prefix, section in SECTIONS for s in section}
     classes = values.get(VEHICLE_CLASSES.name, VEHICLE_CLASSES.default)
     if not (isinstance(classes, list) and all(isinstance(c, str) for c in classes)):
         classes = {k.split(".")[1] for k in values if k.startswith("vehicle.") and k.count(".") >= 2}
-    return names | {f"vehicle.{c}.{s.name}" for c in classes for s in VEHICLE_SPECS}
+    specs.update({f"vehicle.{c}.{s.name}": s for c in classes for s in VEHICLE_SPECS})
+    return specs
+
+
+def known_names(values: Mapping[str, Any]) -> set[str]:
+    """Every parameter name a site file with these values may hold (see :func:`known_specs`)."""
+    return set(known_specs(values)) | set(ROS_PARAMETERS)
 
 
 def check_names(values: Mapping[str, Any], where: str = "") -> None:
@@ -66,22 +73,54 @@ def check_names(values: Mapping[str, Any], where: str = "") -> None:
         raise ConfigError(f"{where}{exc}") from None
 
 
-def load_parameter_file(path: str | Path) -> dict[str, Any]:
-    """Read a ROS 2 parameter file into flat dotted names (the ``/**`` section, else the first),
-    every name checked (ConfigError naming the file and the parameter)."""
-    path = Path(path)
+def _read_document(path: Path) -> Mapping[str, Any]:
     try:
         doc = yaml.safe_load(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
         raise ConfigError(f"{path}: cannot read parameter file: {str(exc).splitlines()[0]}") from None
     if not isinstance(doc, Mapping) or not doc:
         raise ConfigError(f"{path}: not a ROS 2 parameter file (expected '/**: ros__parameters: ...')")
-    section = doc.get("/**", next(iter(doc.values())))
+    return doc
+
+
+def _parameters(path: Path, section: Any) -> dict[str, Any]:
     if not isinstance(section, Mapping) or not isinstance(section.get("ros__parameters"), Mapping):
         raise ConfigError(f"{path}: no 'ros__parameters' mapping")
-    values = flatten(section["ros__parameters"])
+    return flatten(section["ros__parameters"])
+
+
+def load_parameter_file(path: str | Path) -> dict[str, Any]:
+    """Read a ROS 2 parameter file into flat dotted names (the ``/**`` section, else the first),
+    every name checked (ConfigError naming the file and the parameter)."""
+    path = Path(path)
+    doc = _read_document(path)
+    values = _parameters(path, doc.get("/**", next(iter(doc.values()))))
     check_names(values, f"{path}: ")
     return values
+
+
+def check_parameter_file(path: str | Path) -> None:
+    """ConfigError for the first parameter of any section of a ROS 2 parameter file that its spec
+    refuses: an unknown name, a wrong type (a YAML integer for a double, as rcl reads it), a value
+    out of range. rcl merges the files given to a node and drops, without a word, a later file's
+    value whose type differs from an earlier one's: each file is checked on its own first."""
+    path = Path(path)
+    for node, section in _read_document(path).items():
+        values = _parameters(path, section)
+        where = f"{path}: section '{node}': "
+        check_names(values, where)
+        specs = known_specs(values)
+        for name, value in values.items():
+            spec = specs.get(name)
+            if spec is None:  # rclpy's own (use_sim_time, qos_overrides.*)
+                continue
+            items = value if isinstance(value, list) else [value]
+            if spec.kind is float and any(isinstance(v, int) and not isinstance(v, bool) for v in items):
+                raise ConfigError(f"{where}parameter '{name}' must be a double: write {value!r} with a decimal point")
+            try:
+                spec.check(value, name[:-len(spec.name)])
+            except ConfigError as exc:
+                raise ConfigError(f"{where}{exc}") from None
 
 
 def load_site(path: str | Path) -> Site:

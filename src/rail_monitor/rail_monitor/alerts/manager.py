@@ -25,6 +25,7 @@ from rail_monitor.alerts.config import (
     AlertConfig,
 )
 from rail_monitor.alerts.windows import Window, hysteresis_changes
+from rail_monitor.core.text import printable
 from rail_monitor.core.timeutil import format_iso_ns
 
 
@@ -228,4 +229,4 @@ class AlertManager:
 def describe(alert: Alert) -> str:
     """One line for people: pass time, raised/cleared, kind, summary."""
     verb = "raised " if alert.active else "cleared"
-    return f"{format_iso_ns(alert.stamp_ns)}  {verb}  {KIND_NAMES[alert.kind]:17s} {alert.summary}"
+    return f"{format_iso_ns(alert.stamp_ns)}  {verb}  {KIND_NAMES[alert.kind]:17s} {printable(alert.summary)}"

@@ -24,6 +24,7 @@ from rail_monitor.bagio.reader import read_messages
 from rail_monitor.core.errors import InputError
 from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons
 from rail_monitor.core.site import site_from_values
+from rail_monitor.core.text import printable
 from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns
 
 _TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory")
@@ -203,18 +204,23 @@ def _squeal_curves(run: RunData, values: Mapping[str, Any]) -> dict[str, Any]:
     return curves
 
 
+def _text(value: object) -> str:
+    """Text from a bag as HTML: control characters escaped, then markup."""
+    return html.escape(printable(value))
+
+
 def _html(run: RunData, summary: list[str], files: list[Path], site_id: str) -> str:
     imgs = "\n".join(f'<figure><img src="{f.name}" alt="{f.stem}"><figcaption>{f.stem}</figcaption></figure>'
                      for f in files)
     rows = "\n".join(f"<tr><td>{format_iso_ns(a.stamp_ns)}</td><td>{'raised' if a.active else 'cleared'}</td>"
-                     f"<td>{KIND_NAMES[a.kind]}</td><td>{html.escape(a.key)}</td><td>{html.escape(a.summary)}</td></tr>"
+                     f"<td>{KIND_NAMES[a.kind]}</td><td>{_text(a.key)}</td><td>{_text(a.summary)}</td></tr>"
                      for a in run.alerts)
     return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>rail_monitor report: {html.escape(site_id)}</title>
+<html lang="en"><head><meta charset="utf-8"><title>rail_monitor report: {_text(site_id)}</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}} img{{max-width:100%}}
 table{{border-collapse:collapse}} td{{border:1px solid #ccc;padding:2px 6px;font-size:90%}}</style></head>
-<body><h1>rail_monitor report: {html.escape(site_id)}</h1>
-<p>From {html.escape(str(run.bag))}.</p>
+<body><h1>rail_monitor report: {_text(site_id)}</h1>
+<p>From {_text(run.bag)}.</p>
 <pre>{html.escape(chr(10).join(summary))}</pre>
 {imgs}
 <h2>Alerts</h2><table><tr><th>pass time</th><th></th><th>kind</th><th>key</th><th>summary</th></tr>

@@ -15,13 +15,15 @@ from typing import Any
 
 import numpy as np
 
+from rail_monitor.alerts.config import NOISE_METRICS
 from rail_monitor.alerts.manager import Alert
-from rail_monitor.core.timeutil import from_sec_nanosec, to_sec_nanosec
+from rail_monitor.core.timeutil import TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Advice, Forecast, StateSnapshot
+from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.predict import Corrugation, NoisePrediction
+from rail_monitor.squeal.config import RISK_HIGH
 
 Fields = dict[str, Any]
-INT32_END_NS = 2**31 * 10**9  # builtin_interfaces/Time's int32 seconds end in January 2038
 
 
 # -- times and headers ----------------------------------------------------------------------------
@@ -33,7 +35,7 @@ def time_fields(ns: int) -> Fields:
 
 def future_time_fields(ns: int) -> Fields:
     """A future time, or zero ("never") past 2038, where Time's int32 seconds end."""
-    return time_fields(ns if 0 < ns < INT32_END_NS else 0)
+    return time_fields(ns if 0 < ns < TIME_MSG_END_NS else 0)
 
 
 def time_ns(t: Any) -> int:
@@ -134,16 +136,14 @@ def alert_from_msg(msg: Any) -> Alert:
 
 
 def corrugation_from_msg(msg: Any) -> Corrugation:
-    """The bands and amplitudes of a CorrugationState; ValueError when they are inconsistent. A state
-    without post-grinding amplitudes counts growth from zero."""
-    wl, amp = np.asarray(msg.wavelength_m, float), np.asarray(msg.amplitude_m, float)
+    """The bands and amplitudes of a CorrugationState; ValueError (its :func:`corrugation_refusal`)
+    when they are unusable. A state without post-grinding amplitudes counts growth from zero."""
+    why = corrugation_refusal(msg)
+    if why:
+        raise ValueError(why)
+    amp = np.asarray(msg.amplitude_m, float)
     post = np.asarray(msg.post_grinding_m, float) if len(msg.post_grinding_m) else np.zeros_like(amp)
-    if not (len(wl) == len(amp) == len(post)):
-        raise ValueError("wavelength_m, amplitude_m and post_grinding_m differ in length")
-    if not (np.all(np.isfinite(wl)) and np.all(wl > 0) and np.all(np.isfinite(amp)) and np.all(amp >= 0)
-            and np.all(np.isfinite(post)) and np.all(post >= 0)):
-        raise ValueError("a wavelength is not positive or an amplitude is negative or not finite")
-    return Corrugation(wl, amp, post)
+    return Corrugation(np.asarray(msg.wavelength_m, float), amp, post)
 
 
 def corrugation_series(msgs: list[Any]) -> dict[str, np.ndarray]:
@@ -154,3 +154,51 @@ def corrugation_series(msgs: list[Any]) -> dict[str, np.ndarray]:
             "days_to_threshold": np.array([m.days_to_threshold for m in msgs]),
             "grinding_due": np.array([m.grinding_due for m in msgs]),
             "grinding_due_ns": np.array([time_ns(m.grinding_due_time) for m in msgs], np.int64)}
+
+
+# -- checks on the model outputs a node takes from others -----------------------------------------
+# Any publisher may write to a topic: a node refuses (and counts) what it cannot use, instead of
+# raising alerts on it, predicting from it or stopping.
+def stamp_refusal(stamp: Any) -> str:
+    """Why a header stamp is unusable ('' when it is usable)."""
+    return "" if 0 < time_ns(stamp) < TIME_MSG_END_NS else "stamp not set, or before 1970"
+
+
+def squeal_refusal(msg: Any) -> str:
+    """Why a SquealPrediction is unusable ('' when it is usable)."""
+    return stamp_refusal(msg.header.stamp) or ("risk unknown" if msg.risk > RISK_HIGH else "")
+
+
+def noise_refusal(msg: Any) -> str:
+    """Why a RollingNoise is unusable ('' when it is usable)."""
+    if msg.model not in MODELS:
+        return "model unknown"
+    if not all(np.isfinite(getattr(msg, k)) for k in NOISE_METRICS):
+        return "a single-number level is not finite"
+    return stamp_refusal(msg.header.stamp)
+
+
+def corrugation_refusal(msg: Any) -> str:
+    """Why the bands and amplitudes of a CorrugationState are unusable ('' when usable)."""
+    wl, amp, post = (np.asarray(a, float) for a in (msg.wavelength_m, msg.amplitude_m, msg.post_grinding_m))
+    if not (len(wl) == len(amp) > 0 and len(post) in (0, len(wl))):
+        return "wavelength_m, amplitude_m and post_grinding_m differ in length, or are empty"
+    if not np.all(np.isfinite(wl) & (wl > 0)):
+        return "a wavelength is not positive and finite"
+    if not (np.all(np.isfinite(amp) & (amp >= 0)) and np.all(np.isfinite(post) & (post >= 0))):
+        return "an amplitude is negative or not finite"
+    return ""
+
+
+def state_refusal(msg: Any) -> str:
+    """Why a CorrugationState is unusable for alerts ('' when usable): its bands and amplitudes,
+    its thresholds, its forecast and its stamp."""
+    why = corrugation_refusal(msg)
+    if why:
+        return why
+    thr = np.asarray(msg.threshold_m, float)
+    if len(thr) != len(msg.wavelength_m) or not np.all(np.isfinite(thr) & (thr > 0)):
+        return "threshold_m is not one positive, finite value per band"
+    if np.isnan(msg.days_to_threshold) or msg.days_to_threshold < 0:
+        return "days_to_threshold is NaN or negative"
+    return stamp_refusal(msg.header.stamp)

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 
 from rail_monitor.cli import batch, graph, info, predict_corrugation, predict_noise, predict_squeal, report, simulate
 from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.text import printable
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -44,7 +45,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return ns.func(ns)
     except RailMonitorError as exc:
-        print(f"rail-monitor: error: {exc}", file=sys.stderr)
+        print(f"rail-monitor: error: {printable(exc)}", file=sys.stderr)
         return 2
 
 

@@ -7,6 +7,7 @@ import time
 from pathlib import Path
 
 from rail_monitor.cli.common import SALVAGE_HELP, add_site_option, fresh_output, print_report, site_values
+from rail_monitor.core.text import printable
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -33,7 +34,7 @@ def run(ns: argparse.Namespace) -> int:
     values = site_values(ns.site)
     passes = read_passes(ns.source, ns.topic, salvage=ns.salvage)
     if ns.salvage:
-        print(passes.salvage.line(ns.source))
+        print(printable(passes.salvage.line(ns.source)))
     out = Path(ns.output or f"{Path(ns.source).stem}_batch")
     fresh_output(out, ns.overwrite, [ns.source])
     result = run_models(passes, values)

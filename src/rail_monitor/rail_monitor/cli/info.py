@@ -21,22 +21,23 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.reader import bag_info, is_csv, read_passes
     from rail_monitor.bagio.typestore import TRAIN_PASS
+    from rail_monitor.core.text import printable
     from rail_monitor.core.timeutil import NS_PER_DAY, NS_PER_S, format_iso_ns
 
     path = Path(ns.bag)
     if ns.salvage:
         table = read_passes(path, ns.topic, salvage=True)
-        print(table.salvage.line(path))
+        print(printable(table.salvage.line(path)))
     else:
         if not is_csv(path):
             info = bag_info(path)
             span = (info.end_ns - info.start_ns) / NS_PER_S
-            print(f"bag:       {info.path} ({info.storage})")
+            print(f"bag:       {printable(info.path)} ({info.storage})")
             print(f"start:     {format_iso_ns(info.start_ns)}")
             print(f"duration:  {span:.1f} s ({span * NS_PER_S / NS_PER_DAY:.2f} days)")
             print(f"messages:  {info.message_count}")
             for t in info.topics:
-                print(f"  {t.name:32s} {t.typename:40s} {t.count}")
+                print(f"  {printable(t.name):32s} {printable(t.typename):40s} {t.count}")
             if not any(t.typename == TRAIN_PASS for t in info.topics):
                 return 0
         table = read_passes(path, ns.topic)
@@ -48,6 +49,7 @@ def run(ns: argparse.Namespace) -> int:
 def pass_statistics(table) -> list[str]:
     """Lines on a pass table: rate, speed, angle of attack, friction and class mix."""
     from rail_monitor.core.passes import FRICTION_NAMES
+    from rail_monitor.core.text import printable
     from rail_monitor.core.timeutil import NS_PER_DAY
 
     days = max((table.stamp_ns.max() - table.stamp_ns.min()) / NS_PER_DAY, 1e-9)
@@ -60,4 +62,4 @@ def pass_statistics(table) -> list[str]:
         f"AoA:       mean {1e3 * table.angle_of_attack_rad.mean():.2f} mrad, "
         f"95th percentile {1e3 * np.percentile(table.angle_of_attack_rad, 95):.2f} mrad",
         "friction:  " + ", ".join(f"{FRICTION_NAMES.get(int(s), s)} {c}" for s, c in zip(states, counts, strict=True)),
-        "classes:   " + ", ".join(f"{c} {n}" for c, n in zip(classes, class_counts, strict=True))]
+        "classes:   " + ", ".join(f"{printable(c)} {n}" for c, n in zip(classes, class_counts, strict=True))]

@@ -211,7 +211,9 @@ def ahead_of_stream(stamp_ns: np.ndarray, usable: np.ndarray, newest_ns: int, ma
 
 def ahead_reason(margin_s: float, of: str) -> str:
     """The rejection reason of a pass stamped more than margin_s [s] after the stream or the clock."""
-    return f"stamp more than {margin_s:g} s ahead of the {of} (stamps.max_ahead_of_{of}_s)"
+    days = margin_s / 86_400.0
+    span = f"{days:g} d" if days == round(days) else f"{margin_s:g} s"
+    return f"stamp more than {span} ahead of the {of} (stamps.max_ahead_of_{of}_s)"
 
 
 def reject_ahead(stamp_ns: np.ndarray, reasons: np.ndarray, newest_ns: int, margins: Any,

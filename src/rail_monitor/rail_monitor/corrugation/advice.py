@@ -58,6 +58,8 @@ def evaluate(est: CorrugationEstimator, speeds: np.ndarray, probability: np.ndar
         raise ValueError("probabilities must be finite, non-negative and not all zero")
     if friction_state not in (0, *FRICTION_NAMES):
         raise ValueError(f"friction_state {friction_state} unknown")
+    if not (np.isfinite(passes_per_day) and passes_per_day >= 0):
+        raise ValueError("passes_per_day must be finite and not negative (0: the recent traffic)")
     g = growth_at_speeds(est, v, friction_state) @ (p / p.sum())
     current = est.recent_growth().max() if len(est.kept) else np.nan
     band_g = g.max(axis=1)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import sys
 from collections import Counter
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -22,7 +23,10 @@ from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, S
 from rail_monitor.alerts.manager import Alert, AlertManager, describe
 from rail_monitor.bagio.messages import (
     corrugation_series,
+    noise_refusal,
+    squeal_refusal,
     stamps_ns,
+    state_refusal,
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
@@ -55,12 +59,26 @@ class AlertManagerNode(PassConsumerNode):
     def on_validated(self, table: PassTable, reasons: list[str]) -> None:
         self._emit(self.alerts.on_train_passes(table.stamp_ns, np.array([bool(r) for r in reasons])))
 
+    def _usable(self, topic: str, msgs: list[Any], refusal: Callable[[Any], str]) -> list[Any]:
+        """The messages of topic this node can use; the others counted by reason and logged."""
+        self.inputs[topic] += len(msgs)
+        ok = []
+        for m in msgs:
+            why = refusal(m)
+            if not why:
+                ok.append(m)
+                continue
+            self.inputs[f"{topic} refused: {why}"] += 1
+            self.get_logger().warning(f"{topic} message refused: {why}", throttle_duration_sec=5.0)
+        return ok
+
     def _on_squeal(self, msgs: list[SquealPrediction]) -> None:
-        self.inputs["noise/squeal"] += len(msgs)
-        self._emit(self.alerts.on_squeal(stamps_ns(msgs), np.array([m.risk for m in msgs])))
+        msgs = self._usable("noise/squeal", msgs, squeal_refusal)
+        if msgs:
+            self._emit(self.alerts.on_squeal(stamps_ns(msgs), np.array([m.risk for m in msgs])))
 
     def _on_noise(self, msgs: list[RollingNoise]) -> None:
-        self.inputs["noise/rolling"] += len(msgs)
+        msgs = self._usable("noise/rolling", msgs, noise_refusal)
         events: list[Alert] = []
         for model in dict.fromkeys(m.model for m in msgs):  # each source model's stream in its order
             mine = [m for m in msgs if m.model == model]
@@ -69,10 +87,7 @@ class AlertManagerNode(PassConsumerNode):
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
 
     def _on_states(self, msgs: list[CorrugationState]) -> None:
-        self.inputs["corrugation/state"] += len(msgs)
-        ok = [m for m in msgs if len(m.wavelength_m) == len(m.amplitude_m) == len(m.threshold_m)]
-        if len(ok) < len(msgs):
-            self.inputs["corrugation/state refused: arrays differ in length"] += len(msgs) - len(ok)
+        ok = self._usable("corrugation/state", msgs, state_refusal)
         for run in runs(ok, _same_bands):  # states on the same bands and thresholds, as one series
             self._emit(self.alerts.on_states(**corrugation_series(ok[run])))
 

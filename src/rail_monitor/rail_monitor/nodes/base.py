@@ -16,7 +16,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import ExternalShutdownException, ShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
@@ -145,6 +145,34 @@ def wall_timer(node: Node, period_s: float, callback: Callable[[], None], **kwar
     return node.create_timer(period_s, callback, clock=Clock(clock_type=ClockType.STEADY_TIME), **kwargs)
 
 
+# Exceptions that escaped a callback in this process, by cause: rclpy's own handlers raise on some
+# messages (its /clock subscription on a negative time), and no single message may stop a node.
+CALLBACK_ERRORS: Counter[str] = Counter()
+
+
+def spin_once_guarded(executor: Any, timeout_sec: float) -> bool:
+    """executor.spin_once, with an exception out of a callback counted in CALLBACK_ERRORS and
+    logged; False once the context is shut down (stop spinning)."""
+    try:
+        executor.spin_once(timeout_sec=timeout_sec)
+    except (ExternalShutdownException, ShutdownException):
+        return False
+    except Exception as exc:  # any one message's failure
+        why = f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"
+        CALLBACK_ERRORS[why] += 1
+        rclpy.logging.get_logger("rail_monitor").error(f"callback failed, going on: {why}",
+                                                      throttle_duration_sec=5.0)
+    return executor.context.ok()
+
+
+def spin_guarded(executor: Any, ok: Callable[[], bool], timeout_sec: float = 0.1) -> None:
+    """Spin until ok() is False or the context shuts down, surviving any one callback's exception
+    (:func:`spin_once_guarded`): the executor.spin of every executable (make ok() False before
+    shutting the executor down)."""
+    while ok() and spin_once_guarded(executor, timeout_sec):
+        pass
+
+
 class Diagnostics:
     """Publishes one DiagnosticStatus for a node on /diagnostics every period [s]."""
 
@@ -158,9 +186,15 @@ class Diagnostics:
 
     def publish(self) -> None:
         level, message = self._level()
+        values = self._values()
+        if CALLBACK_ERRORS:
+            values["callbacks failed"] = sum(CALLBACK_ERRORS.values())
+            values.update({f"callback failed: {why}": n for why, n in sorted(CALLBACK_ERRORS.items())})
+            if level < DiagnosticStatus.WARN:
+                level, message = DiagnosticStatus.WARN, f"{sum(CALLBACK_ERRORS.values())} callback(s) failed"
         status = DiagnosticStatus(level=level, name=f"{self._node.get_namespace().rstrip('/')}/{self._node.get_name()}",
                                   message=message, hardware_id=self._node.get_name())
-        status.values = [KeyValue(key=k, value=str(v)) for k, v in self._values().items()]
+        status.values = [KeyValue(key=k, value=str(v)) for k, v in values.items()]
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self._node.get_clock().now().to_msg()
         self._pub.publish(msg)
@@ -207,6 +241,19 @@ def use_flow_control_profile() -> None:
             get_package_share_directory("rail_monitor"), "config", "fastdds_flow_control.xml")
 
 
+def params_files(argv: Sequence[str]) -> list[str]:
+    """The files of every ``--params-file`` among the ROS arguments of a command line, in order."""
+    out, in_ros = [], False
+    for i, arg in enumerate(argv):
+        if arg == "--ros-args":
+            in_ros = True
+        elif arg == "--":
+            in_ros = False
+        elif in_ros and arg == "--params-file" and i + 1 < len(argv):
+            out.append(argv[i + 1])
+    return out
+
+
 @contextlib.contextmanager
 def ros_session(args: list[str] | None = None, flow_control: bool = False) -> Iterator[threading.Event]:
     """rclpy initialised for one process, with SIGINT and SIGTERM setting the event it yields
@@ -215,8 +262,12 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False) -> It
 
     flow_control: load the package's Fast DDS profile (see use_flow_control_profile).
     """
+    from rail_monitor.site_file import check_parameter_file
+
     if flow_control:
         use_flow_control_profile()
+    for path in params_files(sys.argv if args is None else args):
+        check_parameter_file(path)
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as exc:  # rcl refuses unreadable params files and malformed -p values at init
@@ -257,22 +308,24 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
             executor = SingleThreadedExecutor()
             executor.add_node(node)
             spinner = None
+            finished = threading.Event()
             try:
                 def ok() -> bool:
                     return not stop.is_set() and rclpy.ok()
 
                 job = getattr(node, "run", None)
                 if job is not None:
-                    spinner = threading.Thread(target=executor.spin, daemon=True)
+                    spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()),
+                                               daemon=True)
                     spinner.start()
                     job(ok)
                 else:
-                    while ok():
-                        executor.spin_once(timeout_sec=0.1)
+                    spin_guarded(executor, ok)
                     drain = getattr(node, "drain", None)
                     if drain is not None and rclpy.ok():
                         drain(executor)
             finally:
+                finished.set()
                 executor.shutdown(timeout_sec=1.0)
                 if spinner is not None and spinner.is_alive():  # leave no thread inside rcl at exit
                     spinner.join(timeout=5.0)

@@ -102,6 +102,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
         try:
             if stamp <= self.est.last_survey_ns:
                 raise ValueError("not newer than the last survey or grinding applied")
+            if self.stamp_ahead(stamp):  # one far-future survey would refuse every later one
+                raise ValueError(self.stamp_ahead(stamp))
             if msg.kind == RoughnessSurvey.KIND_SURVEY:
                 scale = surveys.apply_survey(self.est, msg.wavelength_m, msg.amplitude_m, stamp)
                 self.counts["surveys"] += 1

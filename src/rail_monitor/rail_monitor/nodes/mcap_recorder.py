@@ -37,6 +37,7 @@ from rail_monitor.nodes.base import (
     declare,
     refuse_unknown_parameters,
     run_node,
+    spin_once_guarded,
     subscribe_batched,
     wall_timer,
 )
@@ -150,8 +151,7 @@ class McapRecorder(Node):
         until nothing arrives for quiet_s [s], at most timeout_s [s]; then the bag is closed."""
         deadline = time.monotonic() + timeout_s
         last, quiet_since = self.meter.count, time.monotonic()
-        while time.monotonic() < deadline:
-            executor.spin_once(timeout_sec=0.05)
+        while time.monotonic() < deadline and spin_once_guarded(executor, 0.05):
             if self.meter.count != last:
                 last, quiet_since = self.meter.count, time.monotonic()
             elif time.monotonic() - quiet_since >= quiet_s:

@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections import Counter
 from typing import Any
 
+import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus
 from rclpy.node import Node
 
@@ -73,9 +74,7 @@ class PassConsumerNode(Node):
         """Rejections and runs of accepted passes, in message order."""
         table = PassTable.from_rows([pass_row(m) for m in msgs])
         reasons = rejection_reasons(table, self.site)
-        live = not self.get_parameter("use_sim_time").value
-        clock = self.get_clock().now().nanoseconds if live else None
-        self.stream_ns = reject_ahead(table.stamp_ns, reasons, self.stream_ns, self.margins, clock)
+        self.stream_ns = reject_ahead(table.stamp_ns, reasons, self.stream_ns, self.margins, self._live_clock_ns())
         reasons = reasons.tolist()
         self.on_validated(table, reasons)
         for run in runs(reasons, lambda a, b: not a and not b):
@@ -85,6 +84,17 @@ class PassConsumerNode(Node):
                 continue
             self.rejected[why] += 1
             self.get_logger().warning(f"pass {msgs[run.start].train_id!r} rejected: {why}", throttle_duration_sec=5.0)
+
+    def _live_clock_ns(self) -> int | None:
+        """The node's clock [ns] when it is not on sim time (the stamp margin's second reference)."""
+        return None if self.get_parameter("use_sim_time").value else self.get_clock().now().nanoseconds
+
+    def stamp_ahead(self, stamp_ns: int) -> str:
+        """Why an event stamp (a survey, a grinding) lies too far ahead of the passes taken or of
+        the clock ('' when it does not), by the passes' margins; the stream reference stays."""
+        reasons = np.array([""], dtype=object)
+        reject_ahead(np.array([stamp_ns]), reasons, self.stream_ns, self.margins, self._live_clock_ns())
+        return str(reasons[0])
 
     def _accept(self, table: PassTable, msgs: list[TrainPass]) -> None:
         self.accepted.tick(len(msgs))

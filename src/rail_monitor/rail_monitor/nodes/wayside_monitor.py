@@ -22,7 +22,7 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE, MonitorParams
 from rail_monitor.core.params import values_of
 from rail_monitor.nodes.alert_manager import AlertManagerNode
-from rail_monitor.nodes.base import declare, exit_code, refuse_unknown_parameters, ros_session
+from rail_monitor.nodes.base import declare, exit_code, refuse_unknown_parameters, ros_session, spin_guarded
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
@@ -66,6 +66,7 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
     with ros_session(args, flow_control=True) as stop:
         nodes: list[Node] = []
         executor = spinner = None
+        finished = threading.Event()
         t0 = time.monotonic()
         try:
             settings = _Settings()
@@ -81,10 +82,11 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
             executor = _make_executor(settings.cfg.executor, settings.cfg.threads)
             for n in nodes:
                 executor.add_node(n)
-            spinner = threading.Thread(target=executor.spin, daemon=True)
+            spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()), daemon=True)
             spinner.start()
             return _replay(source, models, recorder, settings.cfg.drain_timeout_s, stop, t0)
         finally:
+            finished.set()
             if executor is not None:
                 executor.shutdown(timeout_sec=2.0)
                 if spinner is not None and spinner.is_alive():
