@@ -65,6 +65,27 @@ def ros_context() -> Iterator[object]:
         rclpy.try_shutdown(context=ctx)
 
 
+@pytest.fixture()
+def tmpfs(tmp_path: Path):
+    """A factory of tmpfs mounts of a given size [bytes] under tmp_path (skips without CAP_SYS_ADMIN);
+    unmounted after the test."""
+    mounted: list[Path] = []
+
+    def mount(size: int) -> Path:
+        disk = tmp_path / f"disk{len(mounted)}"
+        disk.mkdir()
+        r = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(disk)], capture_output=True,
+                           text=True)
+        if r.returncode:
+            pytest.skip(f"cannot mount a tmpfs here (needs CAP_SYS_ADMIN): {r.stderr.strip()}")
+        mounted.append(disk)
+        return disk
+
+    yield mount
+    for disk in mounted:
+        subprocess.run(["umount", "-l", str(disk)], capture_output=True)
+
+
 def run_cmd(*args: str, timeout: float = 120.0, **kw) -> subprocess.CompletedProcess:
     """Run a workspace executable (PATH set by ros2_ws/run) and capture its output."""
     env = {**os.environ, **kw.pop("env", {})}

@@ -168,7 +168,8 @@ def graph():
     ctx = Context()
     # a domain of its own, outside the per-test range of conftest (this fixture outlives a test)
     rclpy.init(context=ctx, domain_id=221 + os.getpid() % 11)
-    params = [Parameter(k, value=v) for k, v in VALUES.items()]
+    # On sim time with no /clock, as under a replay: the streams march on past the wall clock.
+    params = [Parameter(k, value=v) for k, v in VALUES.items()] + [Parameter("use_sim_time", value=True)]
     kw = {"context": ctx, "namespace": NS, "parameter_overrides": params}
     est_node = CorrugationEstimatorNode(**kw)
     nodes = [est_node, RollingNoisePredictor(context=ctx, namespace=NS, parameter_overrides=[

@@ -26,6 +26,7 @@ from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Footer, Message, Schema, Statistics
 from mcap.stream_reader import breakup_chunk
 
+from rail_monitor.bagio.mcap_bag import OPEN_FILE_KEY
 from rail_monitor.core.errors import InputError
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -179,6 +180,12 @@ def bag_files(path: Path) -> tuple[list[Path], dict[str, Any] | None]:
         raise InputError(f"{meta_path}: not a rosbag2 metadata file: {type(exc).__name__}") from None
     if len(set(listed)) < len(listed):
         raise InputError(f"{meta_path}: lists a file more than once ({', '.join(listed)})")
+    custom = meta.get("custom_data")
+    open_file = custom.get(OPEN_FILE_KEY) if isinstance(custom, dict) else None
+    if open_file and sorted([*listed, open_file]) == on_disk:
+        raise InputError(f"{path / open_file}: was being written when the recording stopped (a kill or a power "
+                         f"cut); metadata.yaml lists the {len(listed)} finished file(s); --salvage reads them and "
+                         "its complete chunks")
     if sorted(listed) != on_disk:
         raise InputError(f"{meta_path}: lists {len(listed)} file(s) ({', '.join(listed) or 'none'}) but the folder "
                          f"holds {len(on_disk)} ({', '.join(on_disk) or 'none'})")

@@ -13,7 +13,9 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import time
+from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,9 +28,22 @@ from rail_monitor.bagio.direct_file import DirectFile
 from rail_monitor.bagio.topics import qos_dict
 from rail_monitor.bagio.typestore import schema_text, type_hash
 from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.timeutil import format_iso_ns
 
 # A file the program leaves in every folder it creates: --overwrite replaces only such folders.
 MARKER = ".rail_monitor"
+# metadata.yaml custom_data key naming the file being written when the metadata was last written
+# (a recording that splits rewrites metadata.yaml at every split: a power cut leaves the finished
+# files listed, and this one for --salvage).
+OPEN_FILE_KEY = "rail_monitor.open_file"
+# What a file's summary (indexes, statistics, metadata) may add past its last chunk, and what
+# metadata.yaml and the marker take [bytes].
+SUMMARY_ALLOWANCE = 64 * 1024
+_BLOCK = 4096  # files take whole blocks of the file system
+
+
+def _on_disk(size: int) -> int:
+    return -(-size // _BLOCK) * _BLOCK
 
 
 def mark_output(folder: Path) -> None:
@@ -71,6 +86,8 @@ class _File:
     first_ns: int | None = None
     last_ns: int = 0
     count: int = 0
+    topic_counts: Counter[str] = field(default_factory=Counter)
+    size: int = 0  # bytes on disk once finished
 
 
 class McapBagWriter:
@@ -81,13 +98,20 @@ class McapBagWriter:
     max_file_duration_ns [ns] of log time to start a new file (0: no split); flush_period_ns
     [ns] of log time after which an open chunk is closed (0: only when full);
     flush_wall_period_s [s] of wall time likewise (0: never).
+
+    Retention, for a recorder that runs for months: max_total_bytes [bytes] keeps the folder's
+    files within that budget and max_age_ns [ns] deletes files whose last message is older than
+    that before the newest one (0: no limit). Only finished split files this writer created are
+    deleted, oldest first, never the open one. At every split the finished file is synced and
+    metadata.yaml rewritten (atomically) to list the files kept.
     """
 
     def __init__(self, folder: str | Path, *, compression: str = "zstd", chunk_size: int = 1 << 20,
                  max_file_bytes: int = 0, max_file_duration_ns: int = 0, flush_period_ns: int = 0,
-                 flush_wall_period_s: float = 0.0) -> None:
+                 flush_wall_period_s: float = 0.0, max_total_bytes: int = 0, max_age_ns: int = 0) -> None:
         if compression not in ("zstd", "none"):
             raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
+        _check_retention(max_total_bytes, max_age_ns, max_file_bytes, max_file_duration_ns, chunk_size)
         self.folder = new_output_folder(Path(folder))
         self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
         self._chunk_size = chunk_size
@@ -97,9 +121,15 @@ class McapBagWriter:
         self._flush_wall = flush_wall_period_s
         self._last_flush_ns = 0
         self._last_flush_wall = time.monotonic()
+        self._max_total = max_total_bytes
+        self._max_age = max_age_ns
         self._topics: dict[str, _Topic] = {}
-        self._files: list[_File] = []
+        self._files: list[_File] = []  # the files kept, oldest first (the open one last)
         self._file: _File | None = None
+        self._next_index = 0
+        self._newest_ns = 0
+        self.deleted: list[str] = []  # split files removed by retention, oldest first
+        self.deleted_bytes = 0
         self.closed = False
         self.error = ""  # the first write error (e.g. a full disk); the bag takes no more messages
 
@@ -123,8 +153,12 @@ class McapBagWriter:
             metadata={"offered_qos_profiles": _dump(t.qos).rstrip("\n"), "topic_type_hash": type_hash(t.typename)},
         )
 
+    def _file_path(self, index: int) -> Path:
+        return self.folder / f"{self.folder.name}_{index}.mcap"
+
     def _open_file(self) -> _File:
-        path = self.folder / f"{self.folder.name}_{len(self._files)}.mcap"
+        path = self._file_path(self._next_index)
+        self._next_index += 1
         stream = DirectFile(path)
         writer = Writer(stream, chunk_size=self._chunk_size, compression=self._compression)
         writer.start(profile="ros2", library="rail_monitor")
@@ -137,7 +171,32 @@ class McapBagWriter:
     def _close_file(self, f: _File) -> None:
         f.writer.add_metadata("rosbag2", {"serialized_metadata": _dump(self._info()), "ROS_DISTRO": "jazzy"})
         f.writer.finish()
+        f.size = f.stream.tell()
+        os.fsync(f.stream.fileno())
         f.stream.close()
+
+    def _split(self, f: _File) -> None:
+        """Finish the open file, apply retention, and list the files kept in metadata.yaml (with
+        the next file named as open)."""
+        self._close_file(f)
+        self._file = None
+        self._retain(open_allowance=_on_disk(self._max_bytes + self._chunk_size + SUMMARY_ALLOWANCE))
+        self._write_metadata(open_file=self._file_path(self._next_index).name)
+
+    def _retain(self, open_allowance: int) -> None:
+        """Delete the oldest finished files past max_age_ns, or past the max_total_bytes budget less
+        open_allowance [bytes] (what the next file may reach) and metadata.yaml's share."""
+        finished = [f for f in self._files if f is not self._file]
+        room = self._max_total - open_allowance - SUMMARY_ALLOWANCE
+        while finished and (
+            (self._max_age and finished[0].last_ns < self._newest_ns - self._max_age)
+            or (self._max_total and sum(_on_disk(f.size) for f in finished) > room)
+        ):
+            old = finished.pop(0)
+            old.path.unlink()
+            self._files.remove(old)
+            self.deleted.append(old.path.name)
+            self.deleted_bytes += old.size
 
     # -- writing ----------------------------------------------------------------------------
     def write(self, topic: str, data: bytes, log_time_ns: int, publish_time_ns: int | None = None) -> None:
@@ -154,7 +213,8 @@ class McapBagWriter:
             (self._max_bytes and f.stream.tell() >= self._max_bytes)
             or (self._max_duration and log_time_ns - f.first_ns >= self._max_duration)
         ):
-            self._close_file(f)
+            with self._failing_on_os_error():
+                self._split(f)
             f = None
         with self._failing_on_os_error():
             if f is None:
@@ -166,7 +226,9 @@ class McapBagWriter:
             f.first_ns = log_time_ns
         f.first_ns = min(f.first_ns, log_time_ns)
         f.last_ns = max(f.last_ns, log_time_ns)
+        self._newest_ns = max(self._newest_ns, log_time_ns)
         f.count += 1
+        f.topic_counts[topic] += 1
         t.count += 1
         self._maybe_flush(log_time_ns)
 
@@ -205,13 +267,50 @@ class McapBagWriter:
     # -- metadata ---------------------------------------------------------------------------
     @property
     def message_count(self) -> int:
+        """Messages written (those in files deleted by retention included)."""
         return sum(t.count for t in self._topics.values())
 
     def topic_counts(self) -> dict[str, int]:
+        """Messages written per topic (those in deleted files included)."""
         return {t.name: t.count for t in self._topics.values()}
 
-    def _info(self) -> dict[str, Any]:
-        files = self._files
+    def health(self) -> dict[str, Any]:
+        """For /diagnostics: bytes written, kept and deleted, files kept and the oldest, free disk."""
+        open_bytes = self._file.stream.tell() if self._file is not None and not self.closed else 0
+        kept = sum(f.size for f in self._files if f is not self._file) + open_bytes
+        try:
+            free = shutil.disk_usage(self.folder).free
+        except OSError:
+            free = -1
+        oldest = self._files[0] if self._files else None
+        return {"bytes written": kept + self.deleted_bytes, "bytes kept": kept, "files kept": len(self._files),
+                "oldest kept file": oldest.path.name if oldest else "",
+                "oldest kept message": format_iso_ns(oldest.first_ns) if oldest and oldest.first_ns else "",
+                "files deleted (retention)": len(self.deleted), "free disk bytes": free}
+
+    def _write_metadata(self, open_file: str | None = None) -> None:
+        """metadata.yaml for the finished files kept, replaced atomically and synced."""
+        info = self._info([f for f in self._files if f is not self._file])
+        if open_file is not None:
+            info["custom_data"] = {OPEN_FILE_KEY: open_file}
+        tmp = self.folder / "metadata.yaml.tmp"
+        with open(tmp, "w", encoding="utf-8") as out:
+            out.write(_dump({"rosbag2_bagfile_information": info}))
+            out.flush()
+            os.fsync(out.fileno())
+        os.replace(tmp, self.folder / "metadata.yaml")
+        fd = os.open(self.folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)  # the rename itself survives a power loss
+        finally:
+            os.close(fd)
+
+    def _info(self, files: list[_File] | None = None) -> dict[str, Any]:
+        """rosbag2 metadata of files (default: every file kept), counts from those files."""
+        files = self._files if files is None else files
+        counts: Counter[str] = Counter()
+        for f in files:
+            counts.update(f.topic_counts)
         start = min((f.first_ns for f in files if f.first_ns is not None), default=0)
         end = max((f.last_ns for f in files), default=0)
         return {
@@ -219,14 +318,14 @@ class McapBagWriter:
             "storage_identifier": "mcap",
             "duration": {"nanoseconds": max(0, end - start)},
             "starting_time": {"nanoseconds_since_epoch": start},
-            "message_count": self.message_count,
+            "message_count": sum(counts.values()),
             "topics_with_message_count": [
                 {
                     "topic_metadata": {
                         "name": t.name, "type": t.typename, "serialization_format": "cdr",
                         "offered_qos_profiles": t.qos, "type_description_hash": type_hash(t.typename),
                     },
-                    "message_count": t.count,
+                    "message_count": counts[t.name],
                 }
                 for t in self._topics.values()
             ],
@@ -257,9 +356,8 @@ class McapBagWriter:
                     self._file = self._open_file()
                 self._close_file(self._file)
                 self._file = None
-                tmp = self.folder / "metadata.yaml.tmp"
-                tmp.write_text(_dump({"rosbag2_bagfile_information": self._info()}), encoding="utf-8")
-                os.replace(tmp, self.folder / "metadata.yaml")
+                self._retain(open_allowance=0)
+                self._write_metadata()
         finally:
             self.closed = True
             if self._file is not None:
@@ -272,3 +370,17 @@ class McapBagWriter:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _check_retention(max_total_bytes: int, max_age_ns: int, max_file_bytes: int, max_file_duration_ns: int,
+                     chunk_size: int) -> None:
+    """RailMonitorError for retention settings that cannot hold: a budget needs files split by size
+    (at least twice what the open file may reach), an age needs files split at all."""
+    if max_total_bytes:
+        allowance = _on_disk(max_file_bytes + chunk_size + SUMMARY_ALLOWANCE)
+        if not max_file_bytes or max_total_bytes < 2 * allowance + SUMMARY_ALLOWANCE:
+            raise RailMonitorError(f"a disk budget of {max_total_bytes} bytes needs files split by size, and at "
+                                   f"least twice (split size + chunk size + {SUMMARY_ALLOWANCE}) plus "
+                                   f"{SUMMARY_ALLOWANCE} = {2 * allowance + SUMMARY_ALLOWANCE} bytes")
+    if max_age_ns and not (max_file_bytes or max_file_duration_ns):
+        raise RailMonitorError("an age limit needs files split by size or by duration")

@@ -60,6 +60,11 @@ RECORDER_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("chunk_size", 1 << 20, "Uncompressed bytes of messages per chunk [bytes].", 1024, 1 << 30),
     ParamSpec("max_bag_size", 0, "Start a new file past this size; 0: never [bytes].", 0, 1 << 50),
     ParamSpec("max_bag_duration_s", 0.0, "Start a new file past this span of log time; 0: never [s].", 0.0, 1.0e9),
+    ParamSpec("max_total_bytes", 0, "Disk budget of the bag: delete the oldest finished files to stay within it "
+              "(needs max_bag_size; at least twice max_bag_size + chunk_size + 64 KiB); 0: no limit [bytes].",
+              0, 1 << 50),
+    ParamSpec("max_age_s", 0.0, "Delete finished files whose last message is older than this before the newest "
+              "(needs a split); 0: keep all [s].", 0.0, 1.0e10),
     ParamSpec("flush_period_s", 5.0, "Close the open chunk at least this often (bounds loss on a kill) [s].",
               0.0, 3600.0),
     ParamSpec("log_time", "header", "Log time of a message: header = its header.stamp (pass time; messages "

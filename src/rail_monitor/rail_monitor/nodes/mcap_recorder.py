@@ -60,7 +60,8 @@ class McapRecorder(Node):
             Path(out), compression=self.cfg.compression, chunk_size=self.cfg.chunk_size,
             max_file_bytes=self.cfg.max_bag_size,
             max_file_duration_ns=int(self.cfg.max_bag_duration_s * NS_PER_S),
-            flush_wall_period_s=self.cfg.flush_period_s)
+            flush_wall_period_s=self.cfg.flush_period_s, max_total_bytes=self.cfg.max_total_bytes,
+            max_age_ns=int(self.cfg.max_age_s * NS_PER_S))
         wanted = [t for t in self.cfg.topics if t]
         self._wanted = {self.resolve_topic_name(t) for t in wanted} if wanted else None
         self._lock = threading.Lock()
@@ -77,10 +78,15 @@ class McapRecorder(Node):
             self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
                            "topics": len(self._subs), "bag": str(self.writer.folder),
                            "not recorded (write failed)": self.dropped, "write error": self.writer.error,
-                           **{f"refused: {why}": n for why, n in sorted(self.refused.items())}},
+                           **{f"refused: {why}": n for why, n in sorted(self.refused.items())},
+                           **self._health()},
             level=lambda: (DiagnosticStatus.ERROR, self.writer.error) if self.writer.error
             else (DiagnosticStatus.OK, "ok"))
         self.discover()
+
+    def _health(self) -> dict[str, object]:
+        with self._lock:
+            return self.writer.health()
 
     def _want(self, topic: str, types: list[str]) -> bool:
         if self._wanted is not None:
