@@ -81,8 +81,7 @@ def main() -> None:
     ns = ap.parse_args()
     header("soak")
     budget, split = int(ns.budget_mib * 2**20), int(ns.split_mib * 2**20)
-    env = {**os.environ, "ROS_DOMAIN_ID": str(150 + os.getpid() % 50), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-           "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    env = dict(os.environ)  # the bench package's: a private domain, localhost discovery, one maths thread
     with tempfile.TemporaryDirectory() as tmp:
         bag = Path(tmp) / "soak"
         log = Path(tmp) / "graph.log"

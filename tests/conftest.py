@@ -19,15 +19,39 @@ EXAMPLE_CSV = TOP / "bags" / "example_passes.csv"
 SITE_FILE = TOP / "src" / "rail_monitor" / "config" / "curve_250.yaml"
 
 
+def _claim_domain_group() -> tuple[int, object]:
+    """One of 11 groups of DDS domains for this test run, held (an exclusive lock) until it ends:
+    two runs on the machine never share a domain. Group g owns domains 1 + 20 g ... 20 + 20 g for
+    tests and 221 + g for module-wide graphs."""
+    import fcntl
+    import tempfile
+
+    folder = Path(tempfile.gettempdir()) / "rail_monitor_test_domains"
+    folder.mkdir(exist_ok=True)
+    for group in range(11):
+        f = open(folder / f"group_{group}.lock", "w")  # noqa: SIM115 (held open for the run)
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            return group, f
+        except OSError:
+            f.close()
+    raise RuntimeError("all 11 groups of test DDS domains are taken by other test runs")
+
+
+DOMAIN_GROUP, _DOMAIN_LOCK = _claim_domain_group()
+GRAPH_DOMAIN = 221 + DOMAIN_GROUP  # for module-scoped fixtures that outlive a test
 _DOMAINS = itertools.count()
+# Discovery stays on this machine: a test graph never meets another host's, nor theirs ours.
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ["ROS_DOMAIN_ID"] = str(GRAPH_DOMAIN)
 
 
 @pytest.fixture(autouse=True)
 def _isolated_dds(monkeypatch: pytest.MonkeyPatch) -> None:
     # A DDS domain of its own per test: endpoints of an earlier test (which discovery may still
     # list for a moment) and other test runs on the machine never join this test's graph.
-    base = os.getpid() % 11 * 20
-    monkeypatch.setenv("ROS_DOMAIN_ID", str(1 + (base + next(_DOMAINS) % 20) % 220))
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(1 + 20 * DOMAIN_GROUP + next(_DOMAINS) % 20))
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
 
 
 @pytest.fixture()

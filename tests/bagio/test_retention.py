@@ -100,7 +100,7 @@ def test_a_power_cut_leaves_the_finished_files_listed_and_the_open_one_salvageab
     assert meta["relative_file_paths"] == on_disk[:-1] and len(on_disk) >= 3
     with AnyReader([cut]) as reader:  # rosbags opens it: the finished files, as metadata.yaml lists them
         assert sum(1 for _ in reader.messages()) == meta["message_count"] > 0
-    with pytest.raises(InputError, match="was being written when the recording stopped.*--salvage"):
+    with pytest.raises(InputError, match=r"was being written when the recording stopped.*--salvage"):
         check_bag(cut)
     salvaged = salvage_bag_passes(cut)
     assert 0 < len(salvaged) <= 2000 and salvaged.salvage.cut_off == 1

@@ -61,3 +61,10 @@ def test_a_bag_folder_rail_monitor_wrote_is_replaced_with_overwrite(tmp_path, ca
     assert main(_batch(out, "--overwrite")) == 0
     assert (out / "metadata.yaml").exists()
     capsys.readouterr()
+
+
+def test_a_report_onto_a_full_disk_is_one_line_and_exit_2(tmp_path, tmpfs, capsys):
+    disk = tmpfs(100 * 1024)  # room for the first plot, not for all of them
+    rc = main(["batch", str(EXAMPLE_CSV), "--output", str(tmp_path / "out"), "--report", str(disk / "rep")])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and "cannot write the report: No space left on device" in err

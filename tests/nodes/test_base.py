@@ -85,3 +85,10 @@ def test_a_recorder_output_that_is_a_file_or_a_dangling_link_is_one_line(tmp_pat
         r = run_cmd("mcap_recorder", "--ros-args", "-p", f"output:={out}", timeout=60)
         assert r.returncode == 2 and "not a folder" in r.stderr and "Traceback" not in r.stderr, r.stderr[-1500:]
     assert a_file.read_text() == "mine"
+
+
+def test_a_recorder_budget_that_cannot_hold_is_one_line_at_start(tmp_path):
+    r = run_cmd("mcap_recorder", "--ros-args", "-p", f"output:={tmp_path / 'bag'}", "-p", "max_total_bytes:=1000000",
+                timeout=60)
+    assert r.returncode == 2 and "needs files split by size" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "bag").exists()

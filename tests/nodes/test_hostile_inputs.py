@@ -13,7 +13,6 @@ estimator fed the valid passes alone.
 from __future__ import annotations
 
 import math
-import os
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
@@ -40,7 +39,7 @@ from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 from rail_monitor.site_file import load_parameter_file
 from rail_msgs.msg import RollingNoise, SquealPrediction, TrainPass
 
-from conftest import SITE_FILE, spinning, wait_until
+from conftest import GRAPH_DOMAIN, SITE_FILE, spinning, wait_until
 
 EXAMPLES = 60          # streams per run (each 40 to 150 messages, plus re-sent duplicates)
 NS = "/curve_250"
@@ -167,7 +166,7 @@ class Graph:
 def graph():
     ctx = Context()
     # a domain of its own, outside the per-test range of conftest (this fixture outlives a test)
-    rclpy.init(context=ctx, domain_id=221 + os.getpid() % 11)
+    rclpy.init(context=ctx, domain_id=GRAPH_DOMAIN)
     # On sim time with no /clock, as under a replay: the streams march on past the wall clock.
     params = [Parameter(k, value=v) for k, v in VALUES.items()] + [Parameter("use_sim_time", value=True)]
     kw = {"context": ctx, "namespace": NS, "parameter_overrides": params}

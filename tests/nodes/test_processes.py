@@ -123,15 +123,22 @@ def test_replayer_with_unusable_csv_exits_nonzero_naming_the_line(tmp_path: Path
     assert "line 2: column 'speed_mps'" in r.stderr
 
 
-def test_recorded_log_time_is_pass_time(tmp_path: Path):
-    # header log time: the recorded history sits on the pass times, however /clock lagged
+def test_recorded_log_times_are_receive_times_on_pass_time_never_1970(tmp_path: Path):
+    # As rosbag2 records: log time = the recorder's clock at receipt, here sim time (/clock from
+    # the replayer). Every message of every topic (/diagnostics and the first standing alerts too)
+    # lies within the replayed pass times, so a timeline (Foxglove's) spans the history, not 57 years.
     r = run_cmd("rail-monitor", "monitor", str(SAMPLE), "--output", str(tmp_path / "lt"),
                 "--end-offset-s", FIVE_DAYS, "--no-progress", timeout=180)
     assert r.returncode == 0, r.stderr
+    passes = read_bag_passes(SAMPLE)
+    first, last = int(passes.stamp_ns[0]), int(passes.stamp_ns[0]) + int(float(FIVE_DAYS) * 1e9)
     with AnyReader([tmp_path / "lt"]) as reader:
-        conns = [c for c in reader.connections if c.msgtype == "rail_msgs/msg/TrainPass"]
-        times = [t for _, t, _ in reader.messages(connections=conns)]
-    assert times == list(read_bag_passes(SAMPLE).stamp_ns[: len(times)])
+        times = {c.topic: [t for _, t, _ in reader.messages(connections=[c])] for c in reader.connections}
+    assert {"/curve_250/train_pass", "/diagnostics", "/curve_250/alerts/standing"} <= set(times)
+    for topic, ts in times.items():
+        assert ts and first <= min(ts) and max(ts) <= last, (topic, min(ts), max(ts))
+    pass_times = times["/curve_250/train_pass"]
+    assert pass_times == sorted(pass_times)  # receipt order is pass order
 
 
 def test_launch_file_and_site_config_are_installed():

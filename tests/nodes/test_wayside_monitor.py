@@ -27,11 +27,12 @@ from rail_monitor.corrugation.checkpoint import load, resume
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.nodes.alert_manager import AlertManagerNode
+from rail_monitor.nodes.layout import PROCESSES, SOURCE
 from rail_monitor.nodes.qos import LATEST_QOS, STREAM_QOS
 from rail_monitor.site_file import load_parameter_file
 from rail_msgs.msg import SquealPrediction, WaysideAlertArray
 
-from conftest import SAMPLE, SITE_FILE, TOP, run_cmd, spinning, wait_until
+from conftest import GRAPH_DOMAIN, SAMPLE, SITE_FILE, TOP, run_cmd, spinning, wait_until
 
 DAYS = 3.0
 # Short alert windows, so that the slice raises and clears a squeal alert (the shipped 200-pass
@@ -99,7 +100,7 @@ def _assert_equal_runs(live, batch) -> None:
 def runs(tmp_path_factory) -> dict:
     """The slice through the live graph in one process and through batch mode, both recorded."""
     tmp = tmp_path_factory.mktemp("graph")
-    os.environ["ROS_DOMAIN_ID"] = "231"
+    os.environ["ROS_DOMAIN_ID"] = str(GRAPH_DOMAIN)
     live = tmp / "live"
     site = _site_file(tmp)
     r = run_cmd("rail-monitor", "monitor", str(SAMPLE), "--site", str(site), "--output", str(live),
@@ -145,43 +146,43 @@ def test_report_rebuilds_from_the_batch_bag(runs, tmp_path):
     assert (tmp_path / "rep" / "index.html").stat().st_size > 0 and "grinding forecast" in r.stdout
 
 
-# The output topics whose publishers exist once the model nodes are up: the recorder must have
-# subscribed to each before the replay starts.
-OUTPUTS = ("noise/squeal", "noise/rolling", "corrugation/state", "speed_advisory", "alerts", "alerts/standing")
-
-
 def _graph_in_processes(runs, folder: Path, graph_host: tuple[str, ...] = (), replayer_host: tuple[str, ...] = (),
                         env: dict | None = None) -> int:
-    """One executable per node under the site namespace, talking over DDS: the recorder and the
-    models prefixed by graph_host, the replayer by replayer_host (e.g. ip netns exec). Returns the
-    passes replayed; the recording is in folder/bag."""
+    """The processes wayside.launch.py starts (rail_monitor.nodes.layout), each executable under the
+    site namespace, talking over DDS, started at once in the launch's order with no waiting on the
+    test's side: the product's handshake must make it right. The recorder and the models are
+    prefixed by graph_host, the replayer by replayer_host (e.g. ip netns exec). When the replayer
+    exits, the rest get SIGINT, as the launch's shutdown on its exit sends. Returns the passes
+    replayed; the recording is in folder/bag."""
     env = {**os.environ, **(env or {})}
-    ns = ["-r", "__ns:=/curve_250"]
-    log = folder / "recorder.log"
-    procs = []
+    args = {"output": str(folder / "bag"), "source": str(SAMPLE), "rate": 0.0, "checkpoint": ""}
+    procs, source = [], None
     try:
-        with open(log, "w") as rec_err:
-            for name, extra in (("mcap_recorder", {"output": str(folder / "bag"), "flush_period_s": 0.2}),
-                                ("corrugation_estimator", {}), ("rolling_noise_predictor", {}),
-                                ("squeal_risk_model", {}), ("alert_manager", {})):
-                procs.append(subprocess.Popen(
-                    [*graph_host, name, "--ros-args", *ns, *_ros_params(runs["site"], extra)], cwd=TOP, env=env,
-                    stdout=subprocess.DEVNULL, stderr=rec_err if name == "mcap_recorder" else subprocess.DEVNULL))
-            assert wait_until(lambda: all(f"recording /curve_250/{t} [" in log.read_text() for t in OUTPUTS),
-                              timeout_s=60), log.read_text()[-2000:]
-            time.sleep(1.0)  # the models' own subscriptions to each other's outputs
-            r = subprocess.run([*replayer_host, "pass_replayer", "--ros-args", *ns, "-p", f"source:={SAMPLE}", "-p",
-                                f"end_offset_s:={DAYS * 86400}", "-p", "wait_for_subscribers:=5", "-p",
-                                "progress:=false", "-p", "site_id:=curve_250"],
-                               cwd=TOP, env=env, capture_output=True, text=True, timeout=180)
-            assert r.returncode == 0, r.stderr[-2000:]
-            # the outputs are in when the recorder holds the last noise and alert messages
-            time.sleep(3.0)
+        for p in PROCESSES:
+            params = {**p.parameters, **{name: args[arg] for name, arg in p.arguments.items()}}
+            if p.executable == SOURCE:
+                params.update({"end_offset_s": DAYS * 86400, "progress": False})
+            cmd = [*(replayer_host if p.executable == SOURCE else graph_host), p.executable, "--ros-args",
+                   "-r", "__ns:=/curve_250", "--params-file", str(runs["site"])]
+            cmd += ["-p", "use_sim_time:=true"] if p.sim_time else []
+            for k, v in params.items():
+                cmd += ["-p", f"{k}:={v if v != '' else chr(39) * 2}"]  # an empty string as YAML ''
+            with open(folder / f"{p.executable}.log", "w") as log:
+                proc = subprocess.Popen(cmd, cwd=TOP, env=env, stdout=subprocess.DEVNULL, stderr=log)
+            if p.executable == SOURCE:
+                source = proc
+            else:
+                procs.append(proc)
+        assert source.wait(timeout=240) == 0, (folder / f"{SOURCE}.log").read_text()[-2000:]
     finally:
-        for p in reversed(procs):
+        for p in procs:
             p.send_signal(signal.SIGINT)
         for p in procs:
             p.wait(timeout=30)
+    for p in PROCESSES:
+        err = (folder / f"{p.executable}.log").read_text()
+        assert "Traceback" not in err, err[-2000:]
+    assert all(p.returncode == 0 for p in procs), [p.returncode for p in procs]
     return len(_slice())
 
 
@@ -224,7 +225,7 @@ def test_replayer_and_graph_on_two_hosts_lose_nothing(runs, tmp_path, tally):
     with _two_hosts() as (a, b):
         n = _graph_in_processes(runs, tmp_path, graph_host=("ip", "netns", "exec", b),
                                 replayer_host=("ip", "netns", "exec", a),
-                                env={"FASTDDS_BUILTIN_TRANSPORTS": "UDPv4"})
+                                env={"FASTDDS_BUILTIN_TRANSPORTS": "UDPv4", "ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET"})
         sent = int(subprocess.run(["ip", "netns", "exec", a, "cat", f"/sys/class/net/va{os.getpid() % 100_000}"
                                    "/statistics/tx_bytes"], capture_output=True, text=True).stdout)
     run = load_run(tmp_path / "bag")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 from rail_monitor.core.errors import ConfigError
@@ -38,6 +39,9 @@ ALERT_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("rejected_raise_share", 0.05, "Share of rejected messages that raises the alert [-].", 0.0, 1.0),
     ParamSpec("rejected_clear_share", 0.0, "Share at or below which it clears [-].", 0.0, 1.0),
 )
+# Every alert parameter may be changed on a running alert_manager (ros2 param set): an operator
+# tunes limits and windows without a restart; the same checks refuse a bad value with the reason.
+ALERT_SPECS = tuple(replace(s, tunable=True) for s in ALERT_SPECS)
 
 
 AlertConfig = values_type("AlertConfig", ALERT_SPECS, "The site's alert parameters (names and units as in "

@@ -59,6 +59,15 @@ class AlertManager:
         self._min_risk = RISK_NAMES.index(cfg.squeal_min_risk)
         self._keys: dict[bytes, list[str]] = {}
 
+    def retune(self, cfg: AlertConfig) -> None:
+        """Take new limits and windows (a running node's parameters changed): each window keeps its
+        newest flags; standing alerts stay until the new limits clear them."""
+        self.cfg = cfg
+        self._noise = {model: w.resized(cfg.noise_window_passes) for model, w in self._noise.items()}
+        self._squeal = self._squeal.resized(cfg.squeal_window_passes)
+        self._rejected = self._rejected.resized(cfg.rejected_window_passes)
+        self._min_risk = RISK_NAMES.index(cfg.squeal_min_risk)
+
     # -- raise / clear ----------------------------------------------------------------------------
     def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
              threshold: float, unit: str, due_ns: int = 0) -> Alert | None:

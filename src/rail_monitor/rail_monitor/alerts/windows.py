@@ -14,6 +14,14 @@ class Window:
         self.flags: deque[tuple[bool, bool]] = deque(maxlen=n)
         self.over = self.near = 0
 
+    def resized(self, n: int) -> Window:
+        """A window of n inputs holding the newest of these flags."""
+        out = Window(n)
+        out.flags.extend(self.flags)
+        out.over = sum(o for o, _ in out.flags)
+        out.near = sum(r for _, r in out.flags)
+        return out
+
     def push(self, over: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Add flag pairs in order; returns the over and near counts and the window's length after
         each one (cumulative sums over the kept flags and the new ones)."""

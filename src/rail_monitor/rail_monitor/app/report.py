@@ -21,7 +21,7 @@ from rail_monitor.alerts.config import KIND_NAMES
 from rail_monitor.alerts.manager import Alert, describe
 from rail_monitor.bagio.messages import alert_from_msg, pass_row, time_ns
 from rail_monitor.bagio.reader import read_messages
-from rail_monitor.core.errors import InputError
+from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.text import printable
@@ -134,10 +134,18 @@ def _grinding_lines(run: RunData) -> list[str]:
 
 # -- report folder ------------------------------------------------------------------------------
 def build_report(run: RunData, values: Mapping[str, Any], out_dir: str | Path) -> list[Path]:
-    """Write the PNG plots and index.html into out_dir; returns the files written."""
+    """Write the PNG plots and index.html into out_dir; returns the files written. A write that
+    fails (a full disk, no permission) is one RailMonitorError naming the folder."""
+    out = Path(out_dir)
+    try:
+        return _write_report(run, values, out)
+    except OSError as exc:
+        raise RailMonitorError(f"{out}: cannot write the report: {exc.strerror or exc}") from None
+
+
+def _write_report(run: RunData, values: Mapping[str, Any], out: Path) -> list[Path]:
     from rail_monitor.app import plots
 
-    out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     site = site_from_values(values)
     files = []

@@ -46,9 +46,10 @@ class Qos:
 
 # Pass events and model outputs: reliable. Publishers keep 1000; subscribers queue 10000 so a
 # burst waits rather than drops (KEEP_ALL readers would give DDS-level backpressure, but Fast
-# DDS's stalled at about 5,100 samples here).
-STREAM = Qos(1000)
-STREAM_SUB = Qos(10000)
+# DDS's stalled at about 5,100 samples here). Transient local: a subscriber that matches a moment
+# late (another process's discovery) still gets the last 1000, so no start-up order loses output.
+STREAM = Qos(1000, transient_local=True)
+STREAM_SUB = Qos(10000, transient_local=True)
 # A state whose latest value is what matters (speed advisory, the standing alerts): a late
 # subscriber (a dashboard started later) gets the current one at once.
 LATEST = Qos(1, transient_local=True)

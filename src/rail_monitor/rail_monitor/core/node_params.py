@@ -51,8 +51,14 @@ MODE_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
+# After SIGINT or SIGTERM, the longest a process takes what was already delivered before it
+# finishes its bag and exits 0 (a supervisor should allow this plus a few seconds).
+STOP_TIMEOUT = ParamSpec("stop_timeout_s", 5.0, "After SIGINT or SIGTERM: the longest wait for messages already "
+                         "sent before the bag is finished and the process exits [s].", 0.0, 300.0)
+
 # mcap_recorder.
 RECORDER_SPECS: tuple[ParamSpec, ...] = (
+    STOP_TIMEOUT,
     ParamSpec("output", "", "Bag folder to create; empty: rail_monitor_<UTC time> in the working folder."),
     ParamSpec("topics", [""], "Topics to record (absolute or relative to the namespace); empty: every "
               "rail_msgs topic and /diagnostics."),
@@ -67,15 +73,16 @@ RECORDER_SPECS: tuple[ParamSpec, ...] = (
               "(needs a split); 0: keep all [s].", 0.0, 1.0e10),
     ParamSpec("flush_period_s", 5.0, "Close the open chunk at least this often (bounds loss on a kill) [s].",
               0.0, 3600.0),
-    ParamSpec("log_time", "header", "Log time of a message: header = its header.stamp (pass time; messages "
-              "without a header take the node clock), receive = the node clock at receipt, as rosbag2 does.",
-              choices=("header", "receive")),
+    ParamSpec("log_time", "receive", "Log time of a message: receive = the node clock at receipt, as rosbag2 "
+              "records (pass time on sim time), header = its header.stamp (messages without one take the clock).",
+              choices=("receive", "header")),
     ParamSpec("discovery_period_s", 0.2, "How often to look for new topics [s].", 0.01, 60.0),
 )
 
 
 # wayside_monitor: the one-process graph.
 MONITOR_SPECS: tuple[ParamSpec, ...] = (
+    STOP_TIMEOUT,
     ParamSpec("record", True, "Host an mcap_recorder for every output topic."),
     ParamSpec("drain_timeout_s", 60.0, "After the replay, wait at most this for the recorder to catch up [s].",
               0.0, 3600.0),
@@ -107,7 +114,7 @@ ESTIMATOR_SPECS: tuple[ParamSpec, ...] = (
 # rolling_noise_predictor: waiting for the corrugation state of a pass.
 PREDICTOR_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("state_wait_s", 5.0, "Longest wall time a pass waits for the corrugation state that includes it; "
-              "0: take the latest state at once [s].", 0.0, 3600.0),
+              "0: take the latest state at once (running without a corrugation_estimator) [s].", 0.0, 3600.0),
 )
 
 

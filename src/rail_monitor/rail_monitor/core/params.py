@@ -29,6 +29,7 @@ class ParamSpec:
     low: float | None = None
     high: float | None = None
     choices: tuple[str, ...] = ()
+    tunable: bool = False  # may be changed on a running node (else read-only once declared)
 
     @property
     def annotation(self) -> Any:
@@ -89,6 +90,20 @@ def resolve(specs: Sequence[ParamSpec], values: Mapping[str, Any], where: str = 
     if strict:
         refuse_unknown(values, {s.name for s in specs}, where)
     return {s.name: s.check(values[s.name], where) if s.name in values else s.default for s in specs}
+
+
+ParamGroups = tuple[tuple[str, Sequence[ParamSpec]], ...]  # (name prefix, specs) a node declares
+
+
+def help_lines(groups: ParamGroups) -> list[str]:
+    """One line per parameter: name, type, allowed values, default, description (for --help)."""
+    out = []
+    for prefix, specs in groups:
+        for s in specs:
+            kind = f"{s.kind.__name__}[]" if isinstance(s.default, list) else s.kind.__name__
+            allowed = "" if s.kind in (bool, str) and not s.choices else f", {s.range_text()}"
+            out.append(f"  {prefix}{s.name} ({kind}{allowed}; default {s.default!r})\n      {s.description}")
+    return out
 
 
 def refuse_unknown(names: Collection[str], known: Collection[str], where: str = "") -> None:

@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.parameter import Parameter
 
 from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, SEVERITY_CRITICAL, alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager, describe
@@ -30,9 +32,10 @@ from rail_monitor.bagio.messages import (
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
+from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import LEAD_TIME
-from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched
+from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
@@ -40,10 +43,14 @@ from rail_msgs.msg import CorrugationState, RollingNoise, SquealPrediction, Ways
 
 
 class AlertManagerNode(PassConsumerNode):
+    EXECUTABLE = "alert_manager"
+    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("corrugation.", (LEAD_TIME,)), ("alerts.", ALERT_SPECS))
+
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("alert_manager", **kwargs)
-        lead = declare(self, (LEAD_TIME,), prefix="corrugation.")["lead_time_days"]
-        self.alerts = AlertManager(alert_config(declare(self, ALERT_SPECS, prefix="alerts."), lead, prefix=""))
+        self._lead = declare(self, (LEAD_TIME,), prefix="corrugation.")["lead_time_days"]
+        self.alerts = AlertManager(alert_config(declare(self, ALERT_SPECS, prefix="alerts."), self._lead, prefix=""))
+        self.add_on_set_parameters_callback(self._on_set_parameters)
         self.inputs: Counter[str] = Counter()
         self.sent = Sent()
         self.pub = self.create_publisher(WaysideAlert, "alerts", ALERT_QOS)
@@ -54,7 +61,14 @@ class AlertManagerNode(PassConsumerNode):
                                              (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS),
                                              (CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS)):
             subscribe_batched(self, msg_type, topic, handle, qos, self.max_batch)
-        self._publish_standing(0)
+        self.listen()
+
+    def key_parameters(self) -> dict[str, Any]:
+        c = self.alerts.cfg
+        return {"noise": f"{c.noise_metric}>{c.noise_limit_dba:g} dB(A)", "squeal_window": c.squeal_window_passes}
+        # The initial (empty) standing set for late subscribers, once the clock runs: a message
+        # stamped 0 before the first /clock would stretch a bag's timeline back to 1970.
+        self._initial = wall_timer(self, 0.1, self._publish_initial_standing)
 
     def on_validated(self, table: PassTable, reasons: list[str]) -> None:
         self._emit(self.alerts.on_train_passes(table.stamp_ns, np.array([bool(r) for r in reasons])))
@@ -90,6 +104,28 @@ class AlertManagerNode(PassConsumerNode):
         ok = self._usable("corrugation/state", msgs, state_refusal)
         for run in runs(ok, _same_bands):  # states on the same bands and thresholds, as one series
             self._emit(self.alerts.on_states(**corrugation_series(ok[run])))
+
+    def _on_set_parameters(self, params: list[Parameter]) -> SetParametersResult:
+        """ros2 param set on alerts.*: checked as at start-up (ranges, hysteresis), then applied to
+        the next inputs; a refusal gives the reason and changes nothing."""
+        mine = {p.name[len("alerts."):]: p.value for p in params if p.name.startswith("alerts.")}
+        if not mine:
+            return SetParametersResult(successful=True)
+        current = {s.name: self.get_parameter(f"alerts.{s.name}").value for s in ALERT_SPECS}
+        try:
+            cfg = alert_config({**current, **mine}, self._lead, prefix="")
+        except ConfigError as exc:
+            return SetParametersResult(successful=False, reason=str(exc))
+        self.alerts.retune(cfg)
+        self.get_logger().info("alerts retuned: " + ", ".join(f"alerts.{k}={v!r}" for k, v in sorted(mine.items())))
+        return SetParametersResult(successful=True)
+
+    def _publish_initial_standing(self) -> None:
+        now = self.get_clock().now().nanoseconds
+        if self.sent[self.standing_pub.topic_name] or now > 0:  # an alert published it already, or the clock runs
+            self._initial.cancel()
+            if not self.sent[self.standing_pub.topic_name]:
+                self._publish_standing(now)
 
     def _emit(self, events: list[Alert]) -> None:
         for e in events:

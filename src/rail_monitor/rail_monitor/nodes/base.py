@@ -21,13 +21,31 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 from rail_monitor.core.errors import ConfigError, RailMonitorError
-from rail_monitor.core.params import ParamSpec
+from rail_monitor.core.params import ParamGroups, ParamSpec, help_lines
 from rail_monitor.core.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
 
+# The site's parameters, which every model node declares (the vehicle sections per class in
+# vehicle_classes).
+SITE_PARAMETERS: ParamGroups = (("", SITE_SPECS), ("contact.", CONTACT_SPECS), ("track.", TRACK_SPECS),
+                                ("vehicle.<class>.", VEHICLE_SPECS))
+
+
+def asked_for_help(argv: Sequence[str]) -> bool:
+    """Whether -h or --help comes before any --ros-args."""
+    head = list(argv)[: list(argv).index("--ros-args")] if "--ros-args" in argv else list(argv)
+    return "-h" in head or "--help" in head
+
+
+def help_text(executable: str, doc: str | None, groups: ParamGroups) -> str:
+    """What --help prints: the executable's summary, how to set parameters, then every parameter."""
+    summary = (doc or "").strip().split("\n\n")[0]
+    return "\n".join([f"usage: {executable} [--ros-args -p NAME:=VALUE ... --params-file SITE.yaml ...]", "",
+                      summary, "", "parameters:", *help_lines(groups), ""])
+
 
 def _descriptor(spec: ParamSpec, prefix: str) -> ParameterDescriptor:
-    d = ParameterDescriptor(name=prefix + spec.name, description=spec.description, read_only=True)
+    d = ParameterDescriptor(name=prefix + spec.name, description=spec.description, read_only=not spec.tunable)
     if spec.choices:
         d.additional_constraints = spec.range_text()
     if spec.kind is float and (spec.low is not None or spec.high is not None):
@@ -61,6 +79,17 @@ def declare(node: Node, specs: Sequence[ParamSpec], prefix: str = "") -> dict[st
             value = list(value)
         values[spec.name] = spec.check(value, prefix)
     return values
+
+
+def announce(node: Node, **key_parameters: Any) -> None:
+    """The node's one start-up line: what it subscribes and publishes, and its key parameters."""
+    def topics(endpoints: Any) -> str:
+        names = sorted({e.topic_name for e in endpoints} - {"/rosout", "/parameter_events"})
+        return ", ".join(names) or "nothing"
+
+    settings = ", ".join(f"{k}={v}" for k, v in key_parameters.items())
+    node.get_logger().info(f"started: subscribes {topics(node.subscriptions)}; publishes {topics(node.publishers)}"
+                           + (f"; {settings}" if settings else ""))
 
 
 def refuse_unknown_parameters(node: Node) -> None:
@@ -173,10 +202,14 @@ def spin_guarded(executor: Any, ok: Callable[[], bool], timeout_sec: float = 0.1
         pass
 
 
-class Diagnostics:
-    """Publishes one DiagnosticStatus for a node on /diagnostics every period [s]."""
+DIAGNOSTICS_PERIOD_S = 1.0
 
-    def __init__(self, node: Node, values: Callable[[], dict[str, Any]], period_s: float = 1.0,
+
+class Diagnostics:
+    """Publishes one DiagnosticStatus for a node on /diagnostics every period [s] (none while
+    the node's clock reads 0: on sim time before the first /clock)."""
+
+    def __init__(self, node: Node, values: Callable[[], dict[str, Any]], period_s: float = DIAGNOSTICS_PERIOD_S,
                  level: Callable[[], tuple[int, str]] | None = None) -> None:
         self._node = node
         self._values = values
@@ -185,6 +218,9 @@ class Diagnostics:
         self._timer = wall_timer(node, period_s, self.publish)
 
     def publish(self) -> None:
+        now = self._node.get_clock().now()
+        if now.nanoseconds == 0:  # a status stamped 1970 would stretch a bag's timeline over decades
+            return
         level, message = self._level()
         values = self._values()
         if CALLBACK_ERRORS:
@@ -196,7 +232,7 @@ class Diagnostics:
                                   message=message, hardware_id=self._node.get_name())
         status.values = [KeyValue(key=k, value=str(v)) for k, v in values.items()]
         msg = DiagnosticArray(status=[status])
-        msg.header.stamp = self._node.get_clock().now().to_msg()
+        msg.header.stamp = now.to_msg()
         self._pub.publish(msg)
 
 
@@ -302,6 +338,10 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
     delivered (the recorder: nothing published before the signal is lost). ``close()`` runs in
     every case; an error there (a bag that cannot be finished) is exit code 2.
     """
+    if isinstance(make, type) and asked_for_help(sys.argv if args is None else args):
+        print(help_text(make.EXECUTABLE, sys.modules[make.__module__].__doc__, make.PARAMETERS))
+        return 0
+
     def main() -> int:
         with ros_session(args, flow_control) as stop:
             node = make()

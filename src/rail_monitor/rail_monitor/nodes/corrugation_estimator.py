@@ -35,6 +35,9 @@ from rail_msgs.srv import EvaluateSpeedDistribution
 
 
 class CorrugationEstimatorNode(PassConsumerNode):
+    EXECUTABLE = "corrugation_estimator"
+    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("", ESTIMATOR_SPECS), ("corrugation.", CORRUGATION_SPECS))
+
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("corrugation_estimator", **kwargs)
         self.params = values_of(EstimatorParams, declare(self, ESTIMATOR_SPECS))
@@ -59,6 +62,11 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
         self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
+        self.listen()
+
+    def key_parameters(self) -> dict[str, Any]:
+        return {"checkpoint": self.checkpoint or "none", "passes": self.est.total_pass_count,
+                "lead_time_days": f"{self.est.cfg.lead_time_days:g}"}
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
         wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
 

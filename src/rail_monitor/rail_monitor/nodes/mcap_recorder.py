@@ -1,8 +1,8 @@
 """mcap_recorder: record the graph's topics into a rosbag2-compatible MCAP bag folder.
 
 Records every topic whose type is in rail_msgs, and /diagnostics, or the topics named in
-``topics``. Messages are taken serialised (no decode). Log time is the message's header stamp
-(pass time; ``log_time:=receive`` uses the node clock at receipt, as rosbag2 does). The bag is
+``topics``. Messages are taken serialised (no decode). Log time is the node clock at receipt, as
+rosbag2 records (on sim time: pass time); ``log_time:=header`` uses the header stamp. The bag is
 finalised on SIGINT and SIGTERM, after taking what was already delivered (a stop right after a
 burst loses nothing); chunks are closed every ``flush_period_s``, so a SIGKILL loses
 at most that much. A write error (a full disk) stops the recording: /diagnostics goes to ERROR
@@ -34,6 +34,7 @@ from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import (
     Diagnostics,
     RateMeter,
+    announce,
     declare,
     refuse_unknown_parameters,
     run_node,
@@ -49,9 +50,12 @@ DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
 
 
 class McapRecorder(Node):
+    EXECUTABLE = "mcap_recorder"
+    PARAMETERS = (("", RECORDER_SPECS),)
     take_at_once = 500  # most queued messages of a topic one callback takes (a burst costs fewer wake-ups)
 
     def __init__(self, **kwargs) -> None:
+        kwargs.setdefault("enable_logger_service", True)
         super().__init__("mcap_recorder", **kwargs)
         refuse_unknown_parameters(self)
         self.cfg = values_of(RecorderParams, declare(self, RECORDER_SPECS))
@@ -67,7 +71,7 @@ class McapRecorder(Node):
         self._lock = threading.Lock()
         self._group = MutuallyExclusiveCallbackGroup()
         self._subs: dict[str, object] = {}
-        self._stamped: dict[str, bool] = {}
+        self._has_header: dict[str, bool] = {}
         self.counts: dict[str, int] = {}
         self.meter = RateMeter()
         wall_timer(self, self.cfg.discovery_period_s, self.discover, callback_group=self._group)
@@ -83,6 +87,8 @@ class McapRecorder(Node):
             level=lambda: (DiagnosticStatus.ERROR, self.writer.error) if self.writer.error
             else (DiagnosticStatus.OK, "ok"))
         self.discover()
+        announce(self, bag=self.writer.folder, log_time=self.cfg.log_time, compression=self.cfg.compression,
+                 max_bag_size=self.cfg.max_bag_size, max_total_bytes=self.cfg.max_total_bytes)
 
     def _health(self) -> dict[str, object]:
         with self._lock:
@@ -110,7 +116,7 @@ class McapRecorder(Node):
             with self._lock:
                 self.writer.add_topic(topic, typename, [qos_to_dict(q) for q in offered])
                 self.counts[topic] = 0
-                self._stamped[topic] = self.cfg.log_time == "header" and starts_with_header(typename)
+                self._has_header[topic] = starts_with_header(typename)
             self._subs[topic] = subscribe_batched(
                 self, msg_type, topic, lambda msgs, t=topic: self._on_messages(t, msgs), subscription_qos(offered),
                 self.take_at_once, raw=True, callback_group=self._group)
@@ -124,10 +130,8 @@ class McapRecorder(Node):
         with self._lock:
             if self.writer.closed:
                 return
-            stamp = header_stamp_ns(data) if self._stamped[topic] else None
             try:
-                # A stamp before 1970 (or unset) cannot be an MCAP log time: the receive time stands in.
-                self.writer.write(topic, data, stamp if stamp and stamp > 0 else self.get_clock().now().nanoseconds)
+                self.writer.write(topic, data, self._log_time(topic, data))
             except RailMonitorError as exc:
                 self._write_failed(exc)
                 return
@@ -136,6 +140,16 @@ class McapRecorder(Node):
                 return
             self.counts[topic] += 1
         self.meter.tick()
+
+    def _log_time(self, topic: str, data: bytes) -> int:
+        """The node clock at receipt (as rosbag2; pass time on sim time), or with log_time header
+        the header stamp. A time the clock cannot give (0: sim time before the first /clock) and a
+        stamp before 1970 cannot be an MCAP log time: the other one, else the wall clock, stands in."""
+        stamp = header_stamp_ns(data) if self._has_header[topic] else 0
+        if self.cfg.log_time == "header" and stamp > 0:
+            return stamp
+        now = self.get_clock().now().nanoseconds
+        return now if now > 0 else stamp if stamp > 0 else time.time_ns()
 
     def _write_failed(self, exc: RailMonitorError) -> None:
         """A full disk or a write error: the bag stops; what it holds stays readable (salvage)."""
@@ -152,10 +166,10 @@ class McapRecorder(Node):
                 except RailMonitorError as exc:
                     self._write_failed(exc)
 
-    def drain(self, executor: Executor, quiet_s: float = 0.3, timeout_s: float = 10.0) -> None:
+    def drain(self, executor: Executor, quiet_s: float = 0.3) -> None:
         """After SIGINT or SIGTERM: take what is already queued (a burst just before the signal)
-        until nothing arrives for quiet_s [s], at most timeout_s [s]; then the bag is closed."""
-        deadline = time.monotonic() + timeout_s
+        until nothing arrives for quiet_s [s], at most stop_timeout_s; then the bag is closed."""
+        deadline = time.monotonic() + self.cfg.stop_timeout_s
         last, quiet_since = self.meter.count, time.monotonic()
         while time.monotonic() < deadline and spin_once_guarded(executor, 0.05):
             if self.meter.count != last:

@@ -22,12 +22,14 @@ from rclpy.node import Node
 
 from rail_monitor.bagio.messages import pass_row, time_ns
 from rail_monitor.core.node_params import BATCH_SPECS, STAMP_SPECS, StampParams
-from rail_monitor.core.params import values_of
+from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, reject_ahead, rejection_reasons, with_class_defaults
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.nodes.base import (
+    SITE_PARAMETERS,
     Diagnostics,
     RateMeter,
+    announce,
     declare,
     declare_site,
     isolate_failures,
@@ -40,9 +42,15 @@ from rail_msgs.msg import TrainPass
 
 
 class PassConsumerNode(Node):
-    """Subscribes ``train_pass``; subclasses implement :meth:`on_passes` for accepted passes."""
+    """Takes ``train_pass``; subclasses implement :meth:`on_passes` for accepted passes and call
+    :meth:`listen` at the end of their ``__init__``, once their publishers exist: a node's outputs
+    are visible in the graph before it takes its first pass (the pass source's start-up wait
+    counts on it)."""
+
+    PARAMETERS: ParamGroups = (*SITE_PARAMETERS, ("", BATCH_SPECS), ("stamps.", STAMP_SPECS))
 
     def __init__(self, name: str, **kwargs: Any) -> None:
+        kwargs.setdefault("enable_logger_service", True)
         super().__init__(name, **kwargs)
         refuse_unknown_parameters(self)
         self.site = declare_site(self)
@@ -54,8 +62,17 @@ class PassConsumerNode(Node):
         self.margins = values_of(StampParams, declare(self, STAMP_SPECS, prefix="stamps."))
         self.stream_ns = 0  # newest pass taken: the reference of the stamp margin (a resumed state sets it)
         self.max_batch = declare(self, BATCH_SPECS)["max_batch"]
-        subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, self.max_batch)
         Diagnostics(self, self.diagnostic_values, level=self._level)
+
+    def listen(self) -> None:
+        """Subscribe train_pass (the last step of a subclass's __init__), and say so."""
+        subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, self.max_batch)
+        announce(self, site=self.site.site_id, radius_m=f"{self.site.curve_radius_m:g}",
+                 classes="/".join(self.site.vehicles), **self.key_parameters())
+
+    def key_parameters(self) -> dict[str, Any]:
+        """What the start-up line states besides the site (subclasses)."""
+        return {}
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         """Handle consecutive accepted passes in order (table rows, class defaults filled, match
@@ -111,6 +128,7 @@ class PassConsumerNode(Node):
 
     def diagnostic_values(self) -> dict[str, Any]:
         values: dict[str, Any] = {
+            "taken": self.taken,
             "accepted": self.accepted.count,
             "rejected": sum(self.rejected.values()),
             "rate_per_s": f"{self.accepted.rate():.1f}",

@@ -18,6 +18,9 @@ from rail_monitor.nodes.pass_source import PassSourceNode
 
 
 class PassReplayer(PassSourceNode):
+    EXECUTABLE = "pass_replayer"
+    PARAMETERS = (*PassSourceNode.PARAMETERS, ("", REPLAYER_SPECS))
+
     def __init__(self, **kwargs) -> None:
         super().__init__("pass_replayer", **kwargs)
         self.src = values_of(ReplayerParams, declare(self, REPLAYER_SPECS))

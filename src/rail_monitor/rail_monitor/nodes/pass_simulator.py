@@ -15,11 +15,14 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MODE_SPECS, ModeParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
-from rail_monitor.nodes.base import declare, declare_site, run_node
+from rail_monitor.nodes.base import SITE_PARAMETERS, declare, declare_site, run_node
 from rail_monitor.nodes.pass_source import PassSourceNode
 
 
 class PassSimulator(PassSourceNode):
+    EXECUTABLE = "pass_simulator"
+    PARAMETERS = (*PassSourceNode.PARAMETERS, *SITE_PARAMETERS, ("", MODE_SPECS), ("", SIMULATOR_SPECS))
+
     def __init__(self, **kwargs) -> None:
         super().__init__("pass_simulator", **kwargs)
         self.site = declare_site(self)

@@ -11,6 +11,7 @@ import time
 from collections.abc import Callable
 
 import rclpy
+from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
@@ -19,19 +20,31 @@ from tqdm import tqdm
 from rail_monitor.bagio.messages import train_pass_fields
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import PUBLISH_SPECS, STAMP_SPECS, PublishParams, StampParams
-from rail_monitor.core.params import values_of
+from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, publishable
 from rail_monitor.core.timeutil import NS_PER_S
-from rail_monitor.nodes.base import Diagnostics, RateMeter, declare, refuse_unknown_parameters
+from rail_monitor.nodes.base import (
+    DIAGNOSTICS_PERIOD_S,
+    Diagnostics,
+    RateMeter,
+    announce,
+    declare,
+    refuse_unknown_parameters,
+)
 from rail_monitor.nodes.convert import time_msg, to_msg
-from rail_monitor.nodes.qos import CLOCK_QOS, STREAM_QOS
+from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, STREAM_QOS
 from rail_msgs.msg import TrainPass
+
+GRAPH_SETTLE_S = 1.0  # the graph's endpoints unchanged this long [s]: every node has subscribed
 
 
 class PassSourceNode(Node):
     """Base of the nodes that publish train passes on ``train_pass`` (relative: site namespace)."""
 
+    PARAMETERS: ParamGroups = (("", PUBLISH_SPECS), ("stamps.", STAMP_SPECS))
+
     def __init__(self, name: str, **kwargs) -> None:
+        kwargs.setdefault("enable_logger_service", True)
         super().__init__(name, **kwargs)
         refuse_unknown_parameters(self)
         self.cfg = values_of(PublishParams, declare(self, PUBLISH_SPECS))
@@ -45,6 +58,8 @@ class PassSourceNode(Node):
         # Passes taken by the slowest subscriber hosted in this process (set by wayside_monitor).
         self.consumed: Callable[[], int] | None = None
         self.left_out: dict[str, int] = {}
+        self._status: dict[str, dict[str, str]] = {}  # latest /diagnostics values, by status name
+        self.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, DIAGNOSTICS_QOS)
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
                                    "left out": sum(self.left_out.values()),
                                    **{f"left out: {why}": n for why, n in self.left_out.items()},
@@ -74,6 +89,10 @@ class PassSourceNode(Node):
             self.clock_pub.publish(Clock(clock=time_msg(max(ns, 0))))
 
     def _wait_for_subscribers(self, ok: Callable[[], bool]) -> None:
+        """Start-up handshake: wait for wait_for_subscribers train_pass subscribers, then (in
+        other processes) until the graph's endpoints in this namespace have stood still for
+        GRAPH_SETTLE_S: every consumer's publishers exist before it subscribes train_pass
+        (PassConsumerNode.listen), and a recorder has then subscribed what they publish."""
         want = self.cfg.wait_for_subscribers
         deadline = time.monotonic() + self.cfg.wait_timeout_s
         while self.pub.get_subscription_count() < want and ok():
@@ -81,6 +100,51 @@ class PassSourceNode(Node):
                 raise RailMonitorError(f"only {self.pub.get_subscription_count()} of {want} subscribers "
                                        f"on {self.pub.topic_name} after {self.cfg.wait_timeout_s:g} s")
             time.sleep(0.02)
+        if want == 0 or self.consumed is not None:  # nobody to wait for, or paced exactly in one process
+            return
+        last, since = self._endpoints(), time.monotonic()
+        while ok() and time.monotonic() - since < GRAPH_SETTLE_S and time.monotonic() < deadline:
+            time.sleep(0.05)
+            now = self._endpoints()
+            if now != last:
+                last, since = now, time.monotonic()
+
+    def _endpoints(self) -> list[tuple[str, int, int]]:
+        """(topic, publishers, subscribers) of every topic under this node's namespace."""
+        ns = self.get_namespace().rstrip("/") + "/"
+        return sorted((t, self.count_publishers(t), self.count_subscribers(t))
+                      for t, _ in self.get_topic_names_and_types() if t.startswith(ns))
+
+    def _wait_for_graph(self, published: int, ok: Callable[[], bool]) -> None:
+        """End-of-replay handshake (other processes): wait until every train_pass consumer that
+        reports on /diagnostics has taken every pass and has none pending, then until a recorder's
+        count has stood still for a diagnostics period, at most wait_timeout_s. A finite replay
+        that then exits (ros2 launch shuts down on it) leaves nothing in flight."""
+        deadline = time.monotonic() + self.cfg.wait_timeout_s
+        names = {f"{i.node_namespace.rstrip('/')}/{i.node_name}"
+                 for i in self.get_subscriptions_info_by_topic(self.pub.topic_name)}
+
+        def consumers_done() -> bool:
+            statuses = [self._status.get(n, {}) for n in names]
+            return all(int(v.get("taken", published)) >= published and v.get("pending", "0") == "0"
+                       for v in statuses)
+
+        while ok() and not consumers_done() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        recorded = None
+        while ok() and time.monotonic() < deadline:
+            now = tuple(self._status.get(n, {}).get("recorded") for n in sorted(names))
+            if now == recorded:
+                return
+            recorded = now
+            time.sleep(DIAGNOSTICS_PERIOD_S + 0.2)
+        if ok():
+            self.get_logger().warning(f"the graph did not settle within {self.cfg.wait_timeout_s:g} s of the "
+                                      "last pass; outputs may still be in flight")
+
+    def _on_diagnostics(self, msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            self._status[status.name] = {kv.key: kv.value for kv in status.values}
 
     def _throttle(self, published: int, ok: Callable[[], bool]) -> None:
         """Flow control: where the consumers share this process, wait until the slowest has taken
@@ -112,6 +176,8 @@ class PassSourceNode(Node):
         ok = ok or (lambda: rclpy.ok(context=self.context))
         table = self._window(self.passes())
         self.total = len(table)
+        announce(self, site=self.cfg.site_id, passes=len(table), rate=f"{self.cfg.rate:g}",
+                 wait_for_subscribers=self.cfg.wait_for_subscribers)
         self._wait_for_subscribers(ok)
         rate, frame = self.cfg.rate, self.cfg.site_id
         batch, period = self.cfg.ack_batch, self.cfg.clock_period_s
@@ -139,6 +205,8 @@ class PassSourceNode(Node):
                 if (i + 1) % batch == 0:
                     self._throttle(i + 1, ok)
             self._throttle(self.meter.count, ok)
+            if self.consumed is None and self.cfg.wait_for_subscribers > 0:
+                self._wait_for_graph(self.meter.count, ok)
         finally:
             bar.close()
         self.done.set()

@@ -50,6 +50,9 @@ class _Pending:
 
 
 class RollingNoisePredictor(PassConsumerNode):
+    EXECUTABLE = "rolling_noise_predictor"
+    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("noise.", NOISE_SPECS), ("", PREDICTOR_SPECS))
+
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("rolling_noise_predictor", **kwargs)
         cfg = noise_config(declare(self, NOISE_SPECS, prefix="noise."), prefix="")
@@ -62,6 +65,10 @@ class RollingNoisePredictor(PassConsumerNode):
         self.states_rejected: Counter[str] = Counter()
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
         subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch)
+        self.listen()
+
+    def key_parameters(self) -> dict[str, Any]:
+        return {"models": "+".join(self.model.models), "state_wait_s": f"{self.wait_s:g}"}
         wall_timer(self, 0.05, self._flush)
 
     def _on_states(self, msgs: list[CorrugationState]) -> None:
@@ -76,7 +83,9 @@ class RollingNoisePredictor(PassConsumerNode):
         self._flush()
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
-        wait = self.wait_s > 0 and self.count_publishers("corrugation/state") > 0
+        # Always wait (a separate estimator may not be discovered yet when the first pass comes);
+        # run without an estimator with state_wait_s:=0.
+        wait = self.wait_s > 0
         deadline = time.monotonic() + self.wait_s if wait else float("-inf")
         self.pending.extend(_Pending(table, i, msg, time_ns(msg.header.stamp), deadline) for i, msg in enumerate(msgs))
         self._flush()

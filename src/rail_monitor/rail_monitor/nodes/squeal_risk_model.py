@@ -23,11 +23,18 @@ from rail_msgs.msg import SquealPrediction, TrainPass
 
 
 class SquealRiskNode(PassConsumerNode):
+    EXECUTABLE = "squeal_risk_model"
+    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("squeal.", SQUEAL_SPECS))
+
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("squeal_risk_model", **kwargs)
         self.cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
         self.sent = Sent()
         self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
+        self.listen()
+
+    def key_parameters(self) -> dict[str, Any]:
+        return {"k3": self.cfg.k3_convention}
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         values = predict(self.cfg, self.site, table)

@@ -15,14 +15,23 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
+import rclpy
 from rclpy.executors import Executor, MultiThreadedExecutor, SingleThreadedExecutor
 from rclpy.node import Node
 
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE, MonitorParams
-from rail_monitor.core.params import values_of
+from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.nodes.alert_manager import AlertManagerNode
-from rail_monitor.nodes.base import declare, exit_code, refuse_unknown_parameters, ros_session, spin_guarded
+from rail_monitor.nodes.base import (
+    asked_for_help,
+    declare,
+    exit_code,
+    help_text,
+    refuse_unknown_parameters,
+    ros_session,
+    spin_guarded,
+)
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
@@ -46,7 +55,7 @@ class _Settings(Node):
     """Holds the process-level parameters (no topics)."""
 
     def __init__(self) -> None:
-        super().__init__("wayside_monitor")
+        super().__init__("wayside_monitor", enable_logger_service=True)
         refuse_unknown_parameters(self)
         self.cfg = values_of(MonitorParams, declare(self, (*MONITOR_SPECS, SOURCE)))
 
@@ -84,7 +93,7 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
                 executor.add_node(n)
             spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()), daemon=True)
             spinner.start()
-            return _replay(source, models, recorder, settings.cfg.drain_timeout_s, stop, t0)
+            return _replay(source, models, recorder, settings.cfg, stop, t0)
         finally:
             finished.set()
             if executor is not None:
@@ -100,21 +109,28 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
 
 
 def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode], recorder: McapRecorder | None,
-            timeout: float, stop: threading.Event, t0: float) -> MonitorResult:
+            cfg: MonitorParams, stop: threading.Event, t0: float) -> MonitorResult:
     """Replay every pass, wait until every model and the recorder took what was published, and
-    publish the advice on the final state."""
+    publish the advice on the final state. After SIGINT or SIGTERM the waits share
+    ``stop_timeout_s``: what is taken by then is recorded and the bag finished (no error)."""
     estimator, predictor, squeal, alerts = models
     if recorder is not None:
-        _wait(lambda: _outputs(models) <= set(recorder.counts), timeout,
+        _wait(lambda: _outputs(models) <= set(recorder.counts), cfg.drain_timeout_s,
               lambda: f"recorder did not subscribe to {sorted(_outputs(models) - set(recorder.counts))}")
     t_replay = time.monotonic()
     published = source.run(lambda: not stop.is_set() and source.context.ok())
-    _wait(lambda: all(m.taken >= published for m in models) and not predictor.pending, timeout,
-          lambda: f"models took {[m.taken for m in models]} of {published} passes")
-    _wait(lambda: alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
-          and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
-          and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name], timeout,
-          lambda: f"alert_manager took {dict(alerts.inputs)}")
+    stopping = stop.is_set()
+    deadline = time.monotonic() + (cfg.stop_timeout_s if stopping else cfg.drain_timeout_s)
+
+    def wait(done: Callable[[], bool], what: Callable[[], str]) -> None:
+        _wait(done, max(deadline - time.monotonic(), 0.0), what, raise_error=not stopping)
+
+    wait(lambda: all(m.taken >= published for m in models) and not predictor.pending,
+         lambda: f"models took {[m.taken for m in models]} of {published} passes")
+    wait(lambda: alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
+         and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
+         and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name],
+         lambda: f"alert_manager took {dict(alerts.inputs)}")
     estimator.publish_advisory()  # the advice on the final state
     recorded: dict[str, int] = {}
     bag = None
@@ -122,8 +138,8 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
         sent = {source.pub.topic_name: published}
         for m in models:
             sent.update(m.sent)
-        _wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
-              timeout, lambda: f"recorder got {dict(recorder.counts)} of {sent}")
+        wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
+             lambda: f"recorder got {dict(recorder.counts)} of {sent}")
         if recorder.writer.error:  # e.g. a full disk: say so now, not after the drain timeout
             raise RailMonitorError(recorder.writer.error)
     replay_s = time.monotonic() - t_replay
@@ -159,11 +175,15 @@ def _outputs(models: list[PassConsumerNode]) -> set[str]:
             if not p.topic_name.startswith(("/diagnostics", "/rosout", "/parameter_events"))}
 
 
-def _wait(done: Callable[[], bool], timeout_s: float, what: Callable[[], str]) -> None:
+def _wait(done: Callable[[], bool], timeout_s: float, what: Callable[[], str], raise_error: bool = True) -> None:
+    """Poll done() for at most timeout_s [s]; then RailMonitorError (or, stopping, a warning)."""
     deadline = time.monotonic() + timeout_s
     while not done():
         if time.monotonic() > deadline:
-            raise RailMonitorError(f"{what()} within {timeout_s:g} s")
+            if raise_error:
+                raise RailMonitorError(f"{what()} within {timeout_s:g} s")
+            rclpy.logging.get_logger("wayside_monitor").warning(f"stopping: {what()}; the bag keeps what it took")
+            return
         time.sleep(0.02)
 
 
@@ -173,7 +193,25 @@ def _make_executor(kind: str, threads: int) -> Executor:
     return MultiThreadedExecutor(num_threads=threads)
 
 
+def parameters() -> ParamGroups:
+    """Every parameter of the hosted nodes, each once (for --help)."""
+    seen: set[str] = set()
+    out = []
+    hosted = (McapRecorder, CorrugationEstimatorNode, RollingNoisePredictor, SquealRiskNode, AlertManagerNode,
+              PassReplayer, PassSimulator)
+    for prefix, specs in (("", (*MONITOR_SPECS, SOURCE)), *(g for cls in hosted for g in cls.PARAMETERS)):
+        new = tuple(s for s in specs if prefix + s.name not in seen)
+        seen |= {prefix + s.name for s in new}
+        if new:
+            out.append((prefix, new))
+    return tuple(out)
+
+
 def main(args: list[str] | None = None) -> int:
+    if asked_for_help(sys.argv if args is None else args):
+        print(help_text("wayside_monitor", __doc__, parameters()))
+        return 0
+
     def run() -> int:
         r = run_graph(args)
         print(f"wayside_monitor: {r.published} passes through the graph in {r.wall_s:.1f} s "
