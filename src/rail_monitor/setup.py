@@ -12,7 +12,7 @@ setup(
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
         (f"share/{package_name}", ["package.xml"]),
-        (f"share/{package_name}/config", glob("config/*.yaml") + glob("config/*.xml")),
+        (f"share/{package_name}/config", glob("config/*.yaml") + glob("config/*.xml") + glob("config/*.json")),
         (f"share/{package_name}/launch", glob("launch/*.py")),
     ],
     install_requires=["setuptools"],
@@ -30,6 +30,7 @@ setup(
             "corrugation_estimator = rail_monitor.nodes.corrugation_estimator:main",
             "rolling_noise_predictor = rail_monitor.nodes.rolling_noise_predictor:main",
             "alert_manager = rail_monitor.nodes.alert_manager:main",
+            "foxglove_server = rail_monitor.nodes.foxglove_server:main",
             "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
             "rail-monitor = rail_monitor.cli:main",
         ],

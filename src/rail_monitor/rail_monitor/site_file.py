@@ -40,7 +40,8 @@ SECTIONS: tuple[tuple[str, tuple[ParamSpec, ...]], ...] = (
     ("alerts.", ALERT_SPECS), ("stamps.", node_params.STAMP_SPECS), ("", SIMULATOR_SPECS),
     *(("", specs) for specs in (node_params.PUBLISH_SPECS, node_params.REPLAYER_SPECS, node_params.MODE_SPECS,
                                 node_params.RECORDER_SPECS, node_params.MONITOR_SPECS, node_params.BATCH_SPECS,
-                                node_params.ESTIMATOR_SPECS, node_params.PREDICTOR_SPECS)),
+                                node_params.ESTIMATOR_SPECS, node_params.PREDICTOR_SPECS,
+                                node_params.FOXGLOVE_SPECS)),
 )
 # Parameters every rclpy node has, which a parameter file may set too.
 ROS_PARAMETERS = ("use_sim_time", "start_type_description_service")

@@ -20,7 +20,9 @@ PUBLISH_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("publish_clock", True, "Publish /clock with pass time (nodes use use_sim_time)."),
     ParamSpec("clock_period_s", 0.1, "Wall time between /clock ticks while waiting for the next pass [s].",
               0.001, 60.0),
-    ParamSpec("wait_for_subscribers", 0, "Wait for this many train_pass subscribers before starting [-].", 0, 1000),
+    ParamSpec("wait_for_subscribers", 1, "Wait for this many train_pass subscribers (then for the graph to settle) "
+              "before the first pass, and at the end for them to take every pass; 1: a recorder or one model "
+              "started first loses nothing; 0: start at once [-].", 0, 1000),
     ParamSpec("wait_timeout_s", 30.0, "Give up waiting for subscribers after this [s].", 0.0, 3600.0),
     ParamSpec("ack_batch", 100, "Passes published between flow-control checks (below the publisher's "
               "QoS depth of 1000) [-].", 1, 999),
@@ -56,6 +58,9 @@ MODE_SPECS: tuple[ParamSpec, ...] = (
 STOP_TIMEOUT = ParamSpec("stop_timeout_s", 5.0, "After SIGINT or SIGTERM: the longest wait for messages already "
                          "sent before the bag is finished and the process exits [s].", 0.0, 300.0)
 
+# The recorder and the Foxglove server: how often they look for new topics.
+DISCOVERY_PERIOD = ParamSpec("discovery_period_s", 0.2, "How often to look for new topics [s].", 0.01, 60.0)
+
 # mcap_recorder.
 RECORDER_SPECS: tuple[ParamSpec, ...] = (
     STOP_TIMEOUT,
@@ -76,7 +81,17 @@ RECORDER_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("log_time", "receive", "Log time of a message: receive = the node clock at receipt, as rosbag2 "
               "records (pass time on sim time), header = its header.stamp (messages without one take the clock).",
               choices=("receive", "header")),
-    ParamSpec("discovery_period_s", 0.2, "How often to look for new topics [s].", 0.01, 60.0),
+    DISCOVERY_PERIOD,
+)
+
+
+# foxglove_server: the live view.
+FOXGLOVE_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("host", "127.0.0.1", "Address the Foxglove WebSocket server listens on (0.0.0.0: every interface)."),
+    ParamSpec("port", 8765, "Its TCP port; 0: any free port (stated in the start-up line) [-].", 0, 65535),
+    ParamSpec("topics", [""], "Topics to serve (absolute or relative to the namespace); empty: every rail_msgs "
+              "topic and /diagnostics."),
+    DISCOVERY_PERIOD,
 )
 
 
@@ -137,5 +152,6 @@ RecorderParams = values_type("RecorderParams", RECORDER_SPECS, "mcap_recorder's 
 MonitorParams = values_type("MonitorParams", (*MONITOR_SPECS, SOURCE), "wayside_monitor's process parameters.",
                             __name__)
 StampParams = values_type("StampParams", STAMP_SPECS, "The stamp plausibility margins.", __name__)
+FoxgloveParams = values_type("FoxgloveParams", FOXGLOVE_SPECS, "foxglove_server's parameters.", __name__)
 EstimatorParams = values_type("EstimatorParams", ESTIMATOR_SPECS, "corrugation_estimator's own parameters.",
                               __name__)

@@ -20,7 +20,6 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticStatus
-from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
 from rclpy.executors import Executor
 from rclpy.node import Node
 from rclpy.qos import QoSProfile
@@ -39,20 +38,15 @@ from rail_monitor.nodes.base import (
     refuse_unknown_parameters,
     run_node,
     spin_once_guarded,
-    subscribe_batched,
     wall_timer,
 )
-from rail_monitor.nodes.qos import qos_to_dict, subscription_qos
-
-DEFAULT_TYPES_PREFIX = "rail_msgs/"
-DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
-
+from rail_monitor.nodes.qos import qos_to_dict
+from rail_monitor.nodes.topic_tap import TopicTap
 
 
 class McapRecorder(Node):
     EXECUTABLE = "mcap_recorder"
     PARAMETERS = (("", RECORDER_SPECS),)
-    take_at_once = 500  # most queued messages of a topic one callback takes (a burst costs fewer wake-ups)
 
     def __init__(self, **kwargs) -> None:
         kwargs.setdefault("enable_logger_service", True)
@@ -66,27 +60,23 @@ class McapRecorder(Node):
             max_file_duration_ns=int(self.cfg.max_bag_duration_s * NS_PER_S),
             flush_wall_period_s=self.cfg.flush_period_s, max_total_bytes=self.cfg.max_total_bytes,
             max_age_ns=int(self.cfg.max_age_s * NS_PER_S))
-        wanted = [t for t in self.cfg.topics if t]
-        self._wanted = {self.resolve_topic_name(t) for t in wanted} if wanted else None
         self._lock = threading.Lock()
-        self._group = MutuallyExclusiveCallbackGroup()
-        self._subs: dict[str, object] = {}
         self._has_header: dict[str, bool] = {}
         self.counts: dict[str, int] = {}
         self.meter = RateMeter()
-        wall_timer(self, self.cfg.discovery_period_s, self.discover, callback_group=self._group)
-        wall_timer(self, max(self.cfg.flush_period_s, 0.05), self._flush, callback_group=self._group)
+        self.tap = TopicTap(self, self.cfg.topics, self.cfg.discovery_period_s, self._add_topic, self._on_messages)
+        wall_timer(self, max(self.cfg.flush_period_s, 0.05), self._flush, callback_group=self.tap.group)
         self.dropped = 0  # messages not recorded after a write error
         self.refused: Counter[str] = Counter()  # messages that could not be written, by cause
         self.diagnostics = Diagnostics(
             self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
-                           "topics": len(self._subs), "bag": str(self.writer.folder),
+                           "topics": len(self.tap.subs), "bag": str(self.writer.folder),
                            "not recorded (write failed)": self.dropped, "write error": self.writer.error,
                            **{f"refused: {why}": n for why, n in sorted(self.refused.items())},
                            **self._health()},
             level=lambda: (DiagnosticStatus.ERROR, self.writer.error) if self.writer.error
             else (DiagnosticStatus.OK, "ok"))
-        self.discover()
+        self.tap.discover()
         announce(self, bag=self.writer.folder, log_time=self.cfg.log_time, compression=self.cfg.compression,
                  max_bag_size=self.cfg.max_bag_size, max_total_bytes=self.cfg.max_total_bytes)
 
@@ -94,33 +84,12 @@ class McapRecorder(Node):
         with self._lock:
             return self.writer.health()
 
-    def _want(self, topic: str, types: list[str]) -> bool:
-        if self._wanted is not None:
-            return topic in self._wanted
-        return any(t.startswith(DEFAULT_TYPES_PREFIX) or t == DIAGNOSTICS_TYPE for t in types)
-
-    def discover(self) -> None:
-        """Subscribe to every wanted topic that has appeared, with a QoS its publishers accept."""
-        for topic, types in self.get_topic_names_and_types():
-            if topic in self._subs or not self._want(topic, types):
-                continue
-            if len(types) != 1:
-                self.get_logger().warning(f"{topic} has several types {types}; not recorded")
-                self._subs[topic] = None
-                continue
-            offered: list[QoSProfile] = [i.qos_profile for i in self.get_publishers_info_by_topic(topic)]
-            if not offered:
-                continue  # only subscribers so far: wait for a publisher to learn its QoS
-            typename = types[0]
-            msg_type = _import_type(typename)
-            with self._lock:
-                self.writer.add_topic(topic, typename, [qos_to_dict(q) for q in offered])
-                self.counts[topic] = 0
-                self._has_header[topic] = starts_with_header(typename)
-            self._subs[topic] = subscribe_batched(
-                self, msg_type, topic, lambda msgs, t=topic: self._on_messages(t, msgs), subscription_qos(offered),
-                self.take_at_once, raw=True, callback_group=self._group)
-            self.get_logger().info(f"recording {topic} [{typename}]")
+    def _add_topic(self, topic: str, typename: str, offered: list[QoSProfile]) -> None:
+        with self._lock:
+            self.writer.add_topic(topic, typename, [qos_to_dict(q) for q in offered])
+            self.counts[topic] = 0
+            self._has_header[topic] = starts_with_header(typename)
+        self.get_logger().info(f"recording {topic} [{typename}]")
 
     def _on_messages(self, topic: str, msgs: list[bytes]) -> None:
         for data in msgs:
@@ -185,15 +154,6 @@ class McapRecorder(Node):
             folder = self.writer.close()  # RailMonitorError after a write error: run_node exits 2
         self.get_logger().info(f"bag {folder}: {self.meter.count} messages")
         return folder
-
-
-def _import_type(typename: str) -> type:
-    pkg, kind, name = typename.split("/")
-    try:
-        module = __import__(f"{pkg}.{kind}", fromlist=[name])
-        return getattr(module, name)
-    except (ImportError, AttributeError):
-        raise RailMonitorError(f"message type {typename} is not installed") from None
 
 
 def main(args: list[str] | None = None) -> int:

@@ -1,0 +1,77 @@
+"""Taking the graph's topics serialised, as they appear: what the recorder and the Foxglove server share.
+
+A tap looks for topics every ``period_s`` (every rail_msgs type and /diagnostics, or the topics
+named), subscribes each once a publisher shows its QoS (with a profile every publisher accepts,
+as rosbag2 adapts it), and hands the serialised messages (CDR bytes, no decode) on in batches.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+
+from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.node import Node
+from rclpy.qos import QoSProfile
+
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.nodes.base import subscribe_batched, wall_timer
+from rail_monitor.nodes.qos import subscription_qos
+
+DEFAULT_TYPES_PREFIX = "rail_msgs/"
+DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
+TAKE_AT_ONCE = 500  # most queued messages of a topic one callback takes (a burst costs fewer wake-ups)
+
+
+class TopicTap:
+    """Subscribe node to every wanted topic as it appears.
+
+    topics: names (absolute or relative to the node's namespace); empty: every rail_msgs topic
+    and /diagnostics. on_topic(topic, typename, offered QoS) runs once per topic before its first
+    message; on_messages(topic, [CDR bytes]) per batch taken.
+    """
+
+    def __init__(self, node: Node, topics: list[str], period_s: float,
+                 on_topic: Callable[[str, str, list[QoSProfile]], None],
+                 on_messages: Callable[[str, list[bytes]], None]) -> None:
+        self.node = node
+        wanted = [t for t in topics if t]
+        self._wanted = {node.resolve_topic_name(t) for t in wanted} if wanted else None
+        self._on_topic, self._on_messages = on_topic, on_messages
+        self.group = MutuallyExclusiveCallbackGroup()
+        self.subs: dict[str, object] = {}
+        wall_timer(node, period_s, self.discover, callback_group=self.group)
+
+    def _want(self, topic: str, types: list[str]) -> bool:
+        if self._wanted is not None:
+            return topic in self._wanted
+        return any(t.startswith(DEFAULT_TYPES_PREFIX) or t == DIAGNOSTICS_TYPE for t in types)
+
+    def discover(self) -> None:
+        """Subscribe to every wanted topic that has appeared, with a QoS its publishers accept."""
+        node = self.node
+        for topic, types in node.get_topic_names_and_types():
+            if topic in self.subs or not self._want(topic, types):
+                continue
+            if len(types) != 1:
+                node.get_logger().warning(f"{topic} has several types {types}; not taken")
+                self.subs[topic] = None
+                continue
+            offered: list[QoSProfile] = [i.qos_profile for i in node.get_publishers_info_by_topic(topic)]
+            if not offered:
+                continue  # only subscribers so far: wait for a publisher to learn its QoS
+            typename = types[0]
+            msg_type = import_type(typename)
+            self._on_topic(topic, typename, offered)
+            self.subs[topic] = subscribe_batched(
+                node, msg_type, topic, lambda msgs, t=topic: self._on_messages(t, msgs), subscription_qos(offered),
+                TAKE_AT_ONCE, raw=True, callback_group=self.group)
+
+
+def import_type(typename: str) -> type:
+    """The rclpy message class of 'pkg/msg/Name'; RailMonitorError when it is not installed."""
+    pkg, _, name = typename.split("/")
+    try:
+        return getattr(importlib.import_module(f"{pkg}.msg"), name)
+    except (ImportError, AttributeError):
+        raise RailMonitorError(f"message type {typename} is not installed") from None
