@@ -22,6 +22,7 @@ from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.nodes.topic_tap import TAKE_AT_ONCE
 from rail_msgs.msg import (
     CorrugationState,
     RollingNoise,
@@ -120,6 +121,6 @@ def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
              for out in r.noise.values()]
     squeal = to_msg(SquealPrediction, fields.squeal_prediction_fields(r.squeal, 0, first["header"], first["train_id"]))
     recorder = type("CountingRecorder", (_CountingRecorder,),
-                    {"take_at_once": McapRecorder.take_at_once if max_batch > 1 else 1})
+                    {"take_at_once": TAKE_AT_ONCE if max_batch > 1 else 1})
     return (lambda: [_Estimator(state, max_batch), _Noise(noise, max_batch), _Squeal(squeal, max_batch),
                      _Alerts(max_batch)]), recorder

@@ -104,10 +104,13 @@ def main() -> None:
     t, rss, size = (np.array(c) for c in zip(*samples, strict=True))
     warm = t >= min(5.0, t[-1] / 3)  # after start-up and the first splits
     slope = np.polyfit(t[warm], rss[warm], 1)[0] if warm.sum() > 2 else float("nan")
+    late = t >= 2 * t[-1] / 3  # the noise predictor's 10,000 kept states fill in the first 17 min at 10/s
+    late_slope = np.polyfit(t[late], rss[late], 1)[0] if late.sum() > 2 else float("nan")
     rows = [("run", f"{wall_min:.1f} min", f"exit {rc}; {len(errors)} error lines"),
             ("passes per second asked", f"{ns.passes_per_s:g}", "every topic recorded"),
             ("RSS after warm-up / at the end", f"{rss[warm][0]:.0f} / {rss[-1]:.0f} MB",
-             f"trend {slope:+.2f} MB/min over {t[warm][-1] - t[warm][0]:.1f} min; peak {rss.max():.0f} MB"),
+             f"trend {slope:+.2f} MB/min over {t[warm][-1] - t[warm][0]:.1f} min, {late_slope:+.2f} MB/min over "
+             f"the last third; peak {rss.max():.0f} MB"),
             ("bag on disk, largest sample / budget", f"{size.max() / 2**20:.2f} / {ns.budget_mib:g} MiB",
              f"final {final / 2**20:.2f} MiB; {len(samples)} samples, every {ns.sample_s:g} s"),
             ("kept files", f"{files}", f"{messages:,} messages read by rosbags through metadata.yaml; "

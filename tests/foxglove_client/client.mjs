@@ -48,8 +48,11 @@ client.on("message", ({ subscriptionId, data }) => {
   }
 });
 client.on("error", (e) => { console.error(`client error: ${e}`); });
-setTimeout(() => {
+// The summary at the end: after SECONDS, or at once on SIGINT (the test's "the graph is done").
+function finish() {
   console.log(JSON.stringify({ server, topics }, (_, v) => (typeof v === "bigint" ? Number(v) : v)));
   client.close();
   process.exit(0);
-}, seconds * 1000);
+}
+setTimeout(finish, seconds * 1000);
+process.on("SIGINT", finish);

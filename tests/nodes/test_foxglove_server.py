@@ -48,7 +48,7 @@ def test_foxglove_client_receives_and_decodes_every_topic_of_the_running_graph(f
     try:
         assert wait_until(lambda: "url=ws://" in log.read_text(), 30), log.read_text()[-2000:]
         url = re.search(r"url=(ws://\S+)", log.read_text()).group(1)
-        client = subprocess.Popen(["node", str(foxglove_client), url, "25"], cwd=CLIENT, stdout=subprocess.PIPE,
+        client = subprocess.Popen(["node", str(foxglove_client), url, "300"], cwd=CLIENT, stdout=subprocess.PIPE,
                                   stderr=subprocess.PIPE, text=True)
         time.sleep(2.0)  # connected before the graph starts
         # six train_pass subscribers: the four models, the recorder and the live view
@@ -56,6 +56,8 @@ def test_foxglove_client_receives_and_decodes_every_topic_of_the_running_graph(f
                     str(5 * 86400.0), "--no-report", "--no-progress", "--ros-args", "-p", "wait_for_subscribers:=6",
                     timeout=180)
         assert r.returncode == 0, r.stderr[-2000:]
+        time.sleep(2.0)  # the last messages on their way to the client
+        client.send_signal(2)
         out, err = client.communicate(timeout=60)
     finally:
         server.send_signal(2)

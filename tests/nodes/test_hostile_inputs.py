@@ -26,14 +26,16 @@ from hypothesis import strategies as st
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rosgraph_msgs.msg import Clock
 
 from rail_monitor.core.passes import PassTable, with_class_defaults
 from rail_monitor.core.site import site_from_values
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.nodes.alert_manager import AlertManagerNode
+from rail_monitor.nodes.convert import time_msg
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
-from rail_monitor.nodes.qos import DIAGNOSTICS_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, STREAM_QOS, STREAM_SUB_QOS
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 from rail_monitor.site_file import load_parameter_file
@@ -174,6 +176,9 @@ def graph():
     nodes = [est_node, RollingNoisePredictor(context=ctx, namespace=NS, parameter_overrides=[
         *params, Parameter("state_wait_s", value=0.2)]), SquealRiskNode(**kw), AlertManagerNode(**kw)]
     probe = Node("hostile_source", context=ctx, namespace=NS)
+    # Pass time for the nodes on sim time (they publish diagnostics once a clock runs).
+    clock = probe.create_publisher(Clock, "/clock", CLOCK_QOS)
+    probe.create_timer(0.1, lambda: clock.publish(Clock(clock=time_msg(_T0 * 10**9))))
     site = site_from_values(VALUES)
     g = Graph(nodes, est_node, probe.create_publisher(TrainPass, "train_pass", STREAM_QOS),
               CorrugationEstimator(site, corrugation_config(VALUES)), {})

@@ -85,7 +85,8 @@ def test_replayer_to_recorder_round_trip(tmp_path: Path, ros_context):
     assert ch.metadata["topic_type_hash"] == type_hash(TRAIN_PASS)
     qos = yaml.safe_load(ch.metadata["offered_qos_profiles"])
     # as discovered from the replayer's publisher (history and depth are not shared by DDS)
-    assert (qos[0]["reliability"], qos[0]["durability"], qos[0]["history"]) == ("reliable", "volatile", "unknown")
+    assert (qos[0]["reliability"], qos[0]["durability"], qos[0]["history"]) == ("reliable", "transient_local",
+                                                                              "unknown")
 
 
 def test_csv_replay(tmp_path: Path, ros_context):
@@ -104,7 +105,8 @@ def test_timed_replay_publishes_clock_on_pass_time(tmp_path: Path, ros_context):
     ticks: list[int] = []
     listener.create_subscription(Clock, "/clock", lambda m: ticks.append(m.clock.sec * 10**9 + m.clock.nanosec), 100)
     rep = PassReplayer(context=ros_context, parameter_overrides=_params(
-        source=str(SAMPLE), progress=False, end_offset_s=2 * 86400.0, rate=2 * 86400.0, clock_period_s=0.02))
+        source=str(SAMPLE), progress=False, end_offset_s=2 * 86400.0, rate=2 * 86400.0, clock_period_s=0.02,
+        wait_for_subscribers=0))  # only /clock is listened to
     ex = SingleThreadedExecutor(context=ros_context)
     ex.add_node(listener)
     ex.add_node(rep)

@@ -134,9 +134,9 @@ def test_recorded_log_times_are_receive_times_on_pass_time_never_1970(tmp_path: 
     first, last = int(passes.stamp_ns[0]), int(passes.stamp_ns[0]) + int(float(FIVE_DAYS) * 1e9)
     with AnyReader([tmp_path / "lt"]) as reader:
         times = {c.topic: [t for _, t, _ in reader.messages(connections=[c])] for c in reader.connections}
-    assert {"/curve_250/train_pass", "/diagnostics", "/curve_250/alerts/standing"} <= set(times)
-    for topic, ts in times.items():
-        assert ts and first <= min(ts) and max(ts) <= last, (topic, min(ts), max(ts))
+    assert times["/curve_250/train_pass"] and times["/curve_250/alerts/standing"]
+    for topic, ts in times.items():  # a topic may have no message yet (/diagnostics ticks once a second)
+        assert not ts or (first <= min(ts) and max(ts) <= last), (topic, min(ts), max(ts))
     pass_times = times["/curve_250/train_pass"]
     assert pass_times == sorted(pass_times)  # receipt order is pass order
 

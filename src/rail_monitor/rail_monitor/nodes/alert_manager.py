@@ -61,14 +61,14 @@ class AlertManagerNode(PassConsumerNode):
                                              (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS),
                                              (CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS)):
             subscribe_batched(self, msg_type, topic, handle, qos, self.max_batch)
+        # The initial (empty) standing set for late subscribers, once the clock runs: a message
+        # stamped 0 before the first /clock would stretch a bag's timeline back to 1970.
+        self._initial = wall_timer(self, 0.1, self._publish_initial_standing)
         self.listen()
 
     def key_parameters(self) -> dict[str, Any]:
         c = self.alerts.cfg
         return {"noise": f"{c.noise_metric}>{c.noise_limit_dba:g} dB(A)", "squeal_window": c.squeal_window_passes}
-        # The initial (empty) standing set for late subscribers, once the clock runs: a message
-        # stamped 0 before the first /clock would stretch a bag's timeline back to 1970.
-        self._initial = wall_timer(self, 0.1, self._publish_initial_standing)
 
     def on_validated(self, table: PassTable, reasons: list[str]) -> None:
         self._emit(self.alerts.on_train_passes(table.stamp_ns, np.array([bool(r) for r in reasons])))

@@ -62,13 +62,13 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
         self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
+        self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
+        wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
         self.listen()
 
     def key_parameters(self) -> dict[str, Any]:
         return {"checkpoint": self.checkpoint or "none", "passes": self.est.total_pass_count,
                 "lead_time_days": f"{self.est.cfg.lead_time_days:g}"}
-        self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
-        wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         # The state and forecast after each counted pass, as advancing one pass at a time gives them.

@@ -60,7 +60,7 @@ class McapRecorder(Node):
             max_file_duration_ns=int(self.cfg.max_bag_duration_s * NS_PER_S),
             flush_wall_period_s=self.cfg.flush_period_s, max_total_bytes=self.cfg.max_total_bytes,
             max_age_ns=int(self.cfg.max_age_s * NS_PER_S))
-        self._lock = threading.Lock()
+        self._lock = threading.RLock()  # a write failure publishes diagnostics, which read the writer
         self._has_header: dict[str, bool] = {}
         self.counts: dict[str, int] = {}
         self.meter = RateMeter()

@@ -55,8 +55,10 @@ class PassSourceNode(Node):
         self.total = 0
         self.last_stamp_ns = 0
         self.done = threading.Event()
-        # Passes taken by the slowest subscriber hosted in this process (set by wayside_monitor).
+        # Passes taken by the slowest subscriber hosted in this process (set by wayside_monitor), and
+        # whether subscribers in other processes are expected too (a live view): then the graph settles.
         self.consumed: Callable[[], int] | None = None
+        self.foreign_subscribers = False
         self.left_out: dict[str, int] = {}
         self._status: dict[str, dict[str, str]] = {}  # latest /diagnostics values, by status name
         self.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, DIAGNOSTICS_QOS)
@@ -100,8 +102,8 @@ class PassSourceNode(Node):
                 raise RailMonitorError(f"only {self.pub.get_subscription_count()} of {want} subscribers "
                                        f"on {self.pub.topic_name} after {self.cfg.wait_timeout_s:g} s")
             time.sleep(0.02)
-        if want == 0 or self.consumed is not None:  # nobody to wait for, or paced exactly in one process
-            return
+        if want == 0 or (self.consumed is not None and not self.foreign_subscribers):
+            return  # nobody to wait for, or only the consumers hosted here (paced exactly)
         last, since = self._endpoints(), time.monotonic()
         while ok() and time.monotonic() - since < GRAPH_SETTLE_S and time.monotonic() < deadline:
             time.sleep(0.05)

@@ -65,11 +65,11 @@ class RollingNoisePredictor(PassConsumerNode):
         self.states_rejected: Counter[str] = Counter()
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
         subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch)
+        wall_timer(self, 0.05, self._flush)
         self.listen()
 
     def key_parameters(self) -> dict[str, Any]:
         return {"models": "+".join(self.model.models), "state_wait_s": f"{self.wait_s:g}"}
-        wall_timer(self, 0.05, self._flush)
 
     def _on_states(self, msgs: list[CorrugationState]) -> None:
         for msg in msgs:

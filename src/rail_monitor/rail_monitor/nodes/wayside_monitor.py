@@ -85,8 +85,9 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
             nodes += ([recorder] if recorder is not None else []) + models
             source = PassReplayer() if settings.cfg.source else PassSimulator()
             nodes.append(source)
-            wanted = max(source.cfg.wait_for_subscribers, len(models) + (recorder is not None))
-            source.cfg = replace(source.cfg, wait_for_subscribers=wanted)
+            hosted = len(models) + (recorder is not None)
+            source.foreign_subscribers = source.cfg.wait_for_subscribers > hosted
+            source.cfg = replace(source.cfg, wait_for_subscribers=max(source.cfg.wait_for_subscribers, hosted))
             source.consumed = _passes_through(models, recorder, source.pub.topic_name)
             executor = _make_executor(settings.cfg.executor, settings.cfg.threads)
             for n in nodes:
