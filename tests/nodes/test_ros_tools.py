@@ -64,6 +64,8 @@ def test_alert_limits_are_tuned_on_a_running_node_and_bad_values_refused(ros_con
         assert not bad.successful and "needs hysteresis" in bad.reason and node.alerts.cfg.noise_clear_count == 0
         (out_of_range,) = _set(client, **{"alerts.squeal_raise_share": 1.5})
         assert not out_of_range.successful and node.alerts.cfg.squeal_raise_share == 0.2
+        (quieter,) = _set(client, log_throttle_s=60.0)
+        assert quieter.successful and node.log_throttle_s == 60.0
         (read_only,) = _set(client, **{"max_batch": 5})  # not a runtime parameter
         assert not read_only.successful and node.max_batch == 200
         # the logger-level service of every node

@@ -112,6 +112,8 @@ MONITOR_SPECS: tuple[ParamSpec, ...] = (
 BATCH_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("max_batch", 200, "Most queued train passes a callback takes and handles at once (1: one by one) [-].",
               1, 10_000),
+    ParamSpec("log_throttle_s", 5.0, "Least time between two log lines of one kind about bad input (rejected "
+              "passes, refused messages); may be changed while the node runs [s].", 0.0, 3600.0, tunable=True),
 )
 
 

@@ -83,7 +83,7 @@ class AlertManagerNode(PassConsumerNode):
                 ok.append(m)
                 continue
             self.inputs[f"{topic} refused: {why}"] += 1
-            self.get_logger().warning(f"{topic} message refused: {why}", throttle_duration_sec=5.0)
+            self.get_logger().warning(f"{topic} message refused: {why}", throttle_duration_sec=self.log_throttle_s)
         return ok
 
     def _on_squeal(self, msgs: list[SquealPrediction]) -> None:

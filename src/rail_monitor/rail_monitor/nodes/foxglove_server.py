@@ -11,8 +11,8 @@ Foxglove SDK's (foxglove-sdk); this node only feeds it. Open Foxglove, connect t
 
 from __future__ import annotations
 
+import queue
 import sys
-import threading
 import time
 from collections import Counter
 
@@ -20,11 +20,20 @@ import foxglove
 from rclpy.node import Node
 from rclpy.qos import QoSProfile
 
+from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.bagio.typestore import schema_text
 from rail_monitor.core.node_params import FOXGLOVE_SPECS, FoxgloveParams
 from rail_monitor.core.params import values_of
-from rail_monitor.nodes.base import Diagnostics, RateMeter, announce, declare, refuse_unknown_parameters, run_node
-from rail_monitor.nodes.topic_tap import TopicTap
+from rail_monitor.nodes.base import (
+    Diagnostics,
+    RateMeter,
+    announce,
+    declare,
+    refuse_unknown_parameters,
+    run_node,
+    wall_timer,
+)
+from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TopicTap
 
 
 class FoxgloveServer(Node):
@@ -39,36 +48,52 @@ class FoxgloveServer(Node):
         self.fg = foxglove.Context()
         self.channels: dict[str, foxglove.Channel] = {}
         self.latest: dict[str, tuple[bytes, int]] = {}  # per topic: the last message and its log time
-        self._lock = threading.Lock()
+        # Topics a client has just subscribed, from the server's thread: their latest message is
+        # logged from this node's own callbacks (the SDK is never called back from its own thread).
+        self._subscribed: queue.SimpleQueue[str] = queue.SimpleQueue()
         self.server = foxglove.start_server(name=f"rail_monitor {self.get_namespace()}", host=self.cfg.host,
                                             port=self.cfg.port, context=self.fg, supported_encodings=["cdr"],
                                             server_listener=_SendLatest(self))
         self.counts: Counter[str] = Counter()
         self.meter = RateMeter()
+        # The graph's own topics get their channels at once, before any client connects: a channel
+        # advertised while a client is subscribing can be missed by it (seen with the SDK's server).
+        wanted = {self.resolve_topic_name(t) for t in self.cfg.topics if t}
+        for name, (typename, _) in (*GRAPH_TOPICS.items(), ("/diagnostics", (DIAGNOSTICS_TYPE, None))):
+            topic = self.resolve_topic_name(name)
+            if not wanted or topic in wanted:
+                self._add_topic(topic, typename, [])
         self.tap = TopicTap(self, self.cfg.topics, self.cfg.discovery_period_s, self._add_topic, self._on_messages)
+        wall_timer(self, 0.05, self._send_latest, callback_group=self.tap.group)
         Diagnostics(self, lambda: {"served": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
                                    "channels": len(self.channels), "port": self.server.port})
         self.tap.discover()
         announce(self, url=f"ws://{self.cfg.host}:{self.server.port}")
 
     def _add_topic(self, topic: str, typename: str, offered: list[QoSProfile]) -> None:
+        if topic in self.channels:
+            return
         schema = foxglove.Schema(name=typename, encoding="ros2msg", data=schema_text(typename).encode())
         self.channels[topic] = foxglove.Channel(topic, schema=schema, message_encoding="cdr", context=self.fg)
 
     def _on_messages(self, topic: str, msgs: list[bytes]) -> None:
         channel = self.channels[topic]
         now = self.get_clock().now().nanoseconds or time.time_ns()  # receipt time; pass time on sim time
-        with self._lock:
-            for data in msgs:
-                channel.log(data, log_time=now)
-            self.latest[topic] = (msgs[-1], now)
+        for data in msgs:
+            channel.log(data, log_time=now)
+        self.latest[topic] = (msgs[-1], now)
         self.counts[topic] += len(msgs)
         self.meter.tick(len(msgs))
 
-    def send_latest(self, topic: str) -> None:
-        """Log a topic's latest message again (a client has just subscribed its channel)."""
-        with self._lock:
-            if topic in self.latest and topic in self.channels:
+    def subscribed(self, topic: str) -> None:
+        """A client has subscribed a channel (called from the server's thread)."""
+        self._subscribed.put(topic)
+
+    def _send_latest(self) -> None:
+        """Log again the latest message of each channel a client has just subscribed."""
+        while not self._subscribed.empty():
+            topic = self._subscribed.get()
+            if topic in self.latest:
                 data, stamp = self.latest[topic]
                 self.channels[topic].log(data, log_time=stamp)
 
@@ -83,7 +108,7 @@ class _SendLatest(foxglove.ServerListener):
         self.node = node
 
     def on_subscribe(self, client: foxglove.websocket.Client, channel: foxglove.websocket.ChannelView) -> None:
-        self.node.send_latest(channel.topic)
+        self.node.subscribed(channel.topic)
 
 
 def main(args: list[str] | None = None) -> int:

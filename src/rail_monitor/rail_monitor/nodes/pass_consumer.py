@@ -18,7 +18,9 @@ from typing import Any
 
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 
 from rail_monitor.bagio.messages import pass_row, time_ns
 from rail_monitor.core.node_params import BATCH_SPECS, STAMP_SPECS, StampParams
@@ -61,7 +63,9 @@ class PassConsumerNode(Node):
         self.last_pass_ns = 0
         self.margins = values_of(StampParams, declare(self, STAMP_SPECS, prefix="stamps."))
         self.stream_ns = 0  # newest pass taken: the reference of the stamp margin (a resumed state sets it)
-        self.max_batch = declare(self, BATCH_SPECS)["max_batch"]
+        batch = declare(self, BATCH_SPECS)
+        self.max_batch, self.log_throttle_s = batch["max_batch"], batch["log_throttle_s"]
+        self.add_on_set_parameters_callback(self._on_set_throttle)
         Diagnostics(self, self.diagnostic_values, level=self._level)
 
     def listen(self) -> None:
@@ -100,7 +104,15 @@ class PassConsumerNode(Node):
                 self._accept(with_class_defaults(table.take(run), self.site), msgs[run])
                 continue
             self.rejected[why] += 1
-            self.get_logger().warning(f"pass {msgs[run.start].train_id!r} rejected: {why}", throttle_duration_sec=5.0)
+            self.get_logger().warning(f"pass {msgs[run.start].train_id!r} rejected: {why}",
+                                      throttle_duration_sec=self.log_throttle_s)
+
+    def _on_set_throttle(self, params: list[Parameter]) -> SetParametersResult:
+        """ros2 param set log_throttle_s: rclpy has checked its type and range already."""
+        for p in params:
+            if p.name == "log_throttle_s":
+                self.log_throttle_s = float(p.value)
+        return SetParametersResult(successful=True)
 
     def _live_clock_ns(self) -> int | None:
         """The node's clock [ns] when it is not on sim time (the stamp margin's second reference)."""
@@ -124,7 +136,7 @@ class PassConsumerNode(Node):
         """Count and log a model raising on an accepted pass (diagnostics go to ERROR)."""
         why = f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"
         self.model_errors[why] += 1
-        self.get_logger().error(f"pass {msg.train_id!r}: model error {why}", throttle_duration_sec=5.0)
+        self.get_logger().error(f"pass {msg.train_id!r}: model error {why}", throttle_duration_sec=self.log_throttle_s)
 
     def diagnostic_values(self) -> dict[str, Any]:
         values: dict[str, Any] = {

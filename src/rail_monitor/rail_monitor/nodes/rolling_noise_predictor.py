@@ -77,7 +77,8 @@ class RollingNoisePredictor(PassConsumerNode):
                 corrugation = corrugation_from_msg(msg)
             except ValueError as exc:
                 self.states_rejected[str(exc)] += 1
-                self.get_logger().warning(f"corrugation state refused: {exc}", throttle_duration_sec=5.0)
+                self.get_logger().warning(f"corrugation state refused: {exc}",
+                                          throttle_duration_sec=self.log_throttle_s)
                 continue
             self.states.append((time_ns(msg.header.stamp), msg.last_train_id, corrugation))
         self._flush()
