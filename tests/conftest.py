@@ -122,7 +122,7 @@ def spinning(ctx, *nodes) -> Iterator[object]:
     """Spin nodes on a SingleThreadedExecutor in a background thread; shut it down on exit."""
     from rclpy.executors import SingleThreadedExecutor
 
-    from rail_monitor.nodes.base import spin_guarded
+    from rail_monitor.nodes.base import shut_down, spin_guarded
 
     ex = SingleThreadedExecutor(context=ctx)
     for node in nodes:
@@ -135,7 +135,7 @@ def spinning(ctx, *nodes) -> Iterator[object]:
         yield ex
     finally:
         done.set()
-        ex.shutdown(timeout_sec=2)
+        shut_down(ex, 2.0)
         spinner.join(timeout=5)
 
 

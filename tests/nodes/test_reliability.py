@@ -129,16 +129,34 @@ def test_every_bad_parameter_in_a_site_file_is_refused_naming_it_and_its_range(r
 
 
 # -- the recorder ---------------------------------------------------------------------------------
+_STARTED: list[subprocess.Popen] = []
+
+
+@pytest.fixture(autouse=True)
+def _no_process_left():
+    """Kill what a failed test left running: a later test on the same DDS domain must not meet it."""
+    yield
+    while _STARTED:
+        p = _STARTED.pop()
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+
+
 def _recorder(out: Path, log: Path, *extra: str) -> subprocess.Popen:
-    return subprocess.Popen(["mcap_recorder", "--ros-args", "-r", "__ns:=/site", "-p", f"output:={out}",
-                             "-p", "flush_period_s:=0.2", *extra], cwd=TOP, stdout=subprocess.DEVNULL,
-                            stderr=open(log, "w"))
+    with open(log, "w") as err:
+        p = subprocess.Popen(["mcap_recorder", "--ros-args", "-r", "__ns:=/site", "-p", f"output:={out}",
+                              "-p", "flush_period_s:=0.2", *extra], cwd=TOP, stdout=subprocess.DEVNULL, stderr=err)
+    _STARTED.append(p)
+    return p
 
 
 def _replayer(source: Path, *extra: str) -> subprocess.Popen:
-    return subprocess.Popen(["pass_replayer", "--ros-args", "-r", "__ns:=/site", "-p", f"source:={source}",
-                             "-p", "wait_for_subscribers:=1", "-p", "progress:=false", *extra],
-                            cwd=TOP, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(["pass_replayer", "--ros-args", "-r", "__ns:=/site", "-p", f"source:={source}",
+                          "-p", "wait_for_subscribers:=1", "-p", "progress:=false", *extra],
+                         cwd=TOP, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _STARTED.append(p)
+    return p
 
 
 class _RecorderDiagnostics:

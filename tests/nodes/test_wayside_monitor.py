@@ -215,8 +215,15 @@ def _graph_in_processes(runs, folder: Path, graph_host: tuple[str, ...] = (), re
     finally:
         for p in procs:
             p.send_signal(signal.SIGINT)
+        hung = []
         for p in procs:
-            p.wait(timeout=30)
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:  # never leave a process behind for later tests
+                hung.append(p.args[0])
+                p.kill()
+                p.wait()
+        assert not hung, f"did not stop within 30 s of SIGINT: {hung}"
     for p in PROCESSES:
         err = (folder / f"{p.executable}.log").read_text()
         assert "Traceback" not in err, err[-2000:]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import gc
 import signal
 import sys
 import threading
@@ -194,6 +195,18 @@ def spin_once_guarded(executor: Any, timeout_sec: float) -> bool:
     return executor.context.ok()
 
 
+def shut_down(executor: Any, timeout_sec: float) -> None:
+    """executor.shutdown, then a garbage collection before any node is destroyed.
+
+    rclpy's executor keeps a generator that may be suspended inside the block holding its
+    entities' handles (it yields a ready waitable, e.g. a QoS event, from there). Shutdown drops
+    it, but a reference cycle can keep it alive, and Node.destroy_node then waits for those handles
+    while holding the GIL, so no collection can ever free them: the process spins forever (seen
+    after SIGINT: 94 % of a core for 18 minutes). Collecting first closes the generator."""
+    executor.shutdown(timeout_sec=timeout_sec)
+    gc.collect()
+
+
 def spin_guarded(executor: Any, ok: Callable[[], bool], timeout_sec: float = 0.1) -> None:
     """Spin until ok() is False or the context shuts down, surviving any one callback's exception
     (:func:`spin_once_guarded`): the executor.spin of every executable (make ok() False before
@@ -366,7 +379,7 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
                         drain(executor)
             finally:
                 finished.set()
-                executor.shutdown(timeout_sec=1.0)
+                shut_down(executor, 1.0)
                 if spinner is not None and spinner.is_alive():  # leave no thread inside rcl at exit
                     spinner.join(timeout=5.0)
                 try:

@@ -30,6 +30,7 @@ from rail_monitor.nodes.base import (
     help_text,
     refuse_unknown_parameters,
     ros_session,
+    shut_down,
     spin_guarded,
 )
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
@@ -98,7 +99,7 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
         finally:
             finished.set()
             if executor is not None:
-                executor.shutdown(timeout_sec=2.0)
+                shut_down(executor, 2.0)
                 if spinner is not None and spinner.is_alive():
                     spinner.join(timeout=5.0)
             for n in reversed(nodes):
