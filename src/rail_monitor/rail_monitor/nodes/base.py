@@ -102,6 +102,16 @@ def refuse_unknown_parameters(node: Node) -> None:
     check_names({name: p.value for name, p in node._parameter_overrides.items()}, f"node {node.get_name()}: ")
 
 
+class RailNode(Node):
+    """The base of every rail_monitor node: the logger-level services on (as an operator expects
+    of a ROS 2 node), and a parameter given that no section knows refused at once."""
+
+    def __init__(self, name: str, **kwargs: Any) -> None:
+        kwargs.setdefault("enable_logger_service", True)
+        super().__init__(name, **kwargs)
+        refuse_unknown_parameters(self)
+
+
 def declare_site(node: Node) -> Site:
     """Declare the site parameters, the contact geometry, the track and the rolling-stock table, and build the Site."""
     flat = declare(node, SITE_SPECS)

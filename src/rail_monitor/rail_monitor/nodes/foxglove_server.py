@@ -17,7 +17,6 @@ import time
 from collections import Counter
 
 import foxglove
-from rclpy.node import Node
 from rclpy.qos import QoSProfile
 
 from rail_monitor.bagio.topics import GRAPH_TOPICS
@@ -26,24 +25,22 @@ from rail_monitor.core.node_params import FOXGLOVE_SPECS, FoxgloveParams
 from rail_monitor.core.params import values_of
 from rail_monitor.nodes.base import (
     Diagnostics,
+    RailNode,
     RateMeter,
     announce,
     declare,
-    refuse_unknown_parameters,
     run_node,
     wall_timer,
 )
 from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TopicTap
 
 
-class FoxgloveServer(Node):
+class FoxgloveServer(RailNode):
     EXECUTABLE = "foxglove_server"
     PARAMETERS = (("", FOXGLOVE_SPECS),)
 
     def __init__(self, **kwargs) -> None:
-        kwargs.setdefault("enable_logger_service", True)
         super().__init__("foxglove_server", **kwargs)
-        refuse_unknown_parameters(self)
         self.cfg = values_of(FoxgloveParams, declare(self, FOXGLOVE_SPECS))
         self.fg = foxglove.Context()
         self.channels: dict[str, foxglove.Channel] = {}

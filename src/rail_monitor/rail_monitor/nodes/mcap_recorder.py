@@ -21,7 +21,6 @@ from pathlib import Path
 
 from diagnostic_msgs.msg import DiagnosticStatus
 from rclpy.executors import Executor
-from rclpy.node import Node
 from rclpy.qos import QoSProfile
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
@@ -32,10 +31,10 @@ from rail_monitor.core.params import values_of
 from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import (
     Diagnostics,
+    RailNode,
     RateMeter,
     announce,
     declare,
-    refuse_unknown_parameters,
     run_node,
     spin_once_guarded,
     wall_timer,
@@ -44,14 +43,12 @@ from rail_monitor.nodes.qos import qos_to_dict
 from rail_monitor.nodes.topic_tap import TopicTap
 
 
-class McapRecorder(Node):
+class McapRecorder(RailNode):
     EXECUTABLE = "mcap_recorder"
     PARAMETERS = (("", RECORDER_SPECS),)
 
     def __init__(self, **kwargs) -> None:
-        kwargs.setdefault("enable_logger_service", True)
         super().__init__("mcap_recorder", **kwargs)
-        refuse_unknown_parameters(self)
         self.cfg = values_of(RecorderParams, declare(self, RECORDER_SPECS))
         out = self.cfg.output or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
         self.writer = McapBagWriter(

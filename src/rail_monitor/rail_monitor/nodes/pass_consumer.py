@@ -19,7 +19,6 @@ from typing import Any
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from rail_monitor.bagio.messages import pass_row, time_ns
@@ -30,12 +29,12 @@ from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.nodes.base import (
     SITE_PARAMETERS,
     Diagnostics,
+    RailNode,
     RateMeter,
     announce,
     declare,
     declare_site,
     isolate_failures,
-    refuse_unknown_parameters,
     runs,
     subscribe_batched,
 )
@@ -43,7 +42,7 @@ from rail_monitor.nodes.qos import STREAM_SUB_QOS
 from rail_msgs.msg import TrainPass
 
 
-class PassConsumerNode(Node):
+class PassConsumerNode(RailNode):
     """Takes ``train_pass``; subclasses implement :meth:`on_passes` for accepted passes and call
     :meth:`listen` at the end of their ``__init__``, once their publishers exist: a node's outputs
     are visible in the graph before it takes its first pass (the pass source's start-up wait
@@ -52,9 +51,7 @@ class PassConsumerNode(Node):
     PARAMETERS: ParamGroups = (*SITE_PARAMETERS, ("", BATCH_SPECS), ("stamps.", STAMP_SPECS))
 
     def __init__(self, name: str, **kwargs: Any) -> None:
-        kwargs.setdefault("enable_logger_service", True)
         super().__init__(name, **kwargs)
-        refuse_unknown_parameters(self)
         self.site = declare_site(self)
         self.taken = 0  # train_pass messages handled (the pass source's flow control reads it)
         self.accepted = RateMeter()

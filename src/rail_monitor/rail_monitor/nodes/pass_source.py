@@ -13,7 +13,6 @@ from collections.abc import Callable
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.duration import Duration
-from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from tqdm import tqdm
 
@@ -26,10 +25,10 @@ from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import (
     DIAGNOSTICS_PERIOD_S,
     Diagnostics,
+    RailNode,
     RateMeter,
     announce,
     declare,
-    refuse_unknown_parameters,
 )
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, STREAM_QOS
@@ -38,15 +37,13 @@ from rail_msgs.msg import TrainPass
 GRAPH_SETTLE_S = 1.0  # the graph's endpoints unchanged this long [s]: every node has subscribed
 
 
-class PassSourceNode(Node):
+class PassSourceNode(RailNode):
     """Base of the nodes that publish train passes on ``train_pass`` (relative: site namespace)."""
 
     PARAMETERS: ParamGroups = (("", PUBLISH_SPECS), ("stamps.", STAMP_SPECS))
 
     def __init__(self, name: str, **kwargs) -> None:
-        kwargs.setdefault("enable_logger_service", True)
         super().__init__(name, **kwargs)
-        refuse_unknown_parameters(self)
         self.cfg = values_of(PublishParams, declare(self, PUBLISH_SPECS))
         self.margins = values_of(StampParams, declare(self, STAMP_SPECS, prefix="stamps."))
         self.pub = self.create_publisher(TrainPass, "train_pass", STREAM_QOS)

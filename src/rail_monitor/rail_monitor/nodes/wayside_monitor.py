@@ -24,11 +24,11 @@ from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE, MonitorParams
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.base import (
+    RailNode,
     asked_for_help,
     declare,
     exit_code,
     help_text,
-    refuse_unknown_parameters,
     ros_session,
     shut_down,
     spin_guarded,
@@ -52,12 +52,11 @@ class MonitorResult:
     replay_s: float = 0.0             # first pass published to the last output recorded [s]
 
 
-class _Settings(Node):
+class _Settings(RailNode):
     """Holds the process-level parameters (no topics)."""
 
     def __init__(self) -> None:
-        super().__init__("wayside_monitor", enable_logger_service=True)
-        refuse_unknown_parameters(self)
+        super().__init__("wayside_monitor")
         self.cfg = values_of(MonitorParams, declare(self, (*MONITOR_SPECS, SOURCE)))
 
 
