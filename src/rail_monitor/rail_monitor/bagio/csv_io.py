@@ -135,7 +135,7 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
     if "vehicle_count" not in seen and "axle_count" not in seen:
         raise InputError(f"{path}: missing column: vehicle_count or axle_count")
 
-    rows, skipped = [], 0
+    rows, skipped, why = [], 0, []
     for n, line in lines[1:]:
         try:
             cells = next(csv.reader([line]))
@@ -152,8 +152,10 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
             if not skip_bad_rows:
                 raise InputError(f"{path}: line {n}: {exc}") from None
             skipped += 1
+            why.append(f"line {n}: {exc}")
     table = PassTable.from_rows(rows)
     table.skipped = skipped  # type: ignore[attr-defined]
+    table.skipped_rows = why  # type: ignore[attr-defined]  (each "line N: reason")
     return table
 
 

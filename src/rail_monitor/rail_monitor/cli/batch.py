@@ -23,6 +23,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--overwrite", action="store_true",
                    help="replace an existing output folder that rail_monitor created")
     s.add_argument("--salvage", action="store_true", help=SALVAGE_HELP)
+    s.add_argument("--skip-bad-rows", action="store_true",
+                   help="CSV: leave malformed rows out (counted, their lines named) instead of failing")
     s.set_defaults(func=run)
 
 
@@ -32,9 +34,13 @@ def run(ns: argparse.Namespace) -> int:
 
     t0 = time.monotonic()
     values = site_values(ns.site)
-    passes = read_passes(ns.source, ns.topic, salvage=ns.salvage)
+    passes = read_passes(ns.source, ns.topic, skip_bad_rows=ns.skip_bad_rows, salvage=ns.salvage)
     if ns.salvage:
         print(printable(passes.salvage.line(ns.source)))
+    skipped = getattr(passes, "skipped_rows", [])
+    if skipped:
+        print(f"batch: {len(skipped)} malformed row(s) of {printable(ns.source)} left out: "
+              + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
     out = Path(ns.output or f"{Path(ns.source).stem}_batch")
     fresh_output(out, ns.overwrite, [ns.source])
     result = run_models(passes, values)

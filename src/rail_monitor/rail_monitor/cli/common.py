@@ -5,10 +5,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import shutil
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.params import ParamSpec
@@ -121,6 +124,24 @@ def print_report(bag: str, site: str | None, report: str | None) -> None:
     print(f"report: {files[-1]} ({len(files) - 1} plots)")
 
 
+def jsonable(data: Any) -> Any:
+    """data with numpy scalars and arrays as Python numbers and lists, and every non-finite number
+    (inf: "never", NaN: "none") as None: strict JSON, which jq and JavaScript parse."""
+    if isinstance(data, dict):
+        return {str(k): jsonable(v) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [jsonable(v) for v in data]
+    if isinstance(data, np.ndarray):
+        return jsonable(data.tolist())
+    if isinstance(data, np.generic):
+        data = data.item()
+    if isinstance(data, float) and not math.isfinite(data):
+        return None
+    if data is None or isinstance(data, (str, int, float, bool)):
+        return data
+    return None  # an object JSON does not know
+
+
 def print_json(data: Any) -> None:
-    """Print data as JSON (objects JSON does not know as null)."""
-    print(json.dumps(data, indent=1, default=lambda x: None))
+    """Print data as strict JSON (see :func:`jsonable`)."""
+    print(json.dumps(jsonable(data), indent=1, allow_nan=False))
