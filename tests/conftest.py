@@ -122,7 +122,7 @@ def spinning(ctx, *nodes) -> Iterator[object]:
     """Spin nodes on a SingleThreadedExecutor in a background thread; shut it down on exit."""
     from rclpy.executors import SingleThreadedExecutor
 
-    from rail_monitor.nodes.base import shut_down, spin_guarded
+    from rail_monitor.nodes.process import shut_down, spin_guarded
 
     ex = SingleThreadedExecutor(context=ctx)
     for node in nodes:

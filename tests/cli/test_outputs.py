@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import os
 
-from rail_monitor.bagio.mcap_bag import MARKER
+from rail_monitor.bagio.output_folder import MARKER
 from rail_monitor.cli import main
 
 from conftest import EXAMPLE_CSV

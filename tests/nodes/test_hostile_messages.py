@@ -1,7 +1,7 @@
 """One of each hostile message on every topic and service of the running graph (issue 21).
 
 The four model nodes and the recorder run in this process on one executor, spun as every
-executable spins (``rail_monitor.nodes.base.spin_guarded``), on sim time, over real DDS. A
+executable spins (``rail_monitor.nodes.process.spin_guarded``), on sim time, over real DDS. A
 hostile node publishes, on each topic a node takes: a /clock before 1970 (rclpy's own handler
 raises on it), TrainPasses with broken stamps and fields, roughness surveys that cannot apply or
 lie years ahead, corrugation states, squeal predictions and rolling-noise messages no model could
@@ -27,7 +27,7 @@ from rail_monitor.bagio.reader import read_messages
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.nodes import base
+from rail_monitor.nodes import process
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
@@ -120,7 +120,7 @@ def graph(ros_context, site_values, tmp_path):
               AlertManagerNode(**kw)]
     recorder = McapRecorder(context=ros_context, parameter_overrides=[Parameter("output", value=str(tmp_path / "bag"))])
     hostile = Node("hostile", context=ros_context, namespace=NS)
-    base.CALLBACK_ERRORS.clear()
+    process.CALLBACK_ERRORS.clear()
     with spinning(ros_context, *models, recorder, hostile):
         yield models, recorder, hostile
     recorder.close()
@@ -179,7 +179,7 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     assert sum(n for k, n in refused.items() if k.startswith("noise/rolling")) == len(noises), refused
     assert est.surveys_rejected["stamp more than 366 d ahead of the stream (stamps.max_ahead_of_stream_s)"] == 2, \
         est.surveys_rejected
-    assert any(why.startswith("ValueError") for why in base.CALLBACK_ERRORS), base.CALLBACK_ERRORS
+    assert any(why.startswith("ValueError") for why in process.CALLBACK_ERRORS), process.CALLBACK_ERRORS
     assert not any("red" in a.key or a.key == "N" for a in alerts.alerts.events)
 
     # Every node goes on: valid passes after the storm get every output, recorded.

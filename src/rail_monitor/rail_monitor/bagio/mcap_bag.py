@@ -25,44 +25,17 @@ import yaml
 from mcap.writer import CompressionType, Writer
 
 from rail_monitor.bagio.direct_file import DirectFile
+from rail_monitor.bagio.output_folder import new_output_folder
+from rail_monitor.bagio.retention import Retention
 from rail_monitor.bagio.topics import qos_dict
 from rail_monitor.bagio.typestore import schema_text, type_hash
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.timeutil import format_iso_ns
 
-# A file the program leaves in every folder it creates: --overwrite replaces only such folders.
-MARKER = ".rail_monitor"
 # metadata.yaml custom_data key naming the file being written when the metadata was last written
 # (a recording that splits rewrites metadata.yaml at every split: a power cut leaves the finished
 # files listed, and this one for --salvage).
 OPEN_FILE_KEY = "rail_monitor.open_file"
-# What a file's summary (indexes, statistics, metadata) may add past its last chunk, and what
-# metadata.yaml and the marker take [bytes].
-SUMMARY_ALLOWANCE = 64 * 1024
-_BLOCK = 4096  # files take whole blocks of the file system
-
-
-def _on_disk(size: int) -> int:
-    return -(-size // _BLOCK) * _BLOCK
-
-
-def mark_output(folder: Path) -> None:
-    """Mark a folder as created by rail_monitor (see :data:`MARKER`)."""
-    (folder / MARKER).write_text("created by rail_monitor; --overwrite may replace this folder\n", encoding="utf-8")
-
-
-def new_output_folder(folder: Path) -> Path:
-    """Create (or take, if empty) an output folder and mark it; RailMonitorError for anything else."""
-    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
-        raise RailMonitorError(f"{folder}: output exists and is not a folder (a file or a link)")
-    if folder.exists() and any(folder.iterdir()):
-        raise RailMonitorError(f"{folder}: output folder exists and is not empty")
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-        mark_output(folder)
-    except OSError as exc:
-        raise RailMonitorError(f"{folder}: cannot create the output folder: {exc.strerror}") from None
-    return folder
 
 
 def _dump(obj: Any) -> str:
@@ -111,7 +84,8 @@ class McapBagWriter:
                  flush_wall_period_s: float = 0.0, max_total_bytes: int = 0, max_age_ns: int = 0) -> None:
         if compression not in ("zstd", "none"):
             raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
-        _check_retention(max_total_bytes, max_age_ns, max_file_bytes, max_file_duration_ns, chunk_size)
+        self._retention = Retention.checked(max_total_bytes, max_age_ns, max_file_bytes, max_file_duration_ns,
+                                            chunk_size)
         self.folder = new_output_folder(Path(folder))
         self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
         self._chunk_size = chunk_size
@@ -121,8 +95,6 @@ class McapBagWriter:
         self._flush_wall = flush_wall_period_s
         self._last_flush_ns = 0
         self._last_flush_wall = time.monotonic()
-        self._max_total = max_total_bytes
-        self._max_age = max_age_ns
         self._topics: dict[str, _Topic] = {}
         self._files: list[_File] = []  # the files kept, oldest first (the open one last)
         self._file: _File | None = None
@@ -180,19 +152,16 @@ class McapBagWriter:
         the next file named as open)."""
         self._close_file(f)
         self._file = None
-        self._retain(open_allowance=_on_disk(self._max_bytes + self._chunk_size + SUMMARY_ALLOWANCE))
+        self._retain(next_file=True)  # the next file opens with the next message
         self._write_metadata(open_file=self._file_path(self._next_index).name)
 
-    def _retain(self, open_allowance: int) -> None:
-        """Delete the oldest finished files past max_age_ns, or past the max_total_bytes budget less
-        open_allowance [bytes] (what the next file may reach) and metadata.yaml's share."""
+    def _retain(self, next_file: bool) -> None:
+        """Delete the oldest finished files the retention settings no longer keep (next_file: a
+        file is still to come, so its allowance is held back)."""
         finished = [f for f in self._files if f is not self._file]
-        room = self._max_total - open_allowance - SUMMARY_ALLOWANCE
-        while finished and (
-            (self._max_age and finished[0].last_ns < self._newest_ns - self._max_age)
-            or (self._max_total and sum(_on_disk(f.size) for f in finished) > room)
-        ):
-            old = finished.pop(0)
+        n = self._retention.oldest_to_delete([f.size for f in finished], [f.last_ns for f in finished],
+                                             self._newest_ns, file_open=next_file)
+        for old in finished[:n]:
             old.path.unlink()
             self._files.remove(old)
             self.deleted.append(old.path.name)
@@ -356,7 +325,7 @@ class McapBagWriter:
                     self._file = self._open_file()
                 self._close_file(self._file)
                 self._file = None
-                self._retain(open_allowance=0)
+                self._retain(next_file=False)
                 self._write_metadata()
         finally:
             self.closed = True
@@ -370,17 +339,3 @@ class McapBagWriter:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-def _check_retention(max_total_bytes: int, max_age_ns: int, max_file_bytes: int, max_file_duration_ns: int,
-                     chunk_size: int) -> None:
-    """RailMonitorError for retention settings that cannot hold: a budget needs files split by size
-    (at least twice what the open file may reach), an age needs files split at all."""
-    if max_total_bytes:
-        allowance = _on_disk(max_file_bytes + chunk_size + SUMMARY_ALLOWANCE)
-        if not max_file_bytes or max_total_bytes < 2 * allowance + SUMMARY_ALLOWANCE:
-            raise RailMonitorError(f"a disk budget of {max_total_bytes} bytes needs files split by size, and at "
-                                   f"least twice (split size + chunk size + {SUMMARY_ALLOWANCE}) plus "
-                                   f"{SUMMARY_ALLOWANCE} = {2 * allowance + SUMMARY_ALLOWANCE} bytes")
-    if max_age_ns and not (max_file_bytes or max_file_duration_ns):
-        raise RailMonitorError("an age limit needs files split by size or by duration")

@@ -17,7 +17,7 @@ import numpy as np
 
 from rail_monitor.alerts.config import NOISE_METRICS
 from rail_monitor.alerts.manager import Alert
-from rail_monitor.core.timeutil import TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
+from rail_monitor.core.timeutil import TIME_MSG_END_NS, fits_time_msg, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Advice, Forecast, StateSnapshot
 from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.predict import Corrugation, NoisePrediction
@@ -161,7 +161,8 @@ def corrugation_series(msgs: list[Any]) -> dict[str, np.ndarray]:
 # raising alerts on it, predicting from it or stopping.
 def stamp_refusal(stamp: Any) -> str:
     """Why a header stamp is unusable ('' when it is usable)."""
-    return "" if 0 < time_ns(stamp) < TIME_MSG_END_NS else "stamp not set, or before 1970"
+    ns = time_ns(stamp)
+    return "" if ns > 0 and fits_time_msg(ns) else "stamp not set, or before 1970"
 
 
 def squeal_refusal(msg: Any) -> str:

@@ -88,7 +88,7 @@ def fresh_output(path: Path, overwrite: bool, inputs: Sequence[str | Path] = ())
     """Make room for an output folder. Without overwrite an existing path is refused; with it, only
     a folder this program created (it holds the marker file of bagio.mcap_bag) is removed, and never
     the working folder, a folder holding an input, or a symbolic link."""
-    from rail_monitor.bagio.mcap_bag import MARKER
+    from rail_monitor.bagio.output_folder import MARKER
 
     if not (path.exists() or path.is_symlink()):
         return

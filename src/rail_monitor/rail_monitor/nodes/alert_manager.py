@@ -35,9 +35,10 @@ from rail_monitor.bagio.messages import (
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import LEAD_TIME
-from rail_monitor.nodes.base import Sent, declare, run_node, runs, subscribe_batched, wall_timer
+from rail_monitor.nodes.base import Sent, declare, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
+from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
 from rail_msgs.msg import CorrugationState, RollingNoise, SquealPrediction, WaysideAlert, WaysideAlertArray
 

@@ -26,9 +26,10 @@ from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.corrugation import advice, checkpoint, surveys
 from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.nodes.base import Sent, declare, run_node, wall_timer
+from rail_monitor.nodes.base import Sent, declare, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
+from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS
 from rail_msgs.msg import CorrugationState, RoughnessSurvey, SpeedAdvisory, TrainPass
 from rail_msgs.srv import EvaluateSpeedDistribution

@@ -23,15 +23,8 @@ from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.bagio.typestore import schema_text
 from rail_monitor.core.node_params import FOXGLOVE_SPECS, FoxgloveParams
 from rail_monitor.core.params import values_of
-from rail_monitor.nodes.base import (
-    Diagnostics,
-    RailNode,
-    RateMeter,
-    announce,
-    declare,
-    run_node,
-    wall_timer,
-)
+from rail_monitor.nodes.base import Diagnostics, RailNode, RateMeter, announce, declare, wall_timer
+from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TopicTap
 
 

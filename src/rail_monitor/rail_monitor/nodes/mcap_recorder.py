@@ -29,16 +29,8 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import RECORDER_SPECS, RecorderParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.timeutil import NS_PER_S
-from rail_monitor.nodes.base import (
-    Diagnostics,
-    RailNode,
-    RateMeter,
-    announce,
-    declare,
-    run_node,
-    spin_once_guarded,
-    wall_timer,
-)
+from rail_monitor.nodes.base import Diagnostics, RailNode, RateMeter, announce, declare, wall_timer
+from rail_monitor.nodes.process import run_node, spin_once_guarded
 from rail_monitor.nodes.qos import qos_to_dict
 from rail_monitor.nodes.topic_tap import TopicTap
 

@@ -13,8 +13,9 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import REPLAYER_SPECS, ReplayerParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
-from rail_monitor.nodes.base import declare, run_node
+from rail_monitor.nodes.base import declare
 from rail_monitor.nodes.pass_source import PassSourceNode
+from rail_monitor.nodes.process import run_node
 
 
 class PassReplayer(PassSourceNode):

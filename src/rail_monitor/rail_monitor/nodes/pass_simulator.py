@@ -15,8 +15,9 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MODE_SPECS, ModeParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
-from rail_monitor.nodes.base import SITE_PARAMETERS, declare, declare_site, run_node
+from rail_monitor.nodes.base import SITE_PARAMETERS, declare, declare_site
 from rail_monitor.nodes.pass_source import PassSourceNode
+from rail_monitor.nodes.process import run_node
 
 
 class PassSimulator(PassSourceNode):

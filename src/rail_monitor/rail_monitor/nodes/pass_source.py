@@ -22,14 +22,7 @@ from rail_monitor.core.node_params import PUBLISH_SPECS, STAMP_SPECS, PublishPar
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, publishable
 from rail_monitor.core.timeutil import NS_PER_S
-from rail_monitor.nodes.base import (
-    DIAGNOSTICS_PERIOD_S,
-    Diagnostics,
-    RailNode,
-    RateMeter,
-    announce,
-    declare,
-)
+from rail_monitor.nodes.base import DIAGNOSTICS_PERIOD_S, Diagnostics, RailNode, RateMeter, announce, declare
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, STREAM_QOS
 from rail_msgs.msg import TrainPass

@@ -28,9 +28,10 @@ from rail_monitor.bagio.messages import corrugation_from_msg, header_of, rolling
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
-from rail_monitor.nodes.base import Sent, declare, isolate_failures, run_node, runs, subscribe_batched, wall_timer
+from rail_monitor.nodes.base import Sent, declare, isolate_failures, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
+from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel

@@ -13,9 +13,10 @@ from typing import Any
 
 from rail_monitor.bagio.messages import header_of, squeal_prediction_fields
 from rail_monitor.core.passes import PassTable
-from rail_monitor.nodes.base import Sent, declare, run_node
+from rail_monitor.nodes.base import Sent, declare
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
+from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STREAM_QOS
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
 from rail_monitor.squeal.predict import predict

@@ -23,21 +23,13 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MONITOR_SPECS, SOURCE, MonitorParams
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.nodes.alert_manager import AlertManagerNode
-from rail_monitor.nodes.base import (
-    RailNode,
-    asked_for_help,
-    declare,
-    exit_code,
-    help_text,
-    ros_session,
-    shut_down,
-    spin_guarded,
-)
+from rail_monitor.nodes.base import RailNode, declare
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.pass_replayer import PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
+from rail_monitor.nodes.process import asked_for_help, exit_code, help_text, ros_session, shut_down, spin_guarded
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 
