@@ -23,6 +23,7 @@ from rail_monitor.alerts.config import KIND_SQUEAL
 from rail_monitor.app.batch import run_models, write_bag
 from rail_monitor.app.report import build_report, load_run
 from rail_monitor.bagio.reader import read_bag_passes, read_messages
+from rail_monitor.bagio.site_record import read_site_record
 from rail_monitor.corrugation.checkpoint import load, resume
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
@@ -165,6 +166,8 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
     assert (KIND_SQUEAL, True) in kinds and (KIND_SQUEAL, False) in kinds  # raised and cleared
     # the console summary names them
     assert "alerts:" in runs["stdout"] and "squeal" in runs["stdout"] and "loudest passes" in runs["stdout"]
+    # the site travels with the data: the recorder stored the site file the process was given
+    assert read_site_record(runs["tmp"] / "live")["site_file"] == runs["site"].read_text()
 
 
 def test_report_folder_has_images_and_a_page(runs):
@@ -239,6 +242,7 @@ def _graph_in_processes(runs, folder: Path, graph_host: tuple[str, ...] = (), re
 def test_separate_processes_equal_batch(runs, tmp_path):
     n = _graph_in_processes(runs, tmp_path)
     run = load_run(tmp_path / "bag")
+    assert read_site_record(tmp_path / "bag")["site_file"] == runs["site"].read_text()
     assert len(run.passes) == n
     _assert_equal_runs(run, runs["batch"])
     _assert_same_messages(tmp_path / "bag", runs["tmp"] / "batch")

@@ -74,9 +74,9 @@ def check_names(values: Mapping[str, Any], where: str = "") -> None:
         raise ConfigError(f"{where}{exc}") from None
 
 
-def _read_document(path: Path) -> Mapping[str, Any]:
+def _read_document(path: Path, text: str | None = None) -> Mapping[str, Any]:
     try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+        doc = yaml.safe_load(path.read_text(encoding="utf-8") if text is None else text)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
         raise ConfigError(f"{path}: cannot read parameter file: {str(exc).splitlines()[0]}") from None
     if not isinstance(doc, Mapping) or not doc:
@@ -90,11 +90,12 @@ def _parameters(path: Path, section: Any) -> dict[str, Any]:
     return flatten(section["ros__parameters"])
 
 
-def load_parameter_file(path: str | Path) -> dict[str, Any]:
+def load_parameter_file(path: str | Path, text: str | None = None) -> dict[str, Any]:
     """Read a ROS 2 parameter file into flat dotted names (the ``/**`` section, else the first),
-    every name checked (ConfigError naming the file and the parameter)."""
+    every name checked (ConfigError naming the file and the parameter). text: the file's content
+    when it comes from elsewhere (a site stored in a bag), path then only names it."""
     path = Path(path)
-    doc = _read_document(path)
+    doc = _read_document(path, text)
     values = _parameters(path, doc.get("/**", next(iter(doc.values()))))
     check_names(values, f"{path}: ")
     return values

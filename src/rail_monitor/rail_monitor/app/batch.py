@@ -22,6 +22,7 @@ from rail_monitor.alerts.manager import Alert, AlertManager
 from rail_monitor.bagio import messages as fields
 from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.mcap_bag import McapBagWriter
+from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
 from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.core.node_params import STAMP_SPECS, StampParams
 from rail_monitor.core.params import resolve, section, values_of
@@ -139,11 +140,14 @@ def _feed_alerts(alerts: AlertManager, table: PassTable, reasons: np.ndarray, ac
 
 
 # -- recording ----------------------------------------------------------------------------------
-def write_bag(result: BatchResult, folder: str | Path, namespace: str, compression: str = "zstd") -> Path:
-    """Record the batch outputs as mcap_recorder records the live graph (log time = header stamp)."""
+def write_bag(result: BatchResult, folder: str | Path, namespace: str, compression: str = "zstd",
+              site: dict[str, str] | None = None) -> Path:
+    """Record the batch outputs as mcap_recorder records the live graph (log time = header stamp);
+    site: the site record stored with the bag (bagio.site_record), as the recorder stores it."""
     ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
     frame = result.site.site_id
-    with McapBagWriter(Path(folder), compression=compression) as bag:
+    stored = {"records": {SITE_RECORD: site}, "custom_data": custom_data(site)} if site else {}
+    with McapBagWriter(Path(folder), compression=compression, **stored) as bag:
         for name, (typename, qos) in GRAPH_TOPICS.items():
             bag.add_topic(f"{ns}/{name}", typename, [qos.as_metadata()])
 

@@ -77,11 +77,15 @@ class McapBagWriter:
     that before the newest one (0: no limit). Only finished split files this writer created are
     deleted, oldest first, never the open one. At every split the finished file is synced and
     metadata.yaml rewritten (atomically) to list the files kept.
+
+    records: MCAP metadata records (name -> string map) written at the start of every file;
+    custom_data: string entries for metadata.yaml's custom_data (bagio.site_record makes both).
     """
 
     def __init__(self, folder: str | Path, *, compression: str = "zstd", chunk_size: int = 1 << 20,
                  max_file_bytes: int = 0, max_file_duration_ns: int = 0, flush_period_ns: int = 0,
-                 flush_wall_period_s: float = 0.0, max_total_bytes: int = 0, max_age_ns: int = 0) -> None:
+                 flush_wall_period_s: float = 0.0, max_total_bytes: int = 0, max_age_ns: int = 0,
+                 records: dict[str, dict[str, str]] | None = None, custom_data: dict[str, str] | None = None) -> None:
         if compression not in ("zstd", "none"):
             raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
         self._retention = Retention.checked(max_total_bytes, max_age_ns, max_file_bytes, max_file_duration_ns,
@@ -95,6 +99,8 @@ class McapBagWriter:
         self._flush_wall = flush_wall_period_s
         self._last_flush_ns = 0
         self._last_flush_wall = time.monotonic()
+        self._records = dict(records or {})
+        self._custom = dict(custom_data or {})
         self._topics: dict[str, _Topic] = {}
         self._files: list[_File] = []  # the files kept, oldest first (the open one last)
         self._file: _File | None = None
@@ -134,6 +140,8 @@ class McapBagWriter:
         stream = DirectFile(path)
         writer = Writer(stream, chunk_size=self._chunk_size, compression=self._compression)
         writer.start(profile="ros2", library="rail_monitor")
+        for name, record in self._records.items():
+            writer.add_metadata(name, record)
         f = _File(path, writer, stream)
         for t in self._topics.values():
             self._register(f, t)
@@ -261,7 +269,7 @@ class McapBagWriter:
         """metadata.yaml for the finished files kept, replaced atomically and synced."""
         info = self._info([f for f in self._files if f is not self._file])
         if open_file is not None:
-            info["custom_data"] = {OPEN_FILE_KEY: open_file}
+            info["custom_data"] = {**(info["custom_data"] or {}), OPEN_FILE_KEY: open_file}
         tmp = self.folder / "metadata.yaml.tmp"
         with open(tmp, "w", encoding="utf-8") as out:
             out.write(_dump({"rosbag2_bagfile_information": info}))
@@ -306,7 +314,7 @@ class McapBagWriter:
                  "duration": {"nanoseconds": f.last_ns - (f.first_ns or f.last_ns)}, "message_count": f.count}
                 for f in files
             ],
-            "custom_data": None,
+            "custom_data": dict(self._custom) or None,
             "ros_distro": "jazzy",
         }
 

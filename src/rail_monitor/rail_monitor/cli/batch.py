@@ -6,7 +6,15 @@ import argparse
 import time
 from pathlib import Path
 
-from rail_monitor.cli.common import SALVAGE_HELP, add_site_option, fresh_output, print_report, site_values
+from rail_monitor.cli.common import (
+    SALVAGE_HELP,
+    add_site_option,
+    beside,
+    fresh_output,
+    print_report,
+    site_values,
+    stored_site,
+)
 from rail_monitor.core.text import printable
 
 
@@ -16,7 +24,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("source", help="bag folder, .mcap, .db3 or .csv")
     add_site_option(s)
     s.add_argument("--topic", help="TrainPass topic of the bag (default: the only one)")
-    s.add_argument("--output", help="bag folder to write (default: <source>_batch)")
+    s.add_argument("--output", help="bag folder to write (default: <source>_batch next to the source)")
     s.add_argument("--namespace", help="topic namespace in the bag (default: the site_id)")
     s.add_argument("--report", help="report folder (default: <output>_report)")
     s.add_argument("--no-report", action="store_true", help="write the bag only")
@@ -41,11 +49,12 @@ def run(ns: argparse.Namespace) -> int:
     if skipped:
         print(f"batch: {len(skipped)} malformed row(s) of {printable(ns.source)} left out: "
               + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
-    out = Path(ns.output or f"{Path(ns.source).stem}_batch")
+    out = Path(ns.output) if ns.output else beside(ns.source, "_batch")
     fresh_output(out, ns.overwrite, [ns.source])
     result = run_models(passes, values)
     t_models = time.monotonic() - t0
-    write_bag(result, out, ns.namespace if ns.namespace is not None else str(values.get("site_id", "")))
+    write_bag(result, out, ns.namespace if ns.namespace is not None else str(values.get("site_id", "")),
+              site=stored_site(ns.site))
     for why, n in result.left_out.items():
         print(f"batch: {n} pass(es) left out: {why}")
     print(f"batch: {len(passes)} passes through the models in {t_models:.2f} s "

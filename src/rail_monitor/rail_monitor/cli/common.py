@@ -7,6 +7,7 @@ import argparse
 import json
 import math
 import shutil
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -36,8 +37,39 @@ def site_values(path: str | None) -> dict[str, Any]:
     return load_parameter_file(site_file(path))
 
 
-def add_site_option(parser: argparse.ArgumentParser, what: str = "site parameter file") -> None:
-    parser.add_argument("--site", help=f"{what} (default: the shipped curve_250.yaml)")
+def add_site_option(parser: argparse.ArgumentParser, what: str = "site parameter file",
+                    default: str = "the shipped curve_250.yaml") -> None:
+    parser.add_argument("--site", help=f"{what} (default: {default})")
+
+
+def stored_site(path: str | None) -> dict[str, str]:
+    """The record of the site file given (or the shipped one) to store with a bag."""
+    from rail_monitor.bagio.site_record import site_record
+
+    return site_record(site_file(path))
+
+
+def bag_site_values(bag: str | Path, site: str | None) -> dict[str, Any]:
+    """The site values to read a bag with: --site if given (a warning on stderr if it differs from
+    the site stored in the bag), else the bag's own site, else the shipped one (with a note)."""
+    from rail_monitor.bagio.site_record import describe, read_site_record
+    from rail_monitor.site_file import load_parameter_file
+
+    record = read_site_record(bag)
+    stored = load_parameter_file(f"{bag}:{record['site_file_name']}", record["site_file"]) if record else None
+    if site:
+        values = site_values(site)
+        if stored is not None and stored != values:
+            differ = sorted(k for k in set(values) | set(stored) if values.get(k) != stored.get(k))
+            print(f"warning: --site {site} differs from the site stored in {bag}, {describe(record)}, in "
+                  f"{len(differ)} parameter(s) ({', '.join(differ[:4])}{', ...' if len(differ) > 4 else ''}); "
+                  "using --site", file=sys.stderr)
+        return values
+    if stored is not None:
+        print(f"site: {describe(record)}, stored in the bag")
+        return stored
+    print(f"site: {bag} stores no site file; using the shipped curve_250.yaml (give --site)", file=sys.stderr)
+    return site_values(None)
 
 
 def add_specs(parser: argparse.ArgumentParser, specs: Sequence[ParamSpec], skip: Sequence[str] = ()) -> None:
@@ -109,6 +141,13 @@ def fresh_output(path: Path, overwrite: bool, inputs: Sequence[str | Path] = ())
     shutil.rmtree(path)
 
 
+def beside(source: str | Path, suffix: str) -> Path:
+    """The default output of a command: <source name><suffix> in the folder that holds the source."""
+    src = Path(source)
+    src = src if src.name else src.absolute()
+    return src.with_name(f"{src.stem if src.suffix.lower() in ('.csv', '.mcap', '.db3') else src.name}{suffix}")
+
+
 def report_dir(bag: str, report: str | None) -> Path:
     return Path(report) if report else Path(f"{str(bag).rstrip('/')}_report")
 
@@ -117,7 +156,7 @@ def print_report(bag: str, site: str | None, report: str | None) -> None:
     """Print the run summary and write the report folder."""
     from rail_monitor.app.report import build_report, load_run, summary_lines
 
-    values = site_values(site)
+    values = bag_site_values(bag, site)
     run = load_run(bag)
     print("\n".join(summary_lines(run, values)))
     files = build_report(run, values, report_dir(bag, report))

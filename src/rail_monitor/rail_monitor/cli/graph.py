@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 from rail_monitor.cli.common import (
     add_site_option,
     add_specs,
+    beside,
     fresh_output,
     print_report,
     ros_args,
@@ -17,7 +19,8 @@ from rail_monitor.cli.common import (
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MONITOR_SPECS, PUBLISH_SPECS, RECORDER_SPECS, REPLAYER_SPECS
 
-DEFAULT_SAMPLE = Path("bags/sample")
+# The bundled sample: ros2_ws/run says where the repository is; else the working folder's bags/.
+DEFAULT_SAMPLE = Path(os.environ.get("RAIL_MONITOR_HOME", ".")) / "bags" / "sample"
 
 
 def add_parsers(sub: argparse._SubParsersAction) -> None:
@@ -39,7 +42,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         s = sub.add_parser(name, help=helptext)
         if name == "monitor":
             s.add_argument("source", help="bag folder, .mcap, .db3 or .csv")
-            s.add_argument("--output", help="bag folder to record into")
+            s.add_argument("--output", help="bag folder to record into (default: <source>_monitor next to it)")
         else:
             s.add_argument("--source", type=Path, default=DEFAULT_SAMPLE, help="history to replay")
             s.add_argument("--output", default="out/demo", help="bag folder to record into")
@@ -71,14 +74,14 @@ def monitor(ns: argparse.Namespace) -> int:
 
 def demo(ns: argparse.Namespace) -> int:
     if not ns.source.exists():
-        raise RailMonitorError(f"{ns.source} not found: run the demo from the repository's top folder")
+        raise RailMonitorError(f"{ns.source} not found: run the demo through ros2_ws/run, or give --source")
     return _monitor_and_report(ns, str(ns.source))
 
 
 def _monitor_and_report(ns: argparse.Namespace, source: str) -> int:
     from rail_monitor.nodes.wayside_monitor import main
 
-    output = ns.output or f"rail_monitor_{Path(source).stem}"
+    output = ns.output or str(beside(source, "_monitor"))
     fresh_output(Path(output), ns.overwrite, [source])
     if not ns.namespace:
         ns.namespace = str(site_values(ns.site).get("site_id", ""))

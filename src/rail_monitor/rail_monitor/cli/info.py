@@ -20,6 +20,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.reader import bag_info, is_csv, read_passes
+    from rail_monitor.bagio.site_record import describe, read_site_record
     from rail_monitor.bagio.typestore import TRAIN_PASS
     from rail_monitor.core.text import printable
     from rail_monitor.core.timeutil import NS_PER_DAY, NS_PER_S, format_iso_ns
@@ -36,6 +37,8 @@ def run(ns: argparse.Namespace) -> int:
             print(f"start:     {format_iso_ns(info.start_ns)}")
             print(f"duration:  {span:.1f} s ({span * NS_PER_S / NS_PER_DAY:.2f} days)")
             print(f"messages:  {info.message_count}")
+            record = read_site_record(path)
+            print(f"site:      {printable(describe(record)) if record else 'none stored'}")
             for t in info.topics:
                 print(f"  {printable(t.name):32s} {printable(t.typename):40s} {t.count}")
             if not any(t.typename == TRAIN_PASS for t in info.topics):

@@ -11,7 +11,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("report", help="print the summary of a recorded run and write its report folder "
                        "(PNG plots, index.html)")
     s.add_argument("bag", help="bag recorded by the graph or by batch")
-    add_site_option(s)
+    add_site_option(s, default="the site stored in the bag")
     s.add_argument("--out", help="report folder (default: <bag>_report)")
     s.set_defaults(func=run)
 

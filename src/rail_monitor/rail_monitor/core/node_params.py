@@ -65,6 +65,8 @@ DISCOVERY_PERIOD = ParamSpec("discovery_period_s", 0.2, "How often to look for n
 RECORDER_SPECS: tuple[ParamSpec, ...] = (
     STOP_TIMEOUT,
     ParamSpec("output", "", "Bag folder to create; empty: rail_monitor_<UTC time> in the working folder."),
+    ParamSpec("site_file", "", "Site file stored with the bag (its text, name, SHA-256 and the software version); "
+              "empty: the first --params-file of the process; none given: no site is stored."),
     ParamSpec("topics", [""], "Topics to record (absolute or relative to the namespace); empty: every "
               "rail_msgs topic and /diagnostics."),
     ParamSpec("compression", "zstd", "Chunk compression.", choices=("zstd", "none")),

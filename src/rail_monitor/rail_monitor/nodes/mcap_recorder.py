@@ -24,13 +24,14 @@ from rclpy.executors import Executor
 from rclpy.qos import QoSProfile
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
+from rail_monitor.bagio.site_record import SITE_RECORD, custom_data, describe, site_record
 from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import RECORDER_SPECS, RecorderParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.nodes.base import Diagnostics, RailNode, RateMeter, announce, declare, wall_timer
-from rail_monitor.nodes.process import run_node, spin_once_guarded
+from rail_monitor.nodes.process import SESSION_PARAMS_FILES, run_node, spin_once_guarded
 from rail_monitor.nodes.qos import qos_to_dict
 from rail_monitor.nodes.topic_tap import TopicTap
 
@@ -43,12 +44,15 @@ class McapRecorder(RailNode):
         super().__init__("mcap_recorder", **kwargs)
         self.cfg = values_of(RecorderParams, declare(self, RECORDER_SPECS))
         out = self.cfg.output or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
+        site = self.cfg.site_file or next(iter(SESSION_PARAMS_FILES), "")
+        record = site_record(site) if site else None
         self.writer = McapBagWriter(
             Path(out), compression=self.cfg.compression, chunk_size=self.cfg.chunk_size,
             max_file_bytes=self.cfg.max_bag_size,
             max_file_duration_ns=int(self.cfg.max_bag_duration_s * NS_PER_S),
             flush_wall_period_s=self.cfg.flush_period_s, max_total_bytes=self.cfg.max_total_bytes,
-            max_age_ns=int(self.cfg.max_age_s * NS_PER_S))
+            max_age_ns=int(self.cfg.max_age_s * NS_PER_S),
+            records={SITE_RECORD: record} if record else None, custom_data=custom_data(record) if record else None)
         self._lock = threading.RLock()  # a write failure publishes diagnostics, which read the writer
         self._has_header: dict[str, bool] = {}
         self.counts: dict[str, int] = {}
@@ -66,7 +70,8 @@ class McapRecorder(RailNode):
             level=lambda: (DiagnosticStatus.ERROR, self.writer.error) if self.writer.error
             else (DiagnosticStatus.OK, "ok"))
         self.tap.discover()
-        announce(self, bag=self.writer.folder, log_time=self.cfg.log_time, compression=self.cfg.compression,
+        announce(self, bag=self.writer.folder, site=describe(record) if record else "none stored",
+                 log_time=self.cfg.log_time, compression=self.cfg.compression,
                  max_bag_size=self.cfg.max_bag_size, max_total_bytes=self.cfg.max_total_bytes)
 
     def _health(self) -> dict[str, object]:

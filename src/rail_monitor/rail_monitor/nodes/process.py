@@ -102,6 +102,11 @@ def params_files(argv: Sequence[str]) -> list[str]:
     return out
 
 
+# The --params-file arguments of this process's session, in order (the recorder stores the first
+# one, the site file, with its bag).
+SESSION_PARAMS_FILES: list[str] = []
+
+
 @contextlib.contextmanager
 def ros_session(args: list[str] | None = None, flow_control: bool = False) -> Iterator[threading.Event]:
     """rclpy initialised for one process, with SIGINT and SIGTERM setting the event it yields
@@ -114,7 +119,8 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False) -> It
 
     if flow_control:
         use_flow_control_profile()
-    for path in params_files(sys.argv if args is None else args):
+    SESSION_PARAMS_FILES[:] = params_files(sys.argv if args is None else args)
+    for path in SESSION_PARAMS_FILES:
         check_parameter_file(path)
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
@@ -125,6 +131,7 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False) -> It
     try:
         yield stop
     finally:
+        SESSION_PARAMS_FILES.clear()
         rclpy.try_shutdown()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
