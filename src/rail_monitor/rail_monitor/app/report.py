@@ -57,7 +57,9 @@ def load_run(bag: str | Path) -> RunData:
         raise InputError(f"{path}: no rail_msgs/msg/TrainPass messages: nothing to report")
     run = RunData(path, PassTable.from_rows(rows))
     run.squeal = {k: np.array([getattr(m, k) for m in sq]) for k in (
-        "crabbing_velocity_mps", "velocity_amplitude_mps", "risk", "level_dba", "friction_state", "speed_mps")}
+        "crabbing_velocity_mps", "velocity_amplitude_mps", "risk", "level_dba", "friction_state", "speed_mps",
+        "regime", "unstable", "frequency_hz", "friction_modifier_benefit_db")}
+    run.squeal["train_id"] = np.array([m.train_id for m in sq], object)
     run.squeal["stamp_ns"] = np.array([time_ns(m.header.stamp) for m in sq], np.int64)
     if st:
         run.states = {k: np.array([list(getattr(m, k)) for m in st]) for k in _STATE}

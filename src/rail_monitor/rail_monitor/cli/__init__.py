@@ -1,4 +1,5 @@
-"""rail-monitor: the command line (simulate, info, replay, record, monitor, demo, batch, report, predict).
+"""rail-monitor: the command line (simulate, info, replay, record, monitor, demo, batch, report, export,
+predict).
 
 One module per verb: its arguments, a call into the package's functions (what-ifs, batch mode,
 the report, the nodes), and the printing. Node options are generated from the same ParamSpecs
@@ -14,7 +15,17 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from rail_monitor.cli import batch, graph, info, predict_corrugation, predict_noise, predict_squeal, report, simulate
+from rail_monitor.cli import (
+    batch,
+    export,
+    graph,
+    info,
+    predict_corrugation,
+    predict_noise,
+    predict_squeal,
+    report,
+    simulate,
+)
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.text import printable
 
@@ -32,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
         verb.add_parser(models)
     batch.add_parser(sub)
     report.add_parser(sub)
+    export.add_parser(sub)
     return p
 
 

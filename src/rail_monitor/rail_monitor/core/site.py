@@ -15,6 +15,7 @@ import numpy as np
 
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, resolve, section
+from rail_monitor.core.timeutil import time_zone
 from rail_monitor.models import hertz
 from rail_monitor.models.cnossos import BRAKE_TYPES
 from rail_monitor.models.track import Track
@@ -25,6 +26,8 @@ SITE_SPECS: tuple[ParamSpec, ...] = (
     SITE_ID,
     ParamSpec("curve_radius_m", 250.0, "Radius of the curve at the site [m].", 10.0, 1.0e5),
     VEHICLE_CLASSES,
+    ParamSpec("time_zone", "UTC", "IANA time zone of the site (e.g. Australia/Brisbane): local times in the report "
+              "and exports; stamps stay UTC."),
 )
 
 # Wheel-rail contact, under contact.: one geometry for every model (squeal's k3, the corrugation
@@ -123,6 +126,7 @@ class Site:
     contact: ContactGeometry = field(default_factory=lambda: ContactGeometry(**{s.name: s.default
                                                                                 for s in CONTACT_SPECS}))
     track: Track = field(default_factory=Track)
+    time_zone: str = "UTC"
 
     def contact_patch(self, wheel_radius_m: np.ndarray | float, load_n: np.ndarray | float) -> hertz.HertzContact:
         """Hertz contact of a wheel of rolling radius [m] on the straight rail head under load [N]
@@ -151,7 +155,9 @@ def site_from_values(values: Mapping[str, Any]) -> Site:
         vehicles[name] = v
     if not vehicles:
         raise ConfigError("parameter 'vehicle_classes' names no vehicle class")
+    time_zone(top["time_zone"])
     return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles,
+                time_zone=top["time_zone"],
                 contact=ContactGeometry(**resolve(CONTACT_SPECS, section(values, "contact."), "contact.",
                                                   strict=True)),
                 track=Track(**resolve(TRACK_SPECS, section(values, "track."), "track.", strict=True)))

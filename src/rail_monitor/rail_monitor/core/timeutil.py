@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import re
 from datetime import UTC, datetime
+from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 
-from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.errors import ConfigError, RailMonitorError
 
 NS_PER_S = 1_000_000_000
 NS_PER_HOUR = 3600 * NS_PER_S
@@ -46,6 +47,22 @@ def format_iso_ns(ns: int) -> str:
     """ns since the epoch -> 'YYYY-MM-DDTHH:MM:SS.fffffffffZ' (UTC, lossless)."""
     sec, frac = divmod(int(ns), NS_PER_S)
     return datetime.fromtimestamp(sec, UTC).strftime("%Y-%m-%dT%H:%M:%S") + f".{frac:09d}Z"
+
+
+def time_zone(name: str):
+    """The IANA time zone called name (ConfigError with one line if none is)."""
+    try:
+        return ZoneInfo(name)
+    except (ZoneInfoNotFoundError, ValueError):
+        raise ConfigError(f"time_zone {name!r} is not an IANA time zone (e.g. 'UTC', 'Australia/Brisbane', "
+                          "'Europe/Berlin')") from None
+
+
+def format_local_ns(ns: int, zone: str, seconds: bool = False) -> str:
+    """ns since the epoch as local time of an IANA zone: 'YYYY-MM-DD HH:MM' (with :SS if seconds)
+    and the zone's abbreviation, for people (format_iso_ns is the lossless form)."""
+    t = datetime.fromtimestamp(int(ns) // NS_PER_S, UTC).astimezone(time_zone(zone))
+    return t.strftime("%Y-%m-%d %H:%M:%S %Z" if seconds else "%Y-%m-%d %H:%M %Z")
 
 
 def to_sec_nanosec(ns: int) -> tuple[int, int]:

@@ -1,0 +1,46 @@
+"""rail-monitor export: a recorded run as tables (one row per pass, one per alert event)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from rail_monitor.cli.common import add_site_option, bag_site_values, beside, fresh_output
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    from rail_monitor.app.export import FORMATS
+
+    s = sub.add_parser("export", help="write a recorded run as tables: passes (every model output per pass) and "
+                       "alerts, as CSV, Parquet or an Excel workbook")
+    s.add_argument("bag", help="bag recorded by the graph or by batch")
+    s.add_argument("--format", choices=FORMATS, default="csv", help="file format (default: csv)")
+    s.add_argument("--output", help="folder to write into (default: <bag>_export next to the bag)")
+    add_site_option(s, default="the site stored in the bag")
+    s.add_argument("--overwrite", action="store_true", help="replace an existing export folder that rail_monitor "
+                   "created")
+    s.set_defaults(func=run)
+
+
+def run(ns: argparse.Namespace) -> int:
+    from rail_monitor import __version__
+    from rail_monitor.app.export import alert_table, pass_table, write_tables
+    from rail_monitor.app.report import load_run
+    from rail_monitor.bagio.output_folder import new_output_folder
+    from rail_monitor.bagio.site_record import read_site_record
+    from rail_monitor.core.text import printable
+
+    values = bag_site_values(ns.bag, ns.site)
+    data = load_run(ns.bag)
+    tables = [pass_table(data, values), alert_table(data, values)]
+    record = read_site_record(ns.bag) or {}
+    about = {"rail_monitor.version": __version__, "source bag": str(Path(ns.bag).absolute()),
+             "site_id": str(values.get("site_id", "")), **{f"site.{k}": v for k, v in record.items()}}
+    out = Path(ns.output) if ns.output else beside(ns.bag, "_export")
+    fresh_output(out, ns.overwrite, [ns.bag])
+    folder = new_output_folder(out)
+    files = write_tables(tables, ns.format, folder, about)
+    for t in tables:
+        print(f"export: {t.name}: {len(t.columns[0].values)} rows, {len(t.columns)} columns")
+    print("export: " + ", ".join(printable(f) for f in files))
+    return 0
