@@ -28,6 +28,7 @@ def test_the_summary_states_what_the_bag_holds(bag):
     run = load_run(path)
     lines = summary_lines(run, values)
     assert lines[0].startswith(f"site curve_250: {len(result.passes)} passes from 2026-09-01T")
+    assert lines[0].endswith("AEST local)")  # the site's zone, Australia/Brisbane
     assert lines[1] == f"processed {len(result.accepted)}, rejected 0"
     assert any(line.startswith("grinding forecast: worst band") for line in lines)
     assert any(line.startswith("squeal: ") for line in lines)
@@ -37,9 +38,13 @@ def test_the_report_folder_has_a_page_and_its_plots(bag, tmp_path):
     path, values, _ = bag
     files = build_report(load_run(path), values, tmp_path)
     page = files[-1].read_text()
-    assert files[-1].name == "index.html" and len(files) == 5
+    assert files[-1].name == "index.html"
+    pngs = [f for f in files if f.suffix == ".png"]
+    assert [f.stem for f in pngs] == ["timeline", "corrugation", "noise", "squeal", "speeds"]
     for f in files[:-1]:
-        assert f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f.name in page
+        assert f.name in page
+    for f in pngs:
+        assert f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_a_missing_bag_is_one_line_and_exit_2(tmp_path, capsys):

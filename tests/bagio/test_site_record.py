@@ -54,9 +54,9 @@ def test_batch_stores_the_site_file_in_every_copy(batch_bag):
 
 def test_report_and_info_use_the_bag_site_and_warn_on_another(batch_bag, capsys):
     bag, site = batch_bag
-    assert bag_site_values(bag, None) == load_parameter_file(site)
+    assert bag_site_values(bag, None)[0] == load_parameter_file(site)
     assert "curve_400.yaml" in capsys.readouterr().out
-    shipped = bag_site_values(bag, str(site_file(None)))  # the user's --site wins, with a warning
+    shipped, _ = bag_site_values(bag, str(site_file(None)))  # the user's --site wins, with a warning
     assert shipped["site_id"] == "curve_250"
     err = capsys.readouterr().err
     assert "differs from the site stored" in err and "curve_radius_m" in err

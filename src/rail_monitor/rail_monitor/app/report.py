@@ -1,4 +1,5 @@
-"""The run report: a console summary and a folder of PNG plots with an HTML page, from a recorded bag.
+"""A recorded run as arrays, its console summary, and its report folder (written by
+:mod:`rail_monitor.app.report_page`).
 
 Reads what the graph (or batch mode) recorded: train_pass, noise/squeal, corrugation/state,
 noise/rolling, alerts and speed_advisory, matched by message type, so any namespace works. The
@@ -8,7 +9,6 @@ spectra before and after growth) and the validation of the passes.
 
 from __future__ import annotations
 
-import html
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -25,11 +25,12 @@ from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.text import printable
-from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns
+from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns, format_local_ns
 
 _TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory")
-_STATE = ("amplitude_m", "threshold_m", "post_grinding_m")
-_STATE_NUMBERS = ("days_to_threshold", "passes_per_day", "worst_band", "pass_count", "total_pass_count")
+_STATE = ("amplitude_m", "threshold_m", "post_grinding_m", "growth_per_axle_pass")
+_STATE_NUMBERS = ("days_to_threshold", "passes_to_threshold", "passes_per_day", "worst_band", "pass_count",
+                  "axle_pass_count", "total_pass_count")
 
 
 @dataclass
@@ -88,7 +89,9 @@ def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12)
     p = run.passes
     reasons = rejection_reasons(p, site)
     lines = [f"site {site.site_id}: {len(p)} passes from {format_iso_ns(int(p.stamp_ns.min()))} to "
-             f"{format_iso_ns(int(p.stamp_ns.max()))} ({np.ptp(p.stamp_ns) / NS_PER_DAY:.1f} days)"]
+             f"{format_iso_ns(int(p.stamp_ns.max()))} ({np.ptp(p.stamp_ns) / NS_PER_DAY:.1f} days; "
+             f"{format_local_ns(int(p.stamp_ns.min()), site.time_zone)} to "
+             f"{format_local_ns(int(p.stamp_ns.max()), site.time_zone)} local)"]
     bad = Counter(r for r in reasons.tolist() if r)
     lines.append(f"processed {int((reasons == '').sum())}, rejected {sum(bad.values())}"
                  + "".join(f"; {n} {why}" for why, n in bad.most_common(3)))
@@ -108,11 +111,33 @@ def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12)
                   f"{cls.get(nz['train_id'][i], ''):8s}"
                   f" {nz['speed_mps'][i]:5.1f} m/s  {nz['lpaeq_tp_dba'][i]:5.1f} / {nz['lpafmax_dba'][i]:5.1f} dB(A)"
                   for i in top]
+    lines += _limit_lines(run, values)
     risk = run.squeal.get("risk", np.zeros(0, int))
     if len(risk):
         counts = np.bincount(risk.astype(int), minlength=4)
         lines.append(f"squeal: {int((risk > 0).sum())} of {len(risk)} passes unstable; risk low {counts[1]}, "
                      f"medium {counts[2]}, high {counts[3]}; loudest {np.max(run.squeal['level_dba']):.1f} dB(A)")
+    return lines
+
+
+def _limit_lines(run: RunData, values: Mapping[str, Any], shown: int = 5) -> list[str]:
+    """Noise percentiles against the limit, and the loudest squealing trains."""
+    from rail_monitor.app import report_tables
+    from rail_monitor.app.export import pass_table
+
+    t = pass_table(run, values).as_dict()
+    lim = report_tables.limits(values)
+    lines = [f"noise against the limit ({n['model']}, {n['metric']}): P50 {n['P50 [dB(A)]']:.1f}, P95 "
+             f"{n['P95 [dB(A)]']:.1f}, max {n['max [dB(A)]']:.1f} dB(A); limit {n['limit [dB(A)]']:g} dB(A), "
+             f"{n['above limit [%]']:.1f} % of passes above"
+             for n in report_tables.noise_percentiles(t, lim, list(run.noise))]
+    trains = report_tables.squealing_trains(t, lim) if "squeal_risk" in t else []
+    lines.append(f"squealing trains (risk {lim['squeal_min_risk']} or above): {len(trains)}"
+                 + (f"; the loudest {min(shown, len(trains))} (all in the report's squealing_trains.csv):"
+                    if trains else ""))
+    lines += [f"  {r['time (local)']}  {printable(r['train_id']):14s} {printable(r['class']):8s} "
+              f"{r['speed [km/h]']:5.1f} km/h  {r['angle of attack [mrad]']:5.1f} mrad  {r['friction']:18s} "
+              f"{r['squeal level [dB(A)]']:5.1f} dB(A) {r['risk']}" for r in trains[:shown]]
     return lines
 
 
@@ -127,7 +152,7 @@ def _grinding_lines(run: RunData) -> list[str]:
     due = int(s["grinding_due_time"][-1])
     when = format_iso_ns(due)[:10] if due else "beyond 2038"
     head = "GRINDING DUE" if s["grinding_due"][-1] else "grinding forecast"
-    text = (f"{head}: worst band {1e3 * lam:.1f} mm at {1e6 * amp:.2f} um r.m.s. of its {1e6 * thr:.2f} um "
+    text = (f"{head}: worst band {1e3 * lam:.1f} mm at {1e6 * amp:.2f} µm r.m.s. of its {1e6 * thr:.2f} µm "
             f"threshold; reached in {days:.0f} days ({when}) at {s['passes_per_day'][-1]:.0f} passes/day"
             if np.isfinite(days) else f"{head}: no band grows towards its threshold")
     grindings = sorted(set(s["last_grinding_time"].tolist()) - {0})
@@ -135,33 +160,22 @@ def _grinding_lines(run: RunData) -> list[str]:
 
 
 # -- report folder ------------------------------------------------------------------------------
-def build_report(run: RunData, values: Mapping[str, Any], out_dir: str | Path) -> list[Path]:
-    """Write the PNG plots and index.html into out_dir; returns the files written. A write that
-    fails (a full disk, no permission) is one RailMonitorError naming the folder."""
+def build_report(run: RunData, values: Mapping[str, Any], out_dir: str | Path, site_text: str = "") -> list[Path]:
+    """Write the report folder (rail_monitor.app.report_page) into out_dir; returns the files
+    written, index.html last. site_text names the site file used. A write that fails (a full disk,
+    no permission) is one RailMonitorError naming the folder."""
+    from rail_monitor.app.report_page import write_report
+
     out = Path(out_dir)
+    extra: dict[str, Any] = {}
+    if run.noise:
+        extra["before"], extra["after"] = _spectra(run, values)
+    if len(run.squeal.get("risk", ())):
+        extra["curves"] = _squeal_curves(run, values)
     try:
-        return _write_report(run, values, out)
+        return write_report(run, values, out, extra, site_text)
     except OSError as exc:
         raise RailMonitorError(f"{out}: cannot write the report: {exc.strerror or exc}") from None
-
-
-def _write_report(run: RunData, values: Mapping[str, Any], out: Path) -> list[Path]:
-    from rail_monitor.app import plots
-
-    out.mkdir(parents=True, exist_ok=True)
-    site = site_from_values(values)
-    files = []
-    if run.states:
-        files.append(plots.corrugation_history(run.states, out / "corrugation.png"))
-    if run.noise:
-        before, after = _spectra(run, values)
-        files.append(plots.noise_history(run.noise, before, after, out / "noise.png"))
-    if len(run.squeal.get("risk", ())):
-        files.append(plots.squeal_passes(run.squeal, _squeal_curves(run, values), out / "squeal.png"))
-    files.append(plots.speed_distribution(run.passes.speed_mps, run.advisory, out / "speeds.png"))
-    page = out / "index.html"
-    page.write_text(_html(run, summary_lines(run, values, max_alerts=10**6), files, site.site_id), encoding="utf-8")
-    return [*files, page]
 
 
 def _reference_pass(run: RunData, values: Mapping[str, Any]) -> PassTable:
@@ -212,27 +226,3 @@ def _squeal_curves(run: RunData, values: Mapping[str, Any]) -> dict[str, Any]:
         case = site_case(cfg, site, str(ref.vehicle_class[0]), state, float(ref.speed_mps[0]))
         curves[name] = sweep(case, vc)
     return curves
-
-
-def _text(value: object) -> str:
-    """Text from a bag as HTML: control characters escaped, then markup."""
-    return html.escape(printable(value))
-
-
-def _html(run: RunData, summary: list[str], files: list[Path], site_id: str) -> str:
-    imgs = "\n".join(f'<figure><img src="{f.name}" alt="{f.stem}"><figcaption>{f.stem}</figcaption></figure>'
-                     for f in files)
-    rows = "\n".join(f"<tr><td>{format_iso_ns(a.stamp_ns)}</td><td>{'raised' if a.active else 'cleared'}</td>"
-                     f"<td>{KIND_NAMES[a.kind]}</td><td>{_text(a.key)}</td><td>{_text(a.summary)}</td></tr>"
-                     for a in run.alerts)
-    return f"""<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>rail_monitor report: {_text(site_id)}</title>
-<style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto}} img{{max-width:100%}}
-table{{border-collapse:collapse}} td{{border:1px solid #ccc;padding:2px 6px;font-size:90%}}</style></head>
-<body><h1>rail_monitor report: {_text(site_id)}</h1>
-<p>From {_text(run.bag)}.</p>
-<pre>{html.escape(chr(10).join(summary))}</pre>
-{imgs}
-<h2>Alerts</h2><table><tr><th>pass time</th><th></th><th>kind</th><th>key</th><th>summary</th></tr>
-{rows}</table></body></html>
-"""

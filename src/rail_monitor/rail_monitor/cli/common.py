@@ -5,17 +5,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import shutil
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.params import ParamSpec
+from rail_monitor.core.text import jsonable
 
 SALVAGE_HELP = ("read every complete chunk of an MCAP file cut off mid-write (a killed recorder, a full disk) "
                 "and say how many messages it recovered")
@@ -49,12 +47,16 @@ def stored_site(path: str | None) -> dict[str, str]:
     return site_record(site_file(path))
 
 
-def bag_site_values(bag: str | Path, site: str | None) -> dict[str, Any]:
-    """The site values to read a bag with: --site if given (a warning on stderr if it differs from
-    the site stored in the bag), else the bag's own site, else the shipped one (with a note)."""
+def bag_site_values(bag: str | Path, site: str | None) -> tuple[dict[str, Any], str]:
+    """The site values to read a bag with, and a line naming them: --site if given (a warning on
+    stderr if it differs from the site stored in the bag), else the bag's own site, else the
+    shipped one (with a note)."""
     from rail_monitor.bagio.site_record import describe, read_site_record
+    from rail_monitor.core.errors import InputError
     from rail_monitor.site_file import load_parameter_file
 
+    if not Path(bag).exists():
+        raise InputError(f"{bag}: no such file or folder")
     record = read_site_record(bag)
     stored = load_parameter_file(f"{bag}:{record['site_file_name']}", record["site_file"]) if record else None
     if site:
@@ -64,12 +66,12 @@ def bag_site_values(bag: str | Path, site: str | None) -> dict[str, Any]:
             print(f"warning: --site {site} differs from the site stored in {bag}, {describe(record)}, in "
                   f"{len(differ)} parameter(s) ({', '.join(differ[:4])}{', ...' if len(differ) > 4 else ''}); "
                   "using --site", file=sys.stderr)
-        return values
+        return values, f"{site} (given with --site)"
     if stored is not None:
         print(f"site: {describe(record)}, stored in the bag")
-        return stored
+        return stored, f"{describe(record)}, stored in the bag"
     print(f"site: {bag} stores no site file; using the shipped curve_250.yaml (give --site)", file=sys.stderr)
-    return site_values(None)
+    return site_values(None), f"{site_file(None)} (the shipped default: the bag stores no site file)"
 
 
 def add_specs(parser: argparse.ArgumentParser, specs: Sequence[ParamSpec], skip: Sequence[str] = ()) -> None:
@@ -156,29 +158,12 @@ def print_report(bag: str, site: str | None, report: str | None) -> None:
     """Print the run summary and write the report folder."""
     from rail_monitor.app.report import build_report, load_run, summary_lines
 
-    values = bag_site_values(bag, site)
+    values, site_text = bag_site_values(bag, site)
     run = load_run(bag)
     print("\n".join(summary_lines(run, values)))
-    files = build_report(run, values, report_dir(bag, report))
-    print(f"report: {files[-1]} ({len(files) - 1} plots)")
-
-
-def jsonable(data: Any) -> Any:
-    """data with numpy scalars and arrays as Python numbers and lists, and every non-finite number
-    (inf: "never", NaN: "none") as None: strict JSON, which jq and JavaScript parse."""
-    if isinstance(data, dict):
-        return {str(k): jsonable(v) for k, v in data.items()}
-    if isinstance(data, (list, tuple)):
-        return [jsonable(v) for v in data]
-    if isinstance(data, np.ndarray):
-        return jsonable(data.tolist())
-    if isinstance(data, np.generic):
-        data = data.item()
-    if isinstance(data, float) and not math.isfinite(data):
-        return None
-    if data is None or isinstance(data, (str, int, float, bool)):
-        return data
-    return None  # an object JSON does not know
+    files = build_report(run, values, report_dir(bag, report), site_text)
+    pngs = sum(f.suffix == ".png" for f in files)
+    print(f"report: {files[-1]} ({pngs} figures; report.pdf, squealing_trains.csv, summary.json beside it)")
 
 
 def print_json(data: Any) -> None:

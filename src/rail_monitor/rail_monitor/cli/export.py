@@ -30,7 +30,7 @@ def run(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.site_record import read_site_record
     from rail_monitor.core.text import printable
 
-    values = bag_site_values(ns.bag, ns.site)
+    values, _ = bag_site_values(ns.bag, ns.site)
     data = load_run(ns.bag)
     tables = [pass_table(data, values), alert_table(data, values)]
     record = read_site_record(ns.bag) or {}
