@@ -43,3 +43,27 @@ def test_usage_errors_are_argparse_exits():
 def test_the_installed_entry_point_runs_the_same_main():
     r = run_cmd("rail-monitor", "predict", "squeal", "--rig", "--crabbing", "0.39")
     assert r.returncode == 0 and "the paper's rig (Figure 5)" in r.stdout
+
+
+def test_every_option_states_its_default_once():
+    """--help of every verb: no option says its default twice (its own text and argparse's)."""
+    import argparse
+
+    from rail_monitor.cli import build_parser
+
+    def parsers(p):
+        yield p
+        for a in p._actions:
+            if isinstance(a, argparse._SubParsersAction):
+                for sub in a.choices.values():
+                    yield from parsers(sub)
+
+    checked = 0
+    for p in parsers(build_parser()):
+        formatter = p._get_formatter()
+        for a in p._actions:
+            if a.help and a.option_strings:
+                text = formatter._expand_help(a)
+                assert text.count("default") <= 1, f"{p.prog} {a.option_strings[0]}: {text}"
+                checked += 1
+    assert checked > 100

@@ -27,4 +27,34 @@ def test_predict_squeal_reproduces_the_rig(tmp_path, capsys):
 def test_a_site_case_names_its_class_and_friction(capsys):
     assert main(["predict", "squeal", "--vehicle-class", "freight", "--friction", "wet", "--aoa-mrad", "12"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].startswith("# site curve_250, class freight, wet: V0 14 m/s, W 100000 N") and len(out) == 3
+    assert out[0].startswith("# site curve_250, class freight, wet: V0 14 m/s, W 100000 N") and len(out) == 4
+
+
+def test_a_site_case_gives_the_level_and_risk_the_squeal_node_gives(capsys):
+    """predict squeal for a site: dB(A), risk and regime equal squeal.predict.predict (what the
+    squeal_risk_model node and batch mode run) for the same pass, exactly: one computation."""
+    import numpy as np
+
+    from rail_monitor.alerts.config import RISK_NAMES
+    from rail_monitor.cli.common import site_values
+    from rail_monitor.core.passes import FRICTION_BY_NAME, PassTable
+    from rail_monitor.core.site import site_from_values
+    from rail_monitor.models.squeal import REGIME_NAMES
+    from rail_monitor.squeal.config import squeal_config
+    from rail_monitor.squeal.predict import predict
+
+    assert main(["predict", "squeal", "--vehicle-class", "emu", "--speed", "18", "--aoa-mrad", "13", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    values = site_values(None)
+    site = site_from_values(values)
+    emu = site.vehicle("emu")
+    table = PassTable(stamp_ns=[1], train_id=["t"], vehicle_class=["emu"], vehicle_count=[3], axle_count=[12],
+                      speed_mps=[18.0], angle_of_attack_rad=[np.arcsin(row["crabbing_velocity_mps"] / 18.0)],
+                      wheel_load_n=[emu.wheel_load_n], friction_state=[FRICTION_BY_NAME["dry"]],
+                      train_length_m=[60.0])
+    node = predict(squeal_config(values), site, table)
+    assert row["level_dba"] == pytest.approx(float(node["level_dba"][0]), rel=1e-12) and row["level_dba"] > 80
+    assert row["risk_name"] == RISK_NAMES[int(node["risk"][0])] and row["regime_name"] == REGIME_NAMES[
+        int(node["regime"][0])]
+    assert main(["predict", "squeal", "--vehicle-class", "emu", "--aoa-mrad", "13"]) == 0
+    assert "level [dB(A)]" in capsys.readouterr().out

@@ -31,8 +31,7 @@ from rail_monitor.core.text import printable
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="rail-monitor", description=__doc__.split("\n\n")[0],
-                                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    p = argparse.ArgumentParser(prog="rail-monitor", description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
     simulate.add_parser(sub)
     info.add_parser(sub)
@@ -44,7 +43,28 @@ def build_parser() -> argparse.ArgumentParser:
     batch.add_parser(sub)
     report.add_parser(sub)
     export.add_parser(sub)
+    _state_defaults_once(p)
     return p
+
+
+class DefaultsOnceFormatter(argparse.HelpFormatter):
+    """Help with each option's default stated once: appended where the option's own text does not
+    state it, and there is a value to state."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if ("default" in text or not action.option_strings or action.default in (None, False, argparse.SUPPRESS)
+                or isinstance(action.default, bool)):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
+def _state_defaults_once(parser: argparse.ArgumentParser) -> None:
+    parser.formatter_class = DefaultsOnceFormatter
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices.values():
+                _state_defaults_once(sub)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -14,7 +14,7 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     from rail_monitor.core.passes import FRICTION_BY_NAME
 
     c = models.add_parser("corrugation", help="corrugation growth per wavelength band, time to the grinding "
-                          "threshold, and speed advice", formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+                          "threshold, and speed advice")
     add_site_option(c)
     g = c.add_mutually_exclusive_group()
     g.add_argument("--history", help="pass history (bag folder, .mcap, .db3 or .csv): state, speeds and traffic "

@@ -19,7 +19,7 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     from rail_monitor.noise.config import MODELS, ROUGHNESS_SOURCES
 
     r = models.add_parser("noise", help="rolling noise pass-by levels and spectra (CNOSSOS-EU and mechanics), "
-                          "before and after roughness growth", formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+                          "before and after roughness growth")
     add_site_option(r)
     r.add_argument("--vehicle-class", help="vehicle class (default: the site's first)")
     r.add_argument("--speed", type=float, nargs="+", help="train speeds [m/s] (default: the class's mean)")
@@ -27,10 +27,11 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     r.add_argument("--model", dest="noise_model", choices=(*MODELS, "both"),
                    help="source model (default: the site's noise.model)")
     r.add_argument("--rail-roughness", choices=tuple(s for s in ROUGHNESS_SOURCES if s != "measured"),
-                   help="baseline rail roughness class")
-    r.add_argument("--sleeper-type", choices=SLEEPER_TYPES)
+                   help="baseline rail roughness class (default: the site's)")
+    r.add_argument("--sleeper-type", choices=SLEEPER_TYPES, help="CNOSSOS sleeper type (default: the site's)")
     r.add_argument("--pad-stiffness", type=float, help="rail pad stiffness [N/m] (track.pad_stiffness_npm)")
-    r.add_argument("--interpolation", choices=INTERPOLATION_RULES)
+    r.add_argument("--interpolation", choices=INTERPOLATION_RULES,
+                   help="wavelength-to-band interpolation rule (default: the site's)")
     r.add_argument("--distance", type=float, help="receiver distance from the track centre [m]")
     r.add_argument("--growth-days", type=float, nargs="+",
                    help="also predict after this many days of corrugation growth from grinding (at the first speed)")

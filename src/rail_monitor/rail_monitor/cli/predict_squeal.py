@@ -19,12 +19,11 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     from rail_monitor.core.passes import FRICTION_BY_NAME
     from rail_monitor.models.squeal import K3_CONVENTIONS
 
-    q = models.add_parser("squeal", help="squeal amplitude and level for a crabbing velocity, or a sweep",
-                          formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    q = models.add_parser("squeal", help="squeal amplitude and level for a crabbing velocity, or a sweep")
     q.add_argument("--rig", action="store_true", help="the UQ paper's two-disc rig (Figure 5) instead of a site")
     add_site_option(q)
     q.add_argument("--vehicle-class", help="vehicle class of the site (default: its first)")
-    q.add_argument("--friction", default="dry", choices=tuple(FRICTION_BY_NAME))
+    q.add_argument("--friction", default="dry", choices=tuple(FRICTION_BY_NAME), help="friction state")
     q.add_argument("--speed", type=float, help="rolling speed V0 [m/s] (default: the class's mean)")
     q.add_argument("--load", type=float, help="wheel load W [N] (default: the class's nominal)")
     g = q.add_mutually_exclusive_group()
@@ -32,7 +31,8 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     g.add_argument("--crabbing", type=float, help="crabbing velocity Vc [m/s]")
     g.add_argument("--sweep", type=float, nargs=3, metavar=("VC_START", "VC_STOP", "N"),
                    help="sweep the crabbing velocity [m/s]")
-    q.add_argument("--k3-convention", choices=K3_CONVENTIONS)
+    q.add_argument("--k3-convention", choices=K3_CONVENTIONS,
+                   help="how k3 follows from Kalker's C22 (default: the site's squeal.k3_convention)")
     for dest, (flag, unit) in OVERRIDES.items():
         q.add_argument(flag, dest=dest, type=float, help=f"override [{unit}]")
     q.add_argument("--reference", type=float, help="A w_ref of the relative level [m/s] (default: the largest A w)")
@@ -45,27 +45,40 @@ def add_parser(models: argparse._SubParsersAction) -> None:
 def run(ns: argparse.Namespace) -> int:
     import dataclasses
 
+    from rail_monitor.alerts.config import RISK_NAMES
     from rail_monitor.models.squeal import REGIME_NAMES
+    from rail_monitor.squeal.config import squeal_config
     from rail_monitor.squeal.whatif import crabbing_velocities, squeal_case, sweep
 
     overrides = {k: getattr(ns, k) for k in OVERRIDES if getattr(ns, k) is not None}
-    case, where = squeal_case(None if ns.rig else site_values(ns.site), ns.vehicle_class, ns.friction, ns.speed,
-                              ns.load, ns.k3_convention, **overrides)
+    values = None if ns.rig else site_values(ns.site)
+    case, where = squeal_case(values, ns.vehicle_class, ns.friction, ns.speed, ns.load, ns.k3_convention, **overrides)
     vc = crabbing_velocities(case, ns.sweep, ns.crabbing, ns.aoa_mrad)
-    rows = sweep(case, vc, reference_mps=ns.reference, ode=ns.ode)
+    cfg = None if values is None else squeal_config(values)
+    rows = sweep(case, vc, reference_mps=ns.reference, ode=ns.ode, cfg=cfg)
+    site_level = "level_dba" in rows
     if ns.json:
         print_json({"case": dataclasses.asdict(case), "where": where,
-                    "rows": [{k: (v[i].item() if np.isfinite(v[i]) else None) for k, v in rows.items()}
+                    "rows": [{**{k: v[i] for k, v in rows.items()}, "regime_name": REGIME_NAMES[int(rows["regime"][i])],
+                              **({"risk_name": RISK_NAMES[int(rows["risk"][i])]} if site_level else {})}
                              for i in range(len(vc))]})
     else:
         print(f"# {where}: V0 {case.speed_mps:g} m/s, W {case.load_n:g} N, m {case.mass_kg:g} kg, "
               f"c {case.damping_nspm:g} N s/m, k {case.stiffness_npm:g} N/m, k1 {case.k1:g}, k2 {case.k2:g}, "
               f"k3 {case.k3_n:.4g} N, u_s {rows['critical_slip_velocity_mps'][0]:.4g} m/s")
+        if site_level:
+            print(f"# level at the site's receiver, {rows['frequency_hz'][0]:.0f} Hz mode; risk from the site's "
+                  "dB(A) limits (squeal.risk_medium_dba, squeal.risk_high_dba); '-': no squeal")
         head = f"{'Vc [m/s]':>9} {'AoA [mrad]':>10} {'A w [m/s]':>10} {'rel [dB]':>9} {'regime':<16}"
-        print(head + (f" {'ODE A w':>9}" if ns.ode else ""))
+        print(head + (f" {'level [dB(A)]':>13} {'risk':<6}" if site_level else "")
+              + (f" {'ODE A w':>9}" if ns.ode else ""))
         for i in range(len(vc)):
             line = (f"{vc[i]:9.4f} {rows['angle_of_attack_mrad'][i]:10.2f} {rows['velocity_amplitude_mps'][i]:10.4f} "
                     f"{rows['relative_level_db'][i]:9.2f} {REGIME_NAMES[int(rows['regime'][i])]:<16}")
+            if site_level:
+                level = rows["level_dba"][i]
+                line += f" {level:13.1f}" if np.isfinite(level) else f" {'-':>13}"
+                line += f" {RISK_NAMES[int(rows['risk'][i])]:<6}"
             print(line + (f" {rows['ode_amplitude_mps'][i]:9.4f}" if ns.ode else ""))
     if ns.plot:
         from rail_monitor.app.plots import squeal_sweep

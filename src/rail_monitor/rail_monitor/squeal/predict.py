@@ -48,7 +48,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     mass, damping, stiffness = cfg.modal_mass_kg, cfg.modal_damping_nspm, cfg.modal_stiffness_npm
     lc = squeal.limit_cycle_amplitude(v0, vc, load, damping, k1, k2, k3)
     freq = np.broadcast_to(squeal.squeal_frequency(mass, stiffness), v0.shape)
-    lev = _levels(cfg, lc.amplitude, freq)
+    lev, risk = level_and_risk(cfg, lc.amplitude, lc.unstable, freq)
 
     # The same passes with the friction-modifier curve: the benefit against the background.
     fm_k1, fm_k2 = cfg.creep(np.full_like(passes.friction_state, FRICTION_MODIFIER))
@@ -57,9 +57,6 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     bg = cfg.background_level_dba
     benefit = _with_background(lev.level_dba, bg) - _with_background(fm_lev.level_dba, bg)
 
-    risk = np.where(~lc.unstable, RISK_NONE,
-                    np.where(lev.level_dba >= cfg.risk_high_dba, RISK_HIGH,
-                             np.where(lev.level_dba >= cfg.risk_medium_dba, RISK_MEDIUM, RISK_LOW)))
     return {
         "friction_state": passes.friction_state,
         "speed_mps": v0,
@@ -74,8 +71,19 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
         "level_dba": lev.level_dba,
         "relative_level_db": squeal.relative_level(lc.amplitude, cfg.reference_amplitude_mps),
         "friction_modifier_benefit_db": benefit,
-        "risk": risk.astype(np.int8),
+        "risk": risk,
     }
+
+
+def level_and_risk(cfg: SquealConfig, amplitude: np.ndarray, unstable: np.ndarray,
+                   frequency: np.ndarray) -> tuple[squeal.RadiatedLevel, np.ndarray]:
+    """The radiated level at the site's receiver of a wheel velocity amplitude [m/s] at a squeal
+    frequency [Hz], and the risk class (RISK_*, int8) from the site's dB(A) limits."""
+    lev = _levels(cfg, amplitude, frequency)
+    risk = np.where(~unstable, RISK_NONE,
+                    np.where(lev.level_dba >= cfg.risk_high_dba, RISK_HIGH,
+                             np.where(lev.level_dba >= cfg.risk_medium_dba, RISK_MEDIUM, RISK_LOW)))
+    return lev, risk.astype(np.int8)
 
 
 def kalker_lateral_force(cfg: SquealConfig, site: Site, wheel_radius_m: np.ndarray,

@@ -15,7 +15,7 @@ from rail_monitor.core.passes import FRICTION_BY_NAME
 from rail_monitor.core.site import Site, site_from_values
 from rail_monitor.models import hertz, squeal
 from rail_monitor.squeal.config import SquealConfig, squeal_config
-from rail_monitor.squeal.predict import creep_stiffness, kalker_lateral_force
+from rail_monitor.squeal.predict import creep_stiffness, kalker_lateral_force, level_and_risk
 
 
 @dataclass(frozen=True)
@@ -62,11 +62,13 @@ def site_case(cfg: SquealConfig, site: Site, vehicle_class: str, friction_state:
 
 
 def sweep(case: SquealCase, crabbing_mps: np.ndarray, reference_mps: float | None = None,
-          ode: bool = False) -> dict[str, np.ndarray]:
+          ode: bool = False, cfg: SquealConfig | None = None) -> dict[str, np.ndarray]:
     """Amplitude, regime and relative level over crabbing velocities [m/s] for one case.
 
     The relative level is 20 lg(A w / A w_ref), A w_ref = reference_mps or the largest
-    amplitude of the sweep. With ``ode``, each row also gets the time-domain amplitude.
+    amplitude of the sweep. With ``ode``, each row also gets the time-domain amplitude. With a
+    site's cfg, each row also gets the level at the site's receiver [dB, dB(A)] and the risk class,
+    as the squeal node computes them (at the case's mode frequency sqrt(k/m)/2 pi).
     """
     vc = np.asarray(crabbing_mps, float)
     lc = squeal.limit_cycle_amplitude(case.speed_mps, vc, case.load_n, case.damping_nspm, case.k1, case.k2, case.k3_n)
@@ -80,6 +82,10 @@ def sweep(case: SquealCase, crabbing_mps: np.ndarray, reference_mps: float | Non
         "critical_slip_velocity_mps": np.broadcast_to(lc.critical_slip, vc.shape),
         "effective_damping_nspm": np.broadcast_to(lc.effective_damping, vc.shape),
     }
+    if cfg is not None:
+        freq = np.broadcast_to(squeal.squeal_frequency(case.mass_kg, case.stiffness_npm), vc.shape)
+        lev, out["risk"] = level_and_risk(cfg, lc.amplitude, lc.unstable, freq)
+        out["level_db"], out["level_dba"], out["frequency_hz"] = lev.level_db, lev.level_dba, freq
     if ode:
         out["ode_amplitude_mps"] = np.array([
             squeal.simulate_limit_cycle(case.speed_mps, float(v), case.load_n, case.mass_kg, case.damping_nspm,
