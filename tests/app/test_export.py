@@ -46,8 +46,8 @@ def test_every_format_round_trips_the_bag_values(exported, fmt):
     assert [int(t) for t in passes["stamp_ns"]] == run.passes.stamp_ns.tolist()  # Excel: as text, unrounded
     np.testing.assert_array_equal(passes["speed_mps"].to_numpy(), run.passes.speed_mps)  # exact
     for model, nz in run.noise.items():  # joined by (train_id, stamp): the recorded value of that pass
-        got = dict(zip(zip(passes["train_id"], map(int, passes["stamp_ns"]), strict=True), passes[f"{model}_lpaeq_tp_dba"],
-                       strict=True))
+        keys = zip(passes["train_id"], map(int, passes["stamp_ns"]), strict=True)
+        got = dict(zip(keys, passes[f"{model}_lpaeq_tp_dba"], strict=True))
         want = dict(zip(zip(nz["train_id"], nz["stamp_ns"].tolist(), strict=True), nz["lpaeq_tp_dba"], strict=True))
         assert all(same(got[k], v) for k, v in want.items()), model
     level = run.squeal["level_dba"]
