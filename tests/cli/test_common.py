@@ -32,3 +32,24 @@ def test_predict_corrugation_json_parses_as_strict_json(capsys):
     out = capsys.readouterr().out
     data = _strict(out)
     assert "Infinity" not in out and "NaN" not in out and isinstance(data, dict) and data
+
+
+def test_a_users_parameter_beats_the_site_files_node_section(tmp_path):
+    """rcl takes a node's own params-file section over any -p: the command line's overrides file
+    makes `-p checkpoint_path:=...` reach corrugation_estimator, whose section in the shipped site
+    file sets checkpoint_path to '' (issue 24: no checkpoint was written)."""
+    import argparse
+    import subprocess
+    import sys
+
+    from rail_monitor.cli.common import ros_args, site_file
+
+    ns = argparse.Namespace(namespace="curve_250", ros_extra=["--ros-args", "-p", f"checkpoint_path:={tmp_path}/s.npz",
+                                                              "-p", "state_wait_s:=2.5"])
+    args = ros_args(ns, site_file(None), {"source": "x.csv"})
+    probe = ("import sys, rclpy; from rclpy.node import Node; rclpy.init(args=sys.argv); "
+             "n = Node('corrugation_estimator'); "
+             "print(n.declare_parameter('checkpoint_path', '').value, n.declare_parameter('state_wait_s', 0.0).value, "
+             "n.declare_parameter('source', '').value, n.get_namespace())")
+    r = subprocess.run([sys.executable, "-c", probe, *args[1:]], capture_output=True, text=True, timeout=60)
+    assert r.stdout.split() == [f"{tmp_path}/s.npz", "2.5", "x.csv", "/curve_250"], r.stderr

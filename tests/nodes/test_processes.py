@@ -197,3 +197,23 @@ def test_a_signal_mid_replay_stops_the_source_and_the_graph_cleanly(tmp_path):
         assert time.monotonic() - t0 < 5.0 and p.returncode == 0 and "Traceback" not in err, (argv[0], err[-1500:])
         if bag is not None:
             assert 0 < len(read_bag_passes(bag)) < 8638
+
+
+def test_a_model_node_started_bare_reads_the_shipped_site():
+    """No --params-file: a model node says so and reads the shipped site file (all three classes),
+    as the command line does; before, it knew only the default 'emu' and rejected every other
+    pass (issue 24: 1,653 DMU and freight passes)."""
+    p = subprocess.Popen([_exe("squeal_risk_model"), "--ros-args", "-r", "__ns:=/bare"], stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, cwd=TOP)
+    lines = []
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not any("started:" in line for line in lines):
+            lines.append(p.stdout.readline())
+    finally:
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=30)
+    text = "".join(lines)
+    assert "no --params-file given: using the shipped site file" in text and "curve_250.yaml" in text, text
+    assert "classes=emu/dmu/freight" in text, text
+    assert p.returncode == 0

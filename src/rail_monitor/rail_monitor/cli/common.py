@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
 from collections.abc import Sequence
@@ -105,17 +106,66 @@ def _ros_value(v: object) -> str:
 
 
 def ros_args(ns: argparse.Namespace, site: Path | None, extra: dict[str, object]) -> list[str]:
-    """argv for rclpy.init: the site file, the namespace, and -p for every option given."""
+    """argv for rclpy.init: the site file, the namespace, every option given, then the user's own
+    ROS arguments.
+
+    rcl takes a node's own section of a params file (``/**/corrugation_estimator``) over any
+    ``-p``, so a ``-p`` could never override what the site file sets for one node. With a site
+    file, the options and the user's ``-p name:=value`` go into an overrides file placed after it,
+    under ``/**`` and under every section of the site file that sets the name: a later file wins
+    at the same specificity, so what the user asked for is what the node gets."""
     values = {k[2:]: v for k, v in vars(ns).items() if k.startswith("p:") and v is not None}
     values.update({k: v for k, v in extra.items() if v is not None})
-    args = ["rail-monitor", *getattr(ns, "ros_extra", []), "--ros-args"]
-    if site is not None:
-        args += ["--params-file", str(site)]
+    user = list(getattr(ns, "ros_extra", []))
+    args = ["rail-monitor", "--ros-args"]
     if getattr(ns, "namespace", None):
         args += ["-r", f"__ns:=/{ns.namespace.strip('/')}"]
-    for name, v in values.items():
-        args += ["-p", f"{name}:={_ros_value(v)}"]
-    return args
+    if site is None:
+        return args + [a for name, v in values.items() for a in ("-p", f"{name}:={_ros_value(v)}")] + user
+    rest, given = _split_parameter_rules(user)
+    values.update(given)
+    return [*args, "--params-file", str(site), "--params-file", str(_overrides_file(site, values)), *rest]
+
+
+def _split_parameter_rules(argv: list[str]) -> tuple[list[str], dict[str, object]]:
+    """The ROS arguments without their -p/--param rules, and those rules' values (parsed as YAML,
+    as rcl parses them)."""
+    import yaml
+
+    rest, values, i = [], {}, 0
+    while i < len(argv):
+        if argv[i] in ("-p", "--param") and i + 1 < len(argv) and ":=" in argv[i + 1]:
+            name, text = argv[i + 1].split(":=", 1)
+            values[name] = yaml.safe_load(text) if text else ""
+            i += 2
+        else:
+            rest.append(argv[i])
+            i += 1
+    return rest, values
+
+
+def _overrides_file(site: Path, values: dict[str, object]) -> Path:
+    """A params file of values under ``/**`` and under each section of the site file setting them
+    (removed at exit: this process made it)."""
+    import atexit
+    import tempfile
+
+    import yaml
+
+    from rail_monitor.core.params import flatten
+
+    doc = yaml.safe_load(site.read_text(encoding="utf-8")) or {}
+    out: dict[str, dict] = {"/**": {"ros__parameters": dict(values)}}
+    for section, body in doc.items():
+        params = flatten((body or {}).get("ros__parameters") or {}) if isinstance(body, dict) else {}
+        mine = {k: v for k, v in values.items() if k in params}
+        if mine and section != "/**":
+            out[section] = {"ros__parameters": mine}
+    fd, name = tempfile.mkstemp(prefix="rail_monitor_overrides_", suffix=".yaml")
+    with os.fdopen(fd, "w", encoding="utf-8") as f:
+        yaml.safe_dump(out, f, sort_keys=False)
+    atexit.register(lambda: Path(name).unlink(missing_ok=True))
+    return Path(name)
 
 
 def fresh_output(path: Path, overwrite: bool, inputs: Sequence[str | Path] = ()) -> None:

@@ -86,7 +86,12 @@ def refuse_unknown_parameters(node: Node) -> None:
 
 class RailNode(Node):
     """The base of every rail_monitor node: the logger-level services on (as an operator expects
-    of a ROS 2 node), and a parameter given that no section knows refused at once."""
+    of a ROS 2 node), and a parameter given that no section knows refused at once.
+
+    USES_SITE: the node reads the site's parameters, so its executable started without any
+    --params-file reads the shipped site file (as the command line does)."""
+
+    USES_SITE = True
 
     def __init__(self, name: str, **kwargs: Any) -> None:
         kwargs.setdefault("enable_logger_service", True)

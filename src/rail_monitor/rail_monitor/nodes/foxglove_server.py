@@ -29,6 +29,7 @@ from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TopicTap
 
 
 class FoxgloveServer(RailNode):
+    USES_SITE = False  # records or serves any graph: no site of its own
     EXECUTABLE = "foxglove_server"
     PARAMETERS = (("", FOXGLOVE_SPECS),)
 

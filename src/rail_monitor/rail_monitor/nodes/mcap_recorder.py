@@ -37,6 +37,7 @@ from rail_monitor.nodes.topic_tap import TopicTap
 
 
 class McapRecorder(RailNode):
+    USES_SITE = False  # records or serves any graph: no site of its own
     EXECUTABLE = "mcap_recorder"
     PARAMETERS = (("", RECORDER_SPECS),)
 

@@ -108,18 +108,28 @@ SESSION_PARAMS_FILES: list[str] = []
 
 
 @contextlib.contextmanager
-def ros_session(args: list[str] | None = None, flow_control: bool = False) -> Iterator[threading.Event]:
+def ros_session(args: list[str] | None = None, flow_control: bool = False,
+                default_site: bool = False) -> Iterator[threading.Event]:
     """rclpy initialised for one process, with SIGINT and SIGTERM setting the event it yields
     instead of rclpy's handler (which would shut the context down at once, before a node could
     take what DDS already delivered). Shut down on exit.
 
     flow_control: load the package's Fast DDS profile (see use_flow_control_profile).
+    default_site: without any --params-file, read the shipped site file (said on stderr), so that
+    a model node started bare knows the same rolling stock as the command line's default.
     """
     from rail_monitor.site_file import check_parameter_file
 
     if flow_control:
         use_flow_control_profile()
-    SESSION_PARAMS_FILES[:] = params_files(sys.argv if args is None else args)
+    args = list(sys.argv if args is None else args)
+    if default_site and not params_files(args):
+        from ament_index_python.packages import get_package_share_directory
+
+        shipped = f"{get_package_share_directory('rail_monitor')}/config/curve_250.yaml"
+        print(f"no --params-file given: using the shipped site file {shipped}", file=sys.stderr)
+        args += ["--ros-args", "--params-file", shipped]
+    SESSION_PARAMS_FILES[:] = params_files(args)
     for path in SESSION_PARAMS_FILES:
         check_parameter_file(path)
     try:
@@ -162,7 +172,7 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
         return 0
 
     def main() -> int:
-        with ros_session(args, flow_control) as stop:
+        with ros_session(args, flow_control, default_site=getattr(make, "USES_SITE", False)) as stop:
             node = make()
             executor = SingleThreadedExecutor()
             executor.add_node(node)

@@ -64,7 +64,7 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
     with the same topics, types and QoS).
     """
     # The flow-control profile is for subscribers in other processes (in-process ones are paced exactly).
-    with ros_session(args, flow_control=True) as stop:
+    with ros_session(args, flow_control=True, default_site=True) as stop:
         nodes: list[Node] = []
         executor = spinner = None
         finished = threading.Event()
