@@ -1,12 +1,16 @@
+import re
 from glob import glob
+from pathlib import Path
 
 from setuptools import find_packages, setup
 
 package_name = "rail_monitor"
+# The version is package.xml's (the one place it is set, as ament expects).
+version = re.search(r"<version>([^<]+)</version>", (Path(__file__).parent / "package.xml").read_text()).group(1)
 
 setup(
     name=package_name,
-    version="0.1.0",
+    version=version,
     packages=find_packages(exclude=["test", "tests"]),
     package_data={package_name: ["data/*.csv"]},
     data_files=[

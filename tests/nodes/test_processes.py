@@ -214,6 +214,6 @@ def test_a_model_node_started_bare_reads_the_shipped_site():
         p.send_signal(signal.SIGINT)
         p.wait(timeout=30)
     text = "".join(lines)
-    assert "no --params-file given: using the shipped site file" in text and "curve_250.yaml" in text, text
+    assert "curve_250.yaml (shipped; no --params-file given)" in text, text
     assert "classes=emu/dmu/freight" in text, text
     assert p.returncode == 0

@@ -15,4 +15,14 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-__version__ = "0.1.0"
+def _version() -> str:
+    """The installed package's version (set in package.xml, the one place)."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("rail_monitor")
+    except PackageNotFoundError:  # imported from a source tree that colcon has not installed
+        return "unknown"
+
+
+__version__ = _version()

@@ -128,3 +128,48 @@ def check_parameter_file(path: str | Path) -> None:
 def load_site(path: str | Path) -> Site:
     """The Site described by a site parameter file."""
     return site_from_values(load_parameter_file(path))
+
+
+# -- the parameters reference (docs/parameters.md) ------------------------------------------------
+REFERENCE_SECTIONS: tuple[tuple[str, str, tuple[ParamSpec, ...]], ...] = (
+    ("Site", "", SITE_SPECS), ("Wheel-rail contact", "contact.", CONTACT_SPECS), ("Track", "track.", TRACK_SPECS),
+    ("Vehicle class (one section per name in vehicle_classes)", "vehicle.<class>.", VEHICLE_SPECS),
+    ("Corrugation", "corrugation.", CORRUGATION_SPECS), ("Squeal", "squeal.", SQUEAL_SPECS),
+    ("Rolling noise", "noise.", NOISE_SPECS), ("Alerts", "alerts.", ALERT_SPECS),
+    ("Stamp plausibility", "stamps.", node_params.STAMP_SPECS), ("Simulator", "", SIMULATOR_SPECS),
+    ("Pass sources (pass_replayer, pass_simulator)", "", node_params.PUBLISH_SPECS),
+    ("pass_replayer", "", node_params.REPLAYER_SPECS), ("pass_simulator and pass_replayer: mode", "",
+                                                         node_params.MODE_SPECS),
+    ("mcap_recorder", "", node_params.RECORDER_SPECS), ("wayside_monitor", "", node_params.MONITOR_SPECS),
+    ("Model nodes: batches of passes", "", node_params.BATCH_SPECS),
+    ("corrugation_estimator", "", node_params.ESTIMATOR_SPECS),
+    ("rolling_noise_predictor", "", node_params.PREDICTOR_SPECS), ("foxglove_server", "", node_params.FOXGLOVE_SPECS),
+)
+
+
+def parameters_markdown() -> str:
+    """Every parameter a site file may hold, as Markdown tables generated from the specs (the
+    parameters reference; ``python -m rail_monitor.site_file`` prints it)."""
+    def cell(text: object) -> str:
+        return str(text).replace("|", "\\|").replace("\n", " ")
+
+    command = "ros2_ws/run python -m rail_monitor.site_file > docs/parameters.md"
+    lines = ["# Parameters reference", "",
+             f"Generated from the parameter specs by `{command}`",
+             "(a test checks that this page is current). Every name may appear in a site file; the nodes",
+             "declare them as ROS 2 parameters with the same ranges. Units are in brackets at the end of",
+             "each description. Tunable: may be changed on a running node (`ros2 param set`).", ""]
+    for title, prefix, specs in REFERENCE_SECTIONS:
+        lines += [f"## {title}", "", "| parameter | type | default | allowed | tunable | description |",
+                  "|---|---|---|---|---|---|"]
+        for spec in specs:
+            kind = f"{spec.kind.__name__}[]" if isinstance(spec.default, list) else spec.kind.__name__
+            allowed = "" if spec.kind in (bool, str) and not spec.choices else spec.range_text()
+            lines.append(f"| `{prefix}{spec.name}` | {kind} | `{spec.default!r}` | {cell(allowed)} | "
+                         f"{'yes' if spec.tunable else ''} | {cell(spec.description)} |")
+        lines.append("")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(parameters_markdown(), end="")

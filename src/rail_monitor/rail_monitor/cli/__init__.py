@@ -1,5 +1,5 @@
-"""rail-monitor: the command line (simulate, info, replay, record, monitor, demo, batch, report, export,
-predict).
+"""rail-monitor: the command line (site, simulate, info, replay, record, monitor, demo, batch, report,
+export, predict).
 
 One module per verb: its arguments, a call into the package's functions (what-ifs, batch mode,
 the report, the nodes), and the printing. Node options are generated from the same ParamSpecs
@@ -25,6 +25,7 @@ from rail_monitor.cli import (
     predict_squeal,
     report,
     simulate,
+    site,
 )
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.text import printable
@@ -33,6 +34,7 @@ from rail_monitor.core.text import printable
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="rail-monitor", description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
+    site.add_parser(sub)
     simulate.add_parser(sub)
     info.add_parser(sub)
     graph.add_parsers(sub)

@@ -18,7 +18,7 @@ from rclpy.node import Node
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamGroups, ParamSpec
 from rail_monitor.core.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
-from rail_monitor.nodes.process import CALLBACK_ERRORS
+from rail_monitor.nodes.process import CALLBACK_ERRORS, SESSION_DEFAULT_SITE
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
 
 # The site's parameters, which every model node declares (the vehicle sections per class in
@@ -70,6 +70,8 @@ def announce(node: Node, **key_parameters: Any) -> None:
         names = sorted({e.topic_name for e in endpoints} - {"/rosout", "/parameter_events"})
         return ", ".join(names) or "nothing"
 
+    if SESSION_DEFAULT_SITE and getattr(node, "USES_SITE", False):
+        key_parameters["site_file"] = f"{SESSION_DEFAULT_SITE[0]} (shipped; no --params-file given)"
     settings = ", ".join(f"{k}={v}" for k, v in key_parameters.items())
     node.get_logger().info(f"started: subscribes {topics(node.subscriptions)}; publishes {topics(node.publishers)}"
                            + (f"; {settings}" if settings else ""))

@@ -103,8 +103,9 @@ def params_files(argv: Sequence[str]) -> list[str]:
 
 
 # The --params-file arguments of this process's session, in order (the recorder stores the first
-# one, the site file, with its bag).
+# one, the site file, with its bag), and the shipped site file if the session added it.
 SESSION_PARAMS_FILES: list[str] = []
+SESSION_DEFAULT_SITE: list[str] = []
 
 
 @contextlib.contextmanager
@@ -115,8 +116,9 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
     take what DDS already delivered). Shut down on exit.
 
     flow_control: load the package's Fast DDS profile (see use_flow_control_profile).
-    default_site: without any --params-file, read the shipped site file (said on stderr), so that
-    a model node started bare knows the same rolling stock as the command line's default.
+    default_site: without any --params-file, read the shipped site file (the start-up line says
+    so), so that a model node started bare knows the same rolling stock as the command line's
+    default.
     """
     from rail_monitor.site_file import check_parameter_file
 
@@ -127,8 +129,8 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
         from ament_index_python.packages import get_package_share_directory
 
         shipped = f"{get_package_share_directory('rail_monitor')}/config/curve_250.yaml"
-        print(f"no --params-file given: using the shipped site file {shipped}", file=sys.stderr)
         args += ["--ros-args", "--params-file", shipped]
+        SESSION_DEFAULT_SITE[:] = [shipped]
     SESSION_PARAMS_FILES[:] = params_files(args)
     for path in SESSION_PARAMS_FILES:
         check_parameter_file(path)
@@ -142,6 +144,7 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
         yield stop
     finally:
         SESSION_PARAMS_FILES.clear()
+        SESSION_DEFAULT_SITE.clear()
         rclpy.try_shutdown()
         for sig, handler in previous.items():
             signal.signal(sig, handler)

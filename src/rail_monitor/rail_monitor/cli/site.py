@@ -1,0 +1,94 @@
+"""rail-monitor site: a new site file from the shipped one (or another), with parameters changed,
+comments kept, and the result checked by the one strict path before it is written."""
+
+from __future__ import annotations
+
+import argparse
+import io
+from pathlib import Path
+from typing import Any
+
+from rail_monitor.cli.common import add_site_option, site_file
+from rail_monitor.core.errors import ConfigError, RailMonitorError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    s = sub.add_parser("site", help="write a new site file: a copy of the shipped one (or --site) with parameters "
+                       "changed (--set NAME=VALUE), checked before it is written")
+    s.add_argument("output", help="site file to create (.yaml); an existing file is never replaced")
+    add_site_option(s, what="site file to start from")
+    s.add_argument("--set", dest="changes", action="append", default=[], metavar="NAME=VALUE",
+                   help="a parameter and its value as YAML (e.g. curve_radius_m=400.0, "
+                        "vehicle.freight.traffic_share=0.5); repeat for more")
+    s.set_defaults(func=run)
+
+
+def run(ns: argparse.Namespace) -> int:
+    from rail_monitor.site_file import check_parameter_file, load_site
+
+    out = Path(ns.output)
+    if out.exists() or out.is_symlink():
+        raise RailMonitorError(f"{out} exists: give a new file name (a site file is never replaced)")
+    text, changed = edited_site_text(site_file(ns.site).read_text(encoding="utf-8"), ns.changes)
+    tmp = out.with_name(f".{out.name}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        check_parameter_file(tmp)
+        site = load_site(tmp)
+        tmp.replace(out)
+    except OSError as exc:
+        raise RailMonitorError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    except ConfigError as exc:
+        raise ConfigError(str(exc).replace(str(tmp), str(out))) from None
+    finally:
+        tmp.unlink(missing_ok=True)  # this command made it
+    for line in changed:
+        print(f"site: {line}")
+    print(f"site: wrote {out} (site {site.site_id}, {len(site.vehicles)} vehicle classes), checked")
+    return 0
+
+
+def edited_site_text(text: str, changes: list[str]) -> tuple[str, list[str]]:
+    """The site file's text with each NAME=VALUE set where the file sets NAME (in whichever
+    section), else under ``/**``; comments and layout kept (ruamel.yaml round trip). Returns the
+    text and a line per change."""
+    import yaml
+    from ruamel.yaml import YAML
+
+    rt = YAML()
+    rt.preserve_quotes = True
+    rt.width = 4096
+    doc = rt.load(text)
+    lines = []
+    for change in changes:
+        name, sep, raw = change.partition("=")
+        if not sep or not name.strip():
+            raise RailMonitorError(f"--set {change!r}: expected NAME=VALUE")
+        try:
+            value = yaml.safe_load(raw)
+        except yaml.YAMLError as exc:
+            raise RailMonitorError(f"--set {change!r}: the value is not YAML: {str(exc).splitlines()[0]}") from None
+        old = _set(doc, name.strip(), value)
+        lines.append(f"{name.strip()}: {old!r} -> {value!r}")
+    buf = io.StringIO()
+    rt.dump(doc, buf)
+    return buf.getvalue(), lines
+
+
+def _set(doc: Any, name: str, value: Any) -> Any:
+    """Set a dotted name where a section of doc has it, else under /**; returns the old value."""
+    keys = name.split(".")
+    for section in doc.values():
+        params = section.get("ros__parameters") if hasattr(section, "get") else None
+        node = params
+        for k in keys[:-1]:
+            node = node.get(k) if hasattr(node, "get") else None
+        if hasattr(node, "get") and keys[-1] in node:
+            old = node[keys[-1]]
+            node[keys[-1]] = value
+            return old
+    node = doc.setdefault("/**", {}).setdefault("ros__parameters", {})
+    for k in keys[:-1]:
+        node = node.setdefault(k, {})
+    node[keys[-1]] = value
+    return None
