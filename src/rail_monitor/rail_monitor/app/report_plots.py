@@ -34,7 +34,7 @@ def _dates(stamp_ns: np.ndarray) -> np.ndarray:
 
 def _time_axis(ax, zone: str) -> None:
     tz = time_zone(zone)
-    locator = mdates.AutoDateLocator(tz=tz, maxticks=8)
+    locator = mdates.AutoDateLocator(tz=tz)
     ax.xaxis.set_major_locator(locator)
     ax.xaxis.set_major_formatter(mdates.ConciseDateFormatter(locator, tz=tz))
     ax.set_xlabel(f"pass time ({zone})")
