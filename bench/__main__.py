@@ -5,7 +5,8 @@ Run: ros2_ws/run python -m bench [--quick]
 Figures are measured side by side in this run only: compare ratios within a run, not absolute
 times across machines. Sections: the graph against its rclpy ceiling (the no-op graph of
 bench.bare_graph); batch mode at 1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
-per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes.
+per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes;
+many sites on a local Dask cluster of 1 and 2 workers.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from bench import corrugation as bc
 from bench import graph as bg
 from bench import noise as bn
 from bench import recorder as br
+from bench import sites as bsites
 from bench import squeal as bs
 from rail_monitor.app.batch import run_models, write_bag
 from rail_monitor.bagio.passes_bag import write_passes_bag
@@ -159,6 +161,8 @@ def main() -> None:
         sections.append(("models, per pass", model_rows(ns.site)))
         sections.append(("recorder", recorder_rows(values, source, tmp)))
         sections.append(("memory against passes", memory))
+        sections.append(("many sites on a local Dask cluster", bsites.rows(values, ns.site, 2 if ns.quick else 4,
+                                                                           1000 if ns.quick else 20_000)))
     text = f"Machine: {machine()}\n\n{table(sections)}\n"
     print(text)
     Path(ns.out).parent.mkdir(parents=True, exist_ok=True)

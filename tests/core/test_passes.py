@@ -121,3 +121,16 @@ def test_a_source_leaves_out_what_it_cannot_or_should_not_send():
     assert sent.train_id.tolist() == ["T0", "T1", "T2"]
     assert left_out == {"stamp not representable (builtin_interfaces/Time seconds are int32)": 1,
                         ahead_reason(366 * 86_400.0, "stream"): 1}
+
+
+def test_the_control_character_class_is_unicodes_cc_zl_and_zp():
+    """The regular expression that rejects a train_id or class equals Unicode's categories Cc, Zl
+    and Zp over every code point (it replaced a per-character unicodedata lookup)."""
+    import sys
+    import unicodedata
+
+    from rail_monitor.core.passes import _has_control
+
+    for cp in range(sys.maxunicode + 1):
+        c = chr(cp)
+        assert _has_control(c) == (unicodedata.category(c) in ("Cc", "Zl", "Zp")), hex(cp)

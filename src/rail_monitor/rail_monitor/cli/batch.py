@@ -15,13 +15,14 @@ from rail_monitor.cli.common import (
     site_values,
     stored_site,
 )
+from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.text import printable
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     s = sub.add_parser("batch", help="the graph's models over a whole history without DDS (vectorised), "
                        "recorded to a bag like the live graph, with the report")
-    s.add_argument("source", help="bag folder, .mcap, .db3 or .csv")
+    s.add_argument("source", nargs="?", help="bag folder, .mcap, .db3 or .csv (or give --manifest)")
     add_site_option(s)
     s.add_argument("--topic", help="TrainPass topic of the bag (default: the only one)")
     s.add_argument("--output", help="bag folder to write (default: <source>_batch next to the source)")
@@ -33,10 +34,21 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--salvage", action="store_true", help=SALVAGE_HELP)
     s.add_argument("--skip-bad-rows", action="store_true",
                    help="CSV: leave malformed rows out (counted, their lines named) instead of failing")
+    m = s.add_argument_group("many sites (a Dask cluster)")
+    m.add_argument("--manifest", help="YAML list of sites (site:, history:, output:), one task per site; "
+                   "outputs per site, no report")
+    m.add_argument("--workers", type=int, default=0, help="worker processes of the local cluster (default: one "
+                   "per core)")
+    m.add_argument("--scheduler", help="address of a running Dask scheduler (e.g. tcp://10.0.0.5:8786) instead "
+                   "of a local cluster")
     s.set_defaults(func=run)
 
 
 def run(ns: argparse.Namespace) -> int:
+    if bool(ns.manifest) == bool(ns.source):
+        raise RailMonitorError("give a source, or --manifest for many sites (not both)")
+    if ns.manifest:
+        return _many_sites(ns)
     from rail_monitor.app.batch import run_models, write_bag
     from rail_monitor.bagio.reader import read_passes
 
@@ -62,4 +74,21 @@ def run(ns: argparse.Namespace) -> int:
           f"{time.monotonic() - t0 - t_models:.1f} s")
     if not ns.no_report:
         print_report(str(out), ns.site, ns.report)
+    return 0
+
+
+def _many_sites(ns: argparse.Namespace) -> int:
+    from rail_monitor.app.sites import read_manifest, run_sites
+
+    jobs = read_manifest(ns.manifest)
+    t0 = time.monotonic()
+    results = run_sites(jobs, ns.workers, ns.scheduler or "")
+    wall = time.monotonic() - t0
+    for r in results:
+        days = f"grinding in {r.days_to_threshold:.0f} days" if r.days_to_threshold < 1e9 else "no grinding forecast"
+        print(f"batch: site {printable(r.site_id)}: {r.passes} passes ({r.rejected} rejected), {r.alert_events} "
+              f"alert events, {days}; {r.seconds:.1f} s on {r.worker}; recorded to {printable(r.output)}")
+    total = sum(r.passes for r in results)
+    print(f"batch: {len(results)} sites, {total} passes in {wall:.1f} s ({total / max(wall, 1e-9):.0f} passes/s, "
+          f"{len({r.worker for r in results})} workers used)")
     return 0

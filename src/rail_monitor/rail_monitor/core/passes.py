@@ -7,7 +7,7 @@ defaults. Field names, units and enumeration values mirror ``rail_msgs/msg/Train
 
 from __future__ import annotations
 
-import unicodedata
+import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
@@ -116,10 +116,14 @@ class PassTable:
         )
 
 
+# Unicode's categories Cc (C0, DEL, C1), Zl (U+2028) and Zp (U+2029), as one character class: a C
+# string or a terminal would act on them, or a log line would be split.
+_CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
+
+
 def _has_control(text: str) -> bool:
-    """Whether text holds a control character (NUL, ESC, DEL, C1: a C string or a terminal would act
-    on it) or a line or paragraph separator."""
-    return any(unicodedata.category(c) in ("Cc", "Zl", "Zp") for c in text)
+    """Whether text holds a control character (NUL, ESC, DEL, C1) or a line or paragraph separator."""
+    return _CONTROL.search(text) is not None
 
 
 def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
@@ -142,7 +146,8 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     flag(np.array([len(s) > 64 for s in table.train_id], dtype=bool), "train_id longer than 64 characters")
     flag(np.array([_has_control(s) for s in table.train_id], dtype=bool),
          "train_id has control or separator characters")
-    flag(np.array([_has_control(s) for s in table.vehicle_class], dtype=bool),
+    bad_class = {c: _has_control(c) for c in set(table.vehicle_class.tolist())}  # few distinct classes
+    flag(np.array([bad_class[c] for c in table.vehicle_class.tolist()], dtype=bool),
          "vehicle_class has control or separator characters")
     flag(~np.isfinite(table.speed_mps), "speed_mps not finite")
     flag(table.speed_mps <= 0.0, "speed_mps not positive")

@@ -146,29 +146,44 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
     0 where the band is already at or past the level, inf where no component grows. The left
     side's log is convex in n; Newton's method started where the fastest-growing component alone
     reaches the level (at or beyond the root) converges to the root monotonically from above.
+
+    Evaluated component-major ((P, bands) arrays, so the sums over components are row
+    additions, not reductions over a short last axis) and only on the bands not yet converged
+    (a band that took no step takes none again), with the same arithmetic per band as a plain
+    evaluation of every band.
     """
     x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
-    target = np.broadcast_to(np.asarray(log_level, float), x.shape[:-1])
-    grows = np.any(g > 0, axis=-1)
+    shape = x.shape[:-1]
+    p = x.shape[-1]
+    xs = np.ascontiguousarray(x.reshape(-1, p).T)  # (P, M)
+    gs = np.ascontiguousarray(g.reshape(-1, p).T)
+    target = np.broadcast_to(np.asarray(log_level, float), shape).reshape(-1)
 
-    def excess(n: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """ln(band r.m.s.) - ln(level) after n passes, and its slope in n."""
-        e = 2.0 * (x + g * n[..., None])
-        top = e.max(axis=-1, keepdims=True)
+    def excess(idx: np.ndarray | slice, n: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """ln(band r.m.s.) - ln(level) after n passes, and its slope in n, for bands idx."""
+        gi = gs[:, idx]
+        e = 2.0 * (xs[:, idx] + gi * n)
+        top = e.max(axis=0)
         w = np.exp(e - top)
-        return 0.5 * (top[..., 0] + np.log(w.sum(axis=-1))) - target, np.sum(w * g, axis=-1) / w.sum(axis=-1)
+        total = w.sum(axis=0)
+        return 0.5 * (top + np.log(total)) - target[idx], (w * gi).sum(axis=0) / total
 
-    at_level = excess(np.zeros(target.shape))[0] >= 0
+    grows = (gs > 0).any(axis=0)
+    at_level = excess(slice(None), np.zeros(target.shape))[0] >= 0
     with np.errstate(divide="ignore", invalid="ignore"):
-        alone = np.where(g > 0, (target[..., None] - x) / g, np.inf)
-    n = np.where(grows & ~at_level, np.min(alone, axis=-1), 0.0)
+        alone = np.where(gs > 0, (target - xs) / gs, np.inf)
+    n = np.where(grows & ~at_level, alone.min(axis=0), 0.0)
+    active = np.flatnonzero(grows & ~at_level)
     for _ in range(200):
-        f, df = excess(n)
-        step = np.where(grows & ~at_level & (f > 0), f / np.where(df > 0, df, np.inf), 0.0)
-        n = n - step
-        if np.all(step <= 1e-12 * np.maximum(n, 1.0)):
+        if not len(active):
             break
-    return np.where(at_level, 0.0, np.where(grows, n, np.inf))
+        f, df = excess(active, n[active])
+        step = np.where(f > 0, f / np.where(df > 0, df, np.inf), 0.0)
+        n[active] -= step
+        if np.all(step <= 1e-12 * np.maximum(n[active], 1.0)):
+            break
+        active = active[step != 0.0]  # a band with no step keeps its n: it needs no more evaluation
+    return np.where(at_level, 0.0, np.where(grows, n, np.inf)).reshape(shape)
 
 
 # Post-grinding acceptance limits of Grassie, Saxon & Smith (1999), r.m.s. roughness per

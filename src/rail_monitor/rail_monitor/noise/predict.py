@@ -172,12 +172,14 @@ class RollingNoiseModel:
         model = model or self.models[0]
         if model not in MODELS:
             raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
-        roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model)
+        filters: dict[str, np.ndarray] = {}  # the contact filter per class: the same on both rails
+        roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filters)
         pb = self._pass_by(components, passes)
         names = list(components)
         growth = np.zeros(len(passes))
         if corrugation is not None:
-            _, ground = self._sources(self.rail_roughness_db(corrugation, post_grinding=True), passes, model)
+            _, ground = self._sources(self.rail_roughness_db(corrugation, post_grinding=True), passes, model,
+                                      filters)
             growth = pb.lpaeq_tp_dba - self._pass_by(ground, passes, False).lpaeq_tp_dba
         return NoisePrediction(
             model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
@@ -187,10 +189,12 @@ class RollingNoiseModel:
                                           for c in names], axis=-1),
             roughness_growth_increase_db=growth)
 
-    def _sources(self, rail_db: np.ndarray, passes: PassTable,
-                 model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str,
+                 filters: dict[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness [dB re 1 um] and sound power per metre of train per component
-        [dB re 1 pW/m] (passes x bands) on a rail roughness spectrum."""
+        [dB re 1 pW/m] (passes x bands) on a rail roughness spectrum. filters: the mechanics
+        model's contact filter level per class, computed on first use (it depends on the passes
+        only)."""
         n, nb = len(passes), len(self.band)
         per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
         roughness = np.empty((n, nb))
@@ -200,7 +204,7 @@ class RollingNoiseModel:
         for name in set(passes.vehicle_class.tolist()):
             rows = passes.vehicle_class == name
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
-            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model)
+            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model, filters, name)
             roughness[rows] = lr
             for comp, lh in transfers.items():
                 components[comp][rows] = lr + lh + per_metre[rows]
@@ -210,16 +214,17 @@ class RollingNoiseModel:
         return pass_by(_total(components), self.band, passes.train_length_m, passes.speed_mps, self.receiver,
                        self.vertical_db, time_weighted)
 
-    def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray,
-                   model: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray, model: str,
+                   filters: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
         rule = self.cfg.interpolation
         if model == "cnossos":
             lr = cn.total_roughness(rail_db, terms.wheel_db, terms.a3_db, self.impact_db)
             return cn.at_band_frequencies(lr, speed, self.band_hz, rule), terms.cnossos
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
-        filt = wrn.contact_filter_power(speed, self.band, terms.semi_length_m, self.cfg.band_points)
-        lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + level(filt)
+        if name not in filters:
+            filters[name] = level(wrn.contact_filter_power(speed, self.band, terms.semi_length_m, self.cfg.band_points))
+        lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + filters[name]
         return lr, terms.mechanics
 
 
