@@ -10,7 +10,9 @@ topics, types and QoS as mcap_recorder records the live graph.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -62,11 +64,15 @@ class BatchResult:
     left_out: dict[str, int]          # passes the replayer would not send, by reason
 
 
-def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None
-               ) -> BatchResult:
+def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
+               threads: int = 0) -> BatchResult:
     """Every model over ``passes`` for the site of the flat parameter ``values``.
 
     estimator: a state to continue from (e.g. a checkpoint); default the post-grinding state.
+    threads: threads for the independent parts (squeal beside the corrugation history; the noise
+    chunks of every model), 0: one per core. numpy releases the interpreter lock in its array
+    loops, so the threads use the cores; the chunks are the same whatever the count, so the
+    results are too.
     """
     site = site_from_values(values)
     margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
@@ -75,11 +81,14 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     est = estimator or CorrugationEstimator(site, corrugation_config(values))
     reject_ahead(table.stamp_ns, reasons, est.newest_ns, margins)  # as every node of the graph does
     accepted = with_class_defaults(table.take(reasons == ""), site)
-    squeal = predict_squeal(squeal_config(values), site, accepted)
-    traj = _history(est, accepted)
-    state_of_pass = state_index(traj.stamp_ns, traj.train_id.tolist(), accepted.stamp_ns, accepted.train_id.tolist())
     model = RollingNoiseModel(site, noise_config(values))
-    noise = {name: _noise_on_states(model, name, accepted, traj, state_of_pass) for name in model.models}
+    with ThreadPoolExecutor(max_workers=threads or os.cpu_count() or 1) as pool:
+        squeal_job = pool.submit(predict_squeal, squeal_config(values), site, accepted)
+        traj = _history(est, accepted)
+        state_of_pass = state_index(traj.stamp_ns, traj.train_id.tolist(), accepted.stamp_ns,
+                                    accepted.train_id.tolist())
+        noise = _noise_on_states(pool, model, accepted, traj, state_of_pass)
+        squeal = squeal_job.result()
     alerts = AlertManager(alert_config(values, est.cfg.lead_time_days))
     events = _feed_alerts(alerts, table, reasons, accepted, squeal, traj, noise)
     return BatchResult(site, table, reasons, accepted, squeal, traj, state_of_pass, noise, events,
@@ -96,30 +105,35 @@ def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:
                               for i in range(0, len(passes), HISTORY_CHUNK)])
 
 
-def _noise_on_states(model: RollingNoiseModel, name: str, accepted: PassTable, traj: Trajectory,
-                     state_of_pass: np.ndarray) -> NoisePrediction:
-    """One model's noise of every accepted pass, each on its state (passes before any state on none)."""
+def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable, traj: Trajectory,
+                     state_of_pass: np.ndarray) -> dict[str, NoisePrediction]:
+    """Every model's noise of every accepted pass, each on its state (passes before any state on
+    none), as tasks of pool."""
     have = state_of_pass >= 0
     c = traj.constants
-    with_state = _predict_noise(model, accepted.take(have), name, Corrugation(
-        c.bands, traj.amplitude[state_of_pass[have]], c.grinding_amplitude))
-    if have.all():
-        return with_state
-    return with_state.merged(have, _predict_noise(model, accepted.take(~have), name))
+    on_state = accepted.take(have)
+    state = Corrugation(c.bands, traj.amplitude[state_of_pass[have]], c.grinding_amplitude)
+    jobs = {name: (_noise_chunks(pool, model, on_state, name, state),
+                   None if have.all() else _noise_chunks(pool, model, accepted.take(~have), name))
+            for name in model.models}
+    out = {}
+    for name, (with_state, without) in jobs.items():
+        joined = NoisePrediction.concat([f.result() for f in with_state])
+        out[name] = joined if without is None else joined.merged(have, NoisePrediction.concat(
+            [f.result() for f in without]))
+    return out
 
 
-def _predict_noise(model: RollingNoiseModel, passes: PassTable, name: str,
-                   corrugation: Corrugation | None = None) -> NoisePrediction:
-    """model.predict in chunks of passes (each pass is independent), joined in order."""
-    if len(passes) <= NOISE_CHUNK:
-        return model.predict(passes, name, corrugation)
-    parts = []
-    for i in range(0, len(passes), NOISE_CHUNK):
+def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable, name: str,
+                  corrugation: Corrugation | None = None) -> list[Future]:
+    """model.predict over chunks of NOISE_CHUNK passes (each pass is independent), one task each."""
+    jobs = []
+    for i in range(0, max(len(passes), 1), NOISE_CHUNK):
         rows = slice(i, i + NOISE_CHUNK)
         state = corrugation if corrugation is None or corrugation.amplitude_m.ndim == 1 else Corrugation(
             corrugation.wavelength_m, corrugation.amplitude_m[rows], corrugation.post_grinding_m)
-        parts.append(model.predict(passes.take(rows), name, state))
-    return NoisePrediction.concat(parts)
+        jobs.append(pool.submit(model.predict, passes.take(rows), name, state))
+    return jobs
 
 
 def _alert_key(a: Alert) -> tuple[int, int, str, bool]:
