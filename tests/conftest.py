@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import itertools
 import os
+import shutil
 import subprocess
+import tempfile
 import threading
 import time
 from collections.abc import Iterator
@@ -44,6 +47,10 @@ _DOMAINS = itertools.count()
 # Discovery stays on this machine: a test graph never meets another host's, nor theirs ours.
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ["ROS_DOMAIN_ID"] = str(GRAPH_DOMAIN)
+# The disk cache of site tables (rail_monitor.core.cache) of this run only, shared by its processes:
+# the tests never read a cache another version wrote, nor leave one in the user's home.
+os.environ["RAIL_MONITOR_CACHE"] = tempfile.mkdtemp(prefix="rail_monitor_test_cache_")
+atexit.register(shutil.rmtree, os.environ["RAIL_MONITOR_CACHE"], ignore_errors=True)  # it made the folder
 
 
 @pytest.fixture(autouse=True)

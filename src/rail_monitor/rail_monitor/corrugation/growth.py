@@ -9,10 +9,12 @@ load. The growths are tabulated once per site on a 0.1 m/s speed grid and interp
 
 from __future__ import annotations
 
+import dataclasses
 from functools import lru_cache
 
 import numpy as np
 
+from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.passes import MAX_SPEED_MPS
 from rail_monitor.core.site import Site
 from rail_monitor.corrugation.config import SPEED_STEP_MPS, CorrugationConfig
@@ -23,9 +25,14 @@ from rail_monitor.models.contact_filter import hertzian_line_filter
 
 @lru_cache(maxsize=8)
 def _rail_receptance(track: tr.Track) -> tuple[np.ndarray, np.ndarray]:
-    """Bay-averaged discrete-support rail receptance [m/N] on a log frequency grid [Hz]."""
-    f = np.geomspace(0.05, 2.0e4, 700)
-    return f, tr.bay_averaged_receptance(f, track)
+    """Bay-averaged discrete-support rail receptance [m/N] on a log frequency grid [Hz]: about a
+    second to build, so kept on disk per track (rail_monitor.core.cache) and in memory."""
+    def build() -> dict[str, np.ndarray]:
+        f = np.geomspace(0.05, 2.0e4, 700)
+        return {"frequency_hz": f, "receptance_m_per_n": tr.bay_averaged_receptance(f, track)}
+
+    got = cached_arrays("rail_receptance", dataclasses.asdict(track), build)
+    return got["frequency_hz"], got["receptance_m_per_n"]
 
 
 def _interp_log(x: np.ndarray, xp: np.ndarray, yp: np.ndarray) -> np.ndarray:

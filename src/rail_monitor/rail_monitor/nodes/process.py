@@ -5,6 +5,7 @@ single-node executable."""
 from __future__ import annotations
 
 import contextlib
+import faulthandler
 import gc
 import signal
 import sys
@@ -34,6 +35,8 @@ def help_text(executable: str, doc: str | None, groups: ParamGroups) -> str:
     return "\n".join([f"usage: {executable} [--ros-args -p NAME:=VALUE ... --params-file SITE.yaml ...]", "",
                       summary, "", "parameters:", *help_lines(groups), ""])
 
+
+STOP_HANG_S = 20.0  # a process still stopping after this long prints its threads' stacks
 
 # Exceptions that escaped a callback in this process, by cause: rclpy's own handlers raise on some
 # messages (its /clock subscription on a negative time), and no single message may stop a node.
@@ -139,7 +142,14 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
     except Exception as exc:  # rcl refuses unreadable params files and malformed -p values at init
         raise ConfigError(f"cannot start: {(str(exc).strip().splitlines() or [type(exc).__name__])[-1]}") from None
     stop = threading.Event()
-    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGINT, signal.SIGTERM)}
+
+    def on_signal(*_: object) -> None:
+        stop.set()
+        # A stop still under way after STOP_HANG_S is a hang in rcl or a node: every thread's stack
+        # goes to stderr, to say where (the process goes on; a supervisor's kill ends it).
+        faulthandler.dump_traceback_later(STOP_HANG_S, exit=False)
+
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         yield stop
     finally:
@@ -148,6 +158,7 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
         rclpy.try_shutdown()
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+        faulthandler.cancel_dump_traceback_later()
 
 
 def exit_code(main: Callable[[], int]) -> int:
