@@ -60,16 +60,17 @@ def read_manifest(path: str | Path) -> list[SiteJob]:
     if not isinstance(entries, list) or not entries:
         raise ConfigError(f"{path}: expected 'sites:' with a list of entries (site:, history:, output:)")
     jobs, outputs = [], set()
+    base = path.parent.resolve()  # absolute: a worker on another host has its own working folder
     for i, entry in enumerate(entries):
         where = f"{path}: sites[{i}]"
         if not isinstance(entry, dict) or not {"site", "history"} <= set(entry) or set(entry) - {"site", "history",
                                                                                                      "output"}:
             raise ConfigError(f"{where}: expected the keys site and history (and optionally output)")
-        site, history = (path.parent / str(entry[k]) for k in ("site", "history"))
+        site, history = (base / str(entry[k]) for k in ("site", "history"))
         for p in (site, history):
             if not p.exists():
                 raise ConfigError(f"{where}: {p} not found")
-        output = path.parent / str(entry["output"]) if entry.get("output") else _beside(history)
+        output = base / str(entry["output"]) if entry.get("output") else _beside(history)
         if output.resolve() in outputs:
             raise ConfigError(f"{where}: output {output} is another site's too")
         outputs.add(output.resolve())
