@@ -22,7 +22,6 @@ from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 from rail_monitor.core.errors import ConfigError, RailMonitorError
 from rail_monitor.core.params import ParamSpec, resolve
@@ -147,6 +146,8 @@ def simulate(site: Site, cfg: SimulatorConfig) -> PassTable:
     mean, sd = per_class("speed_mean_mps"), per_class("speed_sd_mps")
     lo, hi = per_class("speed_min_mps"), per_class("speed_max_mps")
     sd_safe = np.where(sd > 0.0, sd, 1.0)
+    from scipy import stats  # lazy: scipy.stats costs 0.3 s to import
+
     z = stats.truncnorm.rvs((lo - mean) / sd_safe, (hi - mean) / sd_safe, size=n, random_state=rng)
     speed = np.where(sd > 0.0, mean + sd_safe * z, np.clip(mean, lo, hi))
 

@@ -45,7 +45,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import linprog
 
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
@@ -247,6 +246,8 @@ def optimise_speed_distribution(growth: ArrayLike, speeds: ArrayLike, mean_speed
     cost = np.r_[np.zeros(ns), 1.0]
     a_ub = np.c_[g / scale, -np.ones(nb)]
     a_eq = np.vstack([np.r_[np.ones(ns), 0.0], np.r_[v / mean_speed, 0.0]])
+    from scipy.optimize import linprog  # lazy: scipy.optimize costs 0.3 s to import
+
     res = linprog(cost, A_ub=a_ub, b_ub=np.zeros(nb), A_eq=a_eq, b_eq=[1.0, 1.0],
                   bounds=[(0.0, max_share)] * ns + [(None, None)], method="highs")
     if res.status != 0:

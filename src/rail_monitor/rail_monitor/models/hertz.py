@@ -27,7 +27,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 from scipy.special import ellipe, ellipkm1
 
 FloatArray = NDArray[np.float64]
@@ -78,6 +77,8 @@ def _axis_ratio(curvature_ratio: float) -> float:
         return 1.0
     # B_1/A_1 grows monotonically as k falls; bracket in log k down to k = 1e-6 (ratio ~ 1e10).
     f = lambda log_k: np.log(_ratio_for_axis_ratio(np.exp(log_k))) - np.log(curvature_ratio)  # noqa: E731
+    from scipy.optimize import brentq  # lazy: scipy.optimize costs 0.3 s to import
+
     return float(np.exp(brentq(f, np.log(1e-6), np.log(1.0 - 1e-9), xtol=1e-14, rtol=1e-14)))
 
 

@@ -40,7 +40,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.signal import lfilter
 
 from rail_monitor.models.levels import a_weighted, level, power
 
@@ -172,5 +171,7 @@ def _f_weighted_peak(c1: FloatArray, c2: FloatArray, length: FloatArray, speed: 
     x = c1[:, None] * (g(s, d, r1) - g(s - length[:, None], d, r1)) \
         + c2[:, None] * (g(s, d, r2) - g(s - length[:, None], d, r2))
     a = np.exp(-1.0 / steps_per_tau)
+    from scipy.signal import lfilter  # lazy: scipy.signal costs 0.4 s to import
+
     y, _ = lfilter([1.0 - a], [1.0, -a], x, axis=1, zi=a * x[:, :1])
     return y.max(axis=1)

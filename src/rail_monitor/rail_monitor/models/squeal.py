@@ -44,7 +44,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import solve_ivp
 
 from rail_monitor.models.hertz import HertzContact
 from rail_monitor.models.iec61672 import a_weighting_db
@@ -254,6 +253,8 @@ def simulate_limit_cycle(
     ``max_cycles``. Independent of the closed form: used by the tests to check it, and
     available to users. Units as in :func:`limit_cycle_amplitude`; mass [kg], stiffness [N/m].
     """
+    from scipy.integrate import solve_ivp  # lazy: only the tests and --ode integrate
+
     omega = np.sqrt(stiffness / mass)
     period = 2.0 * np.pi / omega
 
