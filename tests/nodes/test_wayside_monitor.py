@@ -18,6 +18,7 @@ import pytest
 import yaml
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rosbags.highlevel import AnyReader
 
 from rail_monitor.alerts.config import KIND_SQUEAL
 from rail_monitor.app.batch import run_models, write_bag
@@ -243,6 +244,13 @@ def test_separate_processes_equal_batch(runs, tmp_path):
     n = _graph_in_processes(runs, tmp_path)
     run = load_run(tmp_path / "bag")
     assert read_site_record(tmp_path / "bag")["site_file"] == runs["site"].read_text()
+    # Every log time on pass time, the replayer's wall-clock /diagnostics before the first /clock
+    # too (held for the clock's first time): the bag spans the history, not the history to today.
+    first, last = int(run.passes.stamp_ns.min()), int(run.passes.stamp_ns.max())
+    with AnyReader([tmp_path / "bag"]) as reader:
+        for c in reader.connections:
+            times = [t for _, t, _ in reader.messages(connections=[c])]
+            assert not times or first <= min(times) <= max(times) <= last, (c.topic, min(times), max(times))
     assert len(run.passes) == n
     _assert_equal_runs(run, runs["batch"])
     _assert_same_messages(tmp_path / "bag", runs["tmp"] / "batch")

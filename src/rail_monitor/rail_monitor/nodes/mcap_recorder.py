@@ -35,6 +35,8 @@ from rail_monitor.nodes.process import SESSION_PARAMS_FILES, run_node, spin_once
 from rail_monitor.nodes.qos import qos_to_dict
 from rail_monitor.nodes.topic_tap import TopicTap
 
+BEFORE_CLOCK_MAX = 20_000  # messages held for the first /clock; past that, logged as they come
+
 
 class McapRecorder(RailNode):
     USES_SITE = False  # records or serves any graph: no site of its own
@@ -56,6 +58,7 @@ class McapRecorder(RailNode):
             records={SITE_RECORD: record} if record else None, custom_data=custom_data(record) if record else None)
         self._lock = threading.RLock()  # a write failure publishes diagnostics, which read the writer
         self._has_header: dict[str, bool] = {}
+        self._before_clock: list[tuple[str, bytes]] = []  # received on sim time before the first /clock
         self.counts: dict[str, int] = {}
         self.meter = RateMeter()
         self.tap = TopicTap(self, self.cfg.topics, self.cfg.discovery_period_s, self._add_topic, self._on_messages)
@@ -94,8 +97,26 @@ class McapRecorder(RailNode):
         with self._lock:
             if self.writer.closed:
                 return
+            now = self.get_clock().now().nanoseconds
+            if now <= 0 and self.cfg.log_time == "receive" and len(self._before_clock) < BEFORE_CLOCK_MAX:
+                # Sim time before the first /clock: no receipt time yet. Held, and logged at the
+                # clock's first time, so the bag's timeline is the pass time's alone.
+                self._before_clock.append((topic, data))
+                return
+            self._write_before_clock(now)
+            self._write(topic, data, self._log_time(topic, data, now))
+
+    def _write_before_clock(self, now: int) -> None:
+        """Log what arrived before the first /clock at now (the clock's first time), or, when no
+        clock ever came (now 0), at its header stamp or the wall clock."""
+        held, self._before_clock = self._before_clock, []
+        for topic, data in held:
+            self._write(topic, data, now if now > 0 else self._log_time(topic, data, 0))
+
+    def _write(self, topic: str, data: bytes, log_time_ns: int) -> None:
+        with self._lock:
             try:
-                self.writer.write(topic, data, self._log_time(topic, data))
+                self.writer.write(topic, data, log_time_ns)
             except RailMonitorError as exc:
                 self._write_failed(exc)
                 return
@@ -105,14 +126,14 @@ class McapRecorder(RailNode):
             self.counts[topic] += 1
         self.meter.tick()
 
-    def _log_time(self, topic: str, data: bytes) -> int:
-        """The node clock at receipt (as rosbag2; pass time on sim time), or with log_time header
-        the header stamp. A time the clock cannot give (0: sim time before the first /clock) and a
-        stamp before 1970 cannot be an MCAP log time: the other one, else the wall clock, stands in."""
+    def _log_time(self, topic: str, data: bytes, now: int) -> int:
+        """The node clock at receipt, now (as rosbag2; pass time on sim time), or with log_time
+        header the header stamp. A time the clock cannot give (0: sim time before the first
+        /clock) and a stamp before 1970 cannot be an MCAP log time: the other one, else the wall
+        clock, stands in."""
         stamp = header_stamp_ns(data) if self._has_header[topic] else 0
         if self.cfg.log_time == "header" and stamp > 0:
             return stamp
-        now = self.get_clock().now().nanoseconds
         return now if now > 0 else stamp if stamp > 0 else time.time_ns()
 
     def _write_failed(self, exc: RailMonitorError) -> None:
@@ -125,6 +146,9 @@ class McapRecorder(RailNode):
     def _flush(self) -> None:
         with self._lock:
             if not self.writer.closed:
+                now = self.get_clock().now().nanoseconds
+                if self._before_clock and now > 0:  # the clock started, and nothing came since
+                    self._write_before_clock(now)
                 try:
                     self.writer.flush()
                 except RailMonitorError as exc:
@@ -146,6 +170,7 @@ class McapRecorder(RailNode):
         with self._lock:
             if self.writer.closed:
                 return self.writer.folder
+            self._write_before_clock(self.get_clock().now().nanoseconds)
             folder = self.writer.close()  # RailMonitorError after a write error: run_node exits 2
         self.get_logger().info(f"bag {folder}: {self.meter.count} messages")
         return folder
