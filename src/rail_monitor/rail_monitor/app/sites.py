@@ -32,6 +32,8 @@ from rail_monitor.core.errors import ConfigError, RailMonitorError
 
 @dataclass(frozen=True)
 class SiteJob:
+    """One site of a manifest: its site file, its history, and the bag folder to write."""
+
     site: Path
     history: Path
     output: Path
@@ -39,6 +41,8 @@ class SiteJob:
 
 @dataclass(frozen=True)
 class SiteResult:
+    """What a site's task reports (seconds: its own run; worker: where it ran)."""
+
     site_id: str
     output: str
     passes: int
