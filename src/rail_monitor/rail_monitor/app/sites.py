@@ -24,16 +24,15 @@ import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import yaml
 
 from rail_monitor.core.errors import ConfigError, RailMonitorError
 
 
-@dataclass(frozen=True)
-class SiteJob:
-    """One site of a manifest: its site file, its history, and the bag folder to write."""
-
+# One site of a manifest: its site file, its history, and the bag folder to write.
+class SiteJob(NamedTuple):
     site: Path
     history: Path
     output: Path
