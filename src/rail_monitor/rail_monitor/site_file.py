@@ -101,14 +101,20 @@ def load_parameter_file(path: str | Path, text: str | None = None) -> dict[str, 
     return values
 
 
+def parameter_sections(path: str | Path) -> dict[str, dict[str, Any]]:
+    """Every section of a ROS 2 parameter file (``/**``, ``/**/<node>``, ...) as flat dotted
+    names, names not checked (ConfigError naming the file if it is not a parameter file)."""
+    path = Path(path)
+    return {str(node): _parameters(path, section) for node, section in _read_document(path).items()}
+
+
 def check_parameter_file(path: str | Path) -> None:
     """ConfigError for the first parameter of any section of a ROS 2 parameter file that its spec
     refuses: an unknown name, a wrong type (a YAML integer for a double, as rcl reads it), a value
     out of range. rcl merges the files given to a node and drops, without a word, a later file's
     value whose type differs from an earlier one's: each file is checked on its own first."""
     path = Path(path)
-    for node, section in _read_document(path).items():
-        values = _parameters(path, section)
+    for node, values in parameter_sections(path).items():
         where = f"{path}: section '{node}': "
         check_names(values, where)
         specs = known_specs(values)
@@ -123,6 +129,13 @@ def check_parameter_file(path: str | Path) -> None:
                 spec.check(value, name[:-len(spec.name)])
             except ConfigError as exc:
                 raise ConfigError(f"{where}{exc}") from None
+
+
+def shipped_site_file() -> Path:
+    """The installed example site file, curve_250.yaml: the default wherever no site is given."""
+    from ament_index_python.packages import get_package_share_directory
+
+    return Path(get_package_share_directory("rail_monitor")) / "config" / "curve_250.yaml"
 
 
 def load_site(path: str | Path) -> Site:

@@ -6,6 +6,8 @@ from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
+
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 
@@ -16,6 +18,15 @@ KIND_NAMES = {KIND_GRINDING_DUE: "grinding due", KIND_GRINDING_FORECAST: "grindi
 SEVERITY_INFO, SEVERITY_WARNING, SEVERITY_CRITICAL = range(3)
 NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")  # RollingNoise single numbers
 RISK_NAMES = ("none", "low", "medium", "high")
+
+
+def counts_as_squeal(risk: np.ndarray, min_risk: str) -> np.ndarray:
+    """Whether each squeal risk (RISK_* number, or its name) counts as an occurrence: at or above
+    the site's ``squeal_min_risk`` (the alert's rule, and the report's)."""
+    risk = np.asarray(risk)
+    if risk.dtype.kind in "OUS":
+        risk = np.array([RISK_NAMES.index(r) if r in RISK_NAMES else -1 for r in risk.tolist()], dtype=np.int64)
+    return risk >= RISK_NAMES.index(min_risk)
 
 ALERT_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("grinding_clear_fraction", 0.9, "A grinding-due alert clears below this fraction of the band's "

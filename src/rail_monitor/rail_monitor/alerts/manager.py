@@ -18,11 +18,11 @@ from rail_monitor.alerts.config import (
     KIND_NAMES,
     KIND_NOISE_LIMIT,
     KIND_SQUEAL,
-    RISK_NAMES,
     SEVERITY_CRITICAL,
     SEVERITY_INFO,
     SEVERITY_WARNING,
     AlertConfig,
+    counts_as_squeal,
 )
 from rail_monitor.alerts.windows import Window, hysteresis_changes
 from rail_monitor.core.text import printable
@@ -56,7 +56,6 @@ class AlertManager:
         self._noise: dict[str, Window] = {}
         self._squeal = Window(cfg.squeal_window_passes)
         self._rejected = Window(cfg.rejected_window_passes)
-        self._min_risk = RISK_NAMES.index(cfg.squeal_min_risk)
         self._keys: dict[bytes, list[str]] = {}
 
     def retune(self, cfg: AlertConfig) -> None:
@@ -66,7 +65,6 @@ class AlertManager:
         self._noise = {model: w.resized(cfg.noise_window_passes) for model, w in self._noise.items()}
         self._squeal = self._squeal.resized(cfg.squeal_window_passes)
         self._rejected = self._rejected.resized(cfg.rejected_window_passes)
-        self._min_risk = RISK_NAMES.index(cfg.squeal_min_risk)
 
     # -- raise / clear ----------------------------------------------------------------------------
     def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
@@ -226,7 +224,7 @@ class AlertManager:
     def on_squeal(self, stamp_ns: np.ndarray, risk: np.ndarray) -> list[Alert]:
         """SquealPredictions' risks (RISK_*) in order. The window must be full: a share over the
         first few passes would raise on the first squeal."""
-        return self._share(self._squeal, np.asarray(risk) >= self._min_risk, KIND_SQUEAL, "site",
+        return self._share(self._squeal, counts_as_squeal(risk, self.cfg.squeal_min_risk), KIND_SQUEAL, "site",
                            np.asarray(stamp_ns), "squeal", self._squeal_what(), full_window=True)
 
     def on_train_passes(self, stamp_ns: np.ndarray, rejected: np.ndarray) -> list[Alert]:

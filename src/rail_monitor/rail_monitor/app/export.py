@@ -20,13 +20,12 @@ import numpy as np
 from rail_monitor.alerts.config import KIND_NAMES, RISK_NAMES
 from rail_monitor.app.report import RunData
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.passes import FRICTION_NAMES, rejection_reasons
+from rail_monitor.core.passes import FRICTION_NAMES, KMH_PER_MPS, rejection_reasons
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import format_iso_ns, format_local_ns
 from rail_monitor.models.squeal import REGIME_NAMES
 
 FORMATS = ("csv", "parquet", "xlsx")
-MPS_TO_KMH = 3.6
 SEVERITY_NAMES = ("info", "warning", "critical")
 
 
@@ -84,7 +83,7 @@ def pass_table(run: RunData, values: Mapping[str, Any]) -> Table:
         Column("vehicle_count", "-", "vehicles in the consist", p.vehicle_count),
         Column("axle_count", "-", "axles in the consist", p.axle_count),
         Column("speed_mps", "m/s", "train speed", p.speed_mps),
-        Column("speed_kmh", "km/h", "train speed", p.speed_mps * MPS_TO_KMH),
+        Column("speed_kmh", "km/h", "train speed", p.speed_mps * KMH_PER_MPS),
         Column("angle_of_attack_mrad", "mrad", "angle of attack of the leading wheelset", 1e3 * p.angle_of_attack_rad),
         Column("friction_state", "-", "friction state", np.array([FRICTION_NAMES.get(int(f), str(f))
                                                                   for f in p.friction_state], object)),

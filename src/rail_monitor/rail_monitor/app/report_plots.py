@@ -22,7 +22,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from rail_monitor.app.report_tables import METRIC_LABELS
-from rail_monitor.core.passes import FRICTION_NAMES
+from rail_monitor.core.passes import FRICTION_NAMES, KMH_PER_MPS
 from rail_monitor.core.timeutil import time_zone
 
 CLASS_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
@@ -142,10 +142,9 @@ def squeal(squeal_data: Mapping[str, np.ndarray], curves: dict) -> Figure:
 def speeds(speed_mps: np.ndarray, axles: np.ndarray, advisory) -> Figure:
     """Axle-weighted speed distributions in km/h: the whole history, the advisory's recent passes and
     its advised distribution (same mean speed, least peak corrugation growth)."""
-    kmh = 3.6
     fig, ax = plt.subplots(figsize=(8.0, 4.2), constrained_layout=True)
     if advisory is not None and len(advisory.speed_bin_centres_mps):
-        c = kmh * np.asarray(advisory.speed_bin_centres_mps)
+        c = KMH_PER_MPS * np.asarray(advisory.speed_bin_centres_mps)
         width = float(np.min(np.diff(c))) if len(c) > 1 else 2.0
         ax.bar(c - width / 4, advisory.current_probability, width / 2, label="recent passes")
         ax.bar(c + width / 4, advisory.recommended_probability, width / 2,
@@ -153,7 +152,7 @@ def speeds(speed_mps: np.ndarray, axles: np.ndarray, advisory) -> Figure:
         bins = np.append(c - width / 2, c[-1] + width / 2)
     else:
         bins = 30
-    hist, edges = np.histogram(kmh * speed_mps, bins=bins, weights=axles)
+    hist, edges = np.histogram(KMH_PER_MPS * speed_mps, bins=bins, weights=axles)
     ax.stairs(hist / max(hist.sum(), 1), edges, color="k", label="whole history")
     ax.set_xlabel("pass speed [km/h]")
     ax.set_ylabel("share of axle passes [-]")

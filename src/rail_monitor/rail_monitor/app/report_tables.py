@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.alerts.config import RISK_NAMES, alert_config
+from rail_monitor.alerts.config import alert_config, counts_as_squeal
 from rail_monitor.app.report import RunData
 from rail_monitor.core.passes import FRICTION_MODIFIER, FRICTION_NAMES
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
@@ -34,9 +34,9 @@ def limits(values: Mapping[str, Any]) -> dict[str, Any]:
 
 def squealing(t: Mapping[str, np.ndarray], min_risk: str) -> np.ndarray:
     """Passes whose squeal risk counts as an occurrence (the alert's own rule)."""
-    rank = {name: i for i, name in enumerate(RISK_NAMES)}
-    return np.array([rank.get(r, -1) >= rank[min_risk] for r in t["squeal_risk"]], bool) \
-        if "squeal_risk" in t else np.zeros(len(t["stamp_ns"]), bool)
+    if "squeal_risk" not in t:
+        return np.zeros(len(t["stamp_ns"]), bool)
+    return counts_as_squeal(t["squeal_risk"], min_risk)
 
 
 def _processed(t: Mapping[str, np.ndarray]) -> np.ndarray:

@@ -28,6 +28,7 @@ from typing import NamedTuple
 
 import yaml
 
+from rail_monitor.bagio.output_folder import beside
 from rail_monitor.core.errors import ConfigError, RailMonitorError
 
 
@@ -73,17 +74,12 @@ def read_manifest(path: str | Path) -> list[SiteJob]:
         for p in (site, history):
             if not p.exists():
                 raise ConfigError(f"{where}: {p} not found")
-        output = base / str(entry["output"]) if entry.get("output") else _beside(history)
+        output = base / str(entry["output"]) if entry.get("output") else beside(history, "_batch")
         if output.resolve() in outputs:
             raise ConfigError(f"{where}: output {output} is another site's too")
         outputs.add(output.resolve())
         jobs.append(SiteJob(site, history, output))
     return jobs
-
-
-def _beside(history: Path) -> Path:
-    stem = history.stem if history.suffix.lower() in (".csv", ".mcap", ".db3") else history.name
-    return history.with_name(f"{stem}_batch")
 
 
 def run_site(job: SiteJob) -> SiteResult:

@@ -26,7 +26,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from rail_monitor.core.errors import InputError, RailMonitorError
-from rail_monitor.core.passes import FRICTION_BY_NAME, FRICTION_NAMES, PassTable
+from rail_monitor.core.passes import FRICTION_BY_NAME, FRICTION_NAMES, KMH_PER_MPS, PassTable
 from rail_monitor.core.timeutil import NS_PER_S, checked_ns, format_iso_ns, parse_iso_ns
 
 
@@ -70,7 +70,7 @@ _QUANTITIES: dict[str, tuple[str, dict[str, Callable[[str], object]], object]] =
     "vehicle_class": ("vehicle_class", {"vehicle_class": str}, None),
     "vehicle_count": ("vehicle_count", {"vehicle_count": _count}, 0),
     "axle_count": ("axle_count", {"axle_count": _count}, 0),
-    "speed": ("speed_mps", {"speed_mps": float, "speed_kmh": _scaled(1.0 / 3.6)}, None),
+    "speed": ("speed_mps", {"speed_mps": float, "speed_kmh": _scaled(1.0 / KMH_PER_MPS)}, None),
     "angle_of_attack": ("angle_of_attack_rad",
                         {"angle_of_attack_rad": float, "angle_of_attack_mrad": _scaled(1.0e-3)}, None),
     "wheel_load": ("wheel_load_n", {"wheel_load_n": float, "wheel_load_kn": _scaled(1.0e3)}, 0.0),

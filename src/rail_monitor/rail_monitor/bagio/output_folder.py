@@ -11,6 +11,14 @@ from rail_monitor.core.errors import RailMonitorError
 MARKER = ".rail_monitor"
 
 
+def beside(source: str | Path, suffix: str) -> Path:
+    """The default output of a command: <source name><suffix> in the folder that holds the source
+    (a file's name without its .csv, .mcap or .db3)."""
+    src = Path(source)
+    src = src if src.name else src.absolute()
+    return src.with_name(f"{src.stem if src.suffix.lower() in ('.csv', '.mcap', '.db3') else src.name}{suffix}")
+
+
 def mark_output(folder: Path) -> None:
     """Mark a folder as created by rail_monitor (see :data:`MARKER`)."""
     (folder / MARKER).write_text("created by rail_monitor; --overwrite may replace this folder\n", encoding="utf-8")

@@ -6,10 +6,10 @@ import argparse
 import time
 from pathlib import Path
 
+from rail_monitor.bagio.output_folder import beside
 from rail_monitor.cli.common import (
     SALVAGE_HELP,
     add_site_option,
-    beside,
     fresh_output,
     print_report,
     site_values,

@@ -22,11 +22,9 @@ SALVAGE_HELP = ("read every complete chunk of an MCAP file cut off mid-write (a 
 
 def site_file(path: str | None) -> Path:
     """The site parameter file given, or the shipped curve_250.yaml."""
-    if path:
-        return Path(path)
-    from ament_index_python.packages import get_package_share_directory
+    from rail_monitor.site_file import shipped_site_file
 
-    return Path(get_package_share_directory("rail_monitor")) / "config" / "curve_250.yaml"
+    return Path(path) if path else shipped_site_file()
 
 
 def site_values(path: str | None) -> dict[str, Any]:
@@ -152,12 +150,10 @@ def _overrides_file(site: Path, values: dict[str, object]) -> Path:
 
     import yaml
 
-    from rail_monitor.core.params import flatten
+    from rail_monitor.site_file import parameter_sections
 
-    doc = yaml.safe_load(site.read_text(encoding="utf-8")) or {}
     out: dict[str, dict] = {"/**": {"ros__parameters": dict(values)}}
-    for section, body in doc.items():
-        params = flatten((body or {}).get("ros__parameters") or {}) if isinstance(body, dict) else {}
+    for section, params in parameter_sections(site).items():
         mine = {k: v for k, v in values.items() if k in params}
         if mine and section != "/**":
             out[section] = {"ros__parameters": mine}
@@ -191,13 +187,6 @@ def fresh_output(path: Path, overwrite: bool, inputs: Sequence[str | Path] = ())
         raise RailMonitorError(f"{path} exists and was not created by rail_monitor (no {MARKER} file): "
                                "remove it yourself or give another output folder")
     shutil.rmtree(path)
-
-
-def beside(source: str | Path, suffix: str) -> Path:
-    """The default output of a command: <source name><suffix> in the folder that holds the source."""
-    src = Path(source)
-    src = src if src.name else src.absolute()
-    return src.with_name(f"{src.stem if src.suffix.lower() in ('.csv', '.mcap', '.db3') else src.name}{suffix}")
 
 
 def report_dir(bag: str, report: str | None) -> Path:

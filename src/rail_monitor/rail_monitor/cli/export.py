@@ -5,7 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from rail_monitor.cli.common import add_site_option, bag_site_values, beside, fresh_output
+from rail_monitor.bagio.output_folder import beside
+from rail_monitor.cli.common import add_site_option, bag_site_values, fresh_output
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:

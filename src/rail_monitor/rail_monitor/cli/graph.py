@@ -6,10 +6,10 @@ import argparse
 import os
 from pathlib import Path
 
+from rail_monitor.bagio.output_folder import beside
 from rail_monitor.cli.common import (
     add_site_option,
     add_specs,
-    beside,
     fresh_output,
     print_report,
     ros_args,

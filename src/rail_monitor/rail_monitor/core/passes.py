@@ -17,6 +17,8 @@ import numpy as np
 from rail_monitor.core.site import Site
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, fits_time_msg
 
+KMH_PER_MPS = 3.6  # speeds for people (CSV columns, exports, report) are in km/h
+
 # TrainPass.FRICTION_* values and their names in CSV files and site parameters.
 FRICTION_UNSET, FRICTION_DRY, FRICTION_WET, FRICTION_MODIFIER, FRICTION_CONTAMINATED = range(5)
 FRICTION_NAMES: dict[int, str] = {

@@ -22,20 +22,18 @@ from rclpy.qos import QoSProfile
 from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.bagio.typestore import schema_text
 from rail_monitor.core.node_params import FOXGLOVE_SPECS, FoxgloveParams
-from rail_monitor.core.params import values_of
-from rail_monitor.nodes.base import Diagnostics, RailNode, RateMeter, announce, declare, wall_timer
+from rail_monitor.nodes.base import Diagnostics, RateMeter, announce, wall_timer
 from rail_monitor.nodes.process import run_node
-from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TopicTap
+from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TapNode, TopicTap
 
 
-class FoxgloveServer(RailNode):
-    USES_SITE = False  # records or serves any graph: no site of its own
+class FoxgloveServer(TapNode):
     EXECUTABLE = "foxglove_server"
     PARAMETERS = (("", FOXGLOVE_SPECS),)
+    CONFIG = FoxgloveParams
 
     def __init__(self, **kwargs) -> None:
-        super().__init__("foxglove_server", **kwargs)
-        self.cfg = values_of(FoxgloveParams, declare(self, FOXGLOVE_SPECS))
+        super().__init__(**kwargs)
         self.fg = foxglove.Context()
         self.channels: dict[str, foxglove.Channel] = {}
         self.latest: dict[str, tuple[bytes, int]] = {}  # per topic: the last message and its log time

@@ -28,24 +28,22 @@ from rail_monitor.bagio.site_record import SITE_RECORD, custom_data, describe, s
 from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import RECORDER_SPECS, RecorderParams
-from rail_monitor.core.params import values_of
 from rail_monitor.core.timeutil import NS_PER_S
-from rail_monitor.nodes.base import Diagnostics, RailNode, RateMeter, announce, declare, wall_timer
+from rail_monitor.nodes.base import Diagnostics, RateMeter, announce, wall_timer
 from rail_monitor.nodes.process import SESSION_PARAMS_FILES, run_node, spin_once_guarded
 from rail_monitor.nodes.qos import qos_to_dict
-from rail_monitor.nodes.topic_tap import TopicTap
+from rail_monitor.nodes.topic_tap import TapNode, TopicTap
 
 BEFORE_CLOCK_MAX = 20_000  # messages held for the first /clock; past that, logged as they come
 
 
-class McapRecorder(RailNode):
-    USES_SITE = False  # records or serves any graph: no site of its own
+class McapRecorder(TapNode):
     EXECUTABLE = "mcap_recorder"
     PARAMETERS = (("", RECORDER_SPECS),)
+    CONFIG = RecorderParams
 
     def __init__(self, **kwargs) -> None:
-        super().__init__("mcap_recorder", **kwargs)
-        self.cfg = values_of(RecorderParams, declare(self, RECORDER_SPECS))
+        super().__init__(**kwargs)
         out = self.cfg.output or f"rail_monitor_{datetime.now(UTC):%Y_%m_%d-%H_%M_%S}"
         site = self.cfg.site_file or next(iter(SESSION_PARAMS_FILES), "")
         record = site_record(site) if site else None

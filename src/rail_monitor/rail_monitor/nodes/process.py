@@ -123,15 +123,13 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
     so), so that a model node started bare knows the same rolling stock as the command line's
     default.
     """
-    from rail_monitor.site_file import check_parameter_file
+    from rail_monitor.site_file import check_parameter_file, shipped_site_file
 
     if flow_control:
         use_flow_control_profile()
     args = list(sys.argv if args is None else args)
     if default_site and not params_files(args):
-        from ament_index_python.packages import get_package_share_directory
-
-        shipped = f"{get_package_share_directory('rail_monitor')}/config/curve_250.yaml"
+        shipped = str(shipped_site_file())
         args += ["--ros-args", "--params-file", shipped]
         SESSION_DEFAULT_SITE[:] = [shipped]
     SESSION_PARAMS_FILES[:] = params_files(args)

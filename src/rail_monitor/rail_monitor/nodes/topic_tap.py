@@ -15,12 +15,25 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile
 
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.nodes.base import subscribe_batched, wall_timer
+from rail_monitor.core.params import values_of
+from rail_monitor.nodes.base import RailNode, declare, subscribe_batched, wall_timer
 from rail_monitor.nodes.qos import subscription_qos
 
 DEFAULT_TYPES_PREFIX = "rail_msgs/"
 DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
 TAKE_AT_ONCE = 500  # most queued messages of a topic one callback takes (a burst costs fewer wake-ups)
+
+
+class TapNode(RailNode):
+    """A node that records or serves any graph's topics (mcap_recorder, foxglove_server): it has no
+    site of its own, and its parameters are its one PARAMETERS group, read into ``cfg`` (CONFIG)."""
+
+    USES_SITE = False
+    CONFIG: type
+
+    def __init__(self, **kwargs) -> None:
+        super().__init__(self.EXECUTABLE, **kwargs)
+        self.cfg = values_of(self.CONFIG, declare(self, self.PARAMETERS[0][1]))
 
 
 class TopicTap:
