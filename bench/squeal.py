@@ -13,7 +13,7 @@ import numpy as np
 from bench.timing import best_of, header, parser
 from rail_monitor.core.passes import PassTable, with_class_defaults
 from rail_monitor.core.site import site_from_values
-from rail_monitor.models import squeal
+from rail_monitor.models import squeal, squeal_ode
 from rail_monitor.site_file import load_parameter_file
 from rail_monitor.squeal.config import squeal_config
 from rail_monitor.squeal.predict import predict
@@ -28,7 +28,7 @@ def costs(site_file: str, ode_cases: int = 3) -> dict[str, float]:
     t = []
     for vc in np.linspace(0.2, 0.5, ode_cases):
         t0 = time.perf_counter()
-        squeal.simulate_limit_cycle(case.speed_mps, float(vc), case.load_n, case.mass_kg, case.damping_nspm,
+        squeal_ode.simulate_limit_cycle(case.speed_mps, float(vc), case.load_n, case.mass_kg, case.damping_nspm,
                                     case.stiffness_npm, case.k1, case.k2, case.k3_n)
         t.append(time.perf_counter() - t0)
     values = load_parameter_file(site_file)
@@ -61,7 +61,7 @@ def main() -> None:
     ode_times, errs = [], []
     for vc in vcs:
         t = time.perf_counter()
-        r = squeal.simulate_limit_cycle(case.speed_mps, float(vc), case.load_n, case.mass_kg, case.damping_nspm,
+        r = squeal_ode.simulate_limit_cycle(case.speed_mps, float(vc), case.load_n, case.mass_kg, case.damping_nspm,
                                         case.stiffness_npm, case.k1, case.k2, case.k3_n)
         ode_times.append(time.perf_counter() - t)
         cf = float(squeal.limit_cycle_amplitude(args[0], vc, *args[1:]).amplitude)

@@ -54,6 +54,9 @@ if [ "$(cat "$ws/install/.src_stamp" 2>/dev/null)" != "$src_hash" ]; then
     . "$venv/bin/activate"
     export CMAKE_PREFIX_PATH="$VIRTUAL_ENV" AMENT_PREFIX_PATH="$VIRTUAL_ENV"
     export COLCON_DEFAULTS_FILE="$ws/colcon_defaults.yaml" COLCON_HOME="$ws/.colcon" COLCON_LOG_PATH="$ws/log"
+    # A version bump leaves the old egg-info beside the new one (importlib.metadata may then read
+    # the old version): the build writes the current one again.
+    rm -rf "$ws"/install/rail_monitor/lib/python3*/site-packages/rail_monitor-*.egg-info
     with_progress "colcon build" "$ws/colcon_build.log" colcon build --cmake-args -DBUILD_TESTING=OFF \
       "-DPython3_EXECUTABLE=$venv/bin/python" || { tail -n 40 "$ws/colcon_build.log" >&2; exit 1; }
   )

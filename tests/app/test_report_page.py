@@ -72,6 +72,7 @@ def test_the_page_renders_in_chromium_with_every_image_loaded(report):
     for section in ("Headline", "Per vehicle class", "Noise against the limit", "Grinding outlook per band",
                     "Squealing trains (loudest first)", "Appendix for engineers", "Site parameters"):
         assert section in headings
+    assert ("Speed advice per class" in headings) == (report[0].advisory is not None)
 
 
 def test_pdf_summary_and_squealing_trains(report):
@@ -93,6 +94,20 @@ def test_pdf_summary_and_squealing_trains(report):
     trains = pd.read_csv(folder / "squealing_trains.csv")
     assert set(trains["train_id"]) == set(t["train_id"][squealing])
     assert list(trains["squeal level [dB(A)]"]) == sorted(trains["squeal level [dB(A)]"], reverse=True)
+
+
+def test_the_speed_advice_table_is_the_advisory_of_the_bag(report):
+    # One row per class and band of the bag's last SpeedAdvisory, as the plan computed it.
+    from rail_monitor.advice.plan import advice_of_message
+
+    run = report[0]
+    assert run.advisory is not None
+    rows = report_tables.speed_advice(run)
+    a = advice_of_message(run.advisory)
+    assert [r["class"] for r in rows] == a.band_vehicle_class
+    assert [r["advised [%]"] for r in rows] == pytest.approx(100 * a.band_recommended_share, rel=1e-12)
+    for name in a.vehicle_class:
+        assert sum(r["advised [%]"] for r in rows if r["class"] == name) == pytest.approx(100.0)
 
 
 def _labels(fig) -> list[str]:
@@ -119,8 +134,8 @@ def test_figures_follow_the_report_conventions(report):
     fig = report_plots.noise(t, models[:1], lim, spectra, spectra, "UTC")
     labels = _labels(fig)
     assert {"emu", "dmu", "freight"} <= set(labels) and f"limit {lim['limit_dba']:g} dB(A)" in labels
-    fig = report_plots.speeds(run.passes.speed_mps, run.passes.axle_count, run.advisory)
-    assert "km/h" in fig.axes[0].get_xlabel() and "axle" in fig.axes[0].get_ylabel()
+    fig = report_plots.speeds(run.passes.speed_mps, run.advisory)
+    assert "km/h" in fig.axes[0].get_xlabel() and "train passes" in fig.axes[0].get_ylabel()
     report_plots.plt.close("all")
 
 

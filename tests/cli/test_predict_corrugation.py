@@ -17,15 +17,49 @@ from rail_monitor.corrugation.estimator import CorrugationEstimator
 def test_predict_corrugation_json_equals_the_library_and_plots(tmp_path, site, capsys):
     png = tmp_path / "growth.png"
     assert main(["predict", "corrugation", "--speed-mean", "17", "--speed-cv", "0.05", "--passes-per-day", "100",
-                 "--advise", "--json", "--plot-growth", str(png)]) == 0
+                 "--json", "--plot-growth", str(png)]) == 0
     doc = json.loads(capsys.readouterr().out)
     est = CorrugationEstimator(site, corrugation_config({}))
     v = 17 * (1 + 0.05 * np.linspace(-3, 3, 121))
     want = advice.evaluate(est, v, np.exp(-0.5 * ((v - 17) / 0.85) ** 2), FRICTION_DRY, 100.0)
     assert doc["peak_growth"] == pytest.approx(want.peak_growth, rel=1e-12)
     assert doc["days_to_threshold"] == pytest.approx(want.days_to_threshold, rel=1e-9)
-    assert len(doc["bands"]) == len(est.bands) and doc["advice"]["grinding_interval_factor"] > 1.0
+    assert len(doc["bands"]) == len(est.bands)
+    # Without --history: the site's traffic mix for the kernel, and its traffic-weighted axles per train.
+    assert doc["kernel_vehicle_class"] is None and doc["axles_per_train"] == pytest.approx(site.mean_axles_per_train)
     assert png.stat().st_size > 10_000
+
+
+def test_a_class_without_history_uses_its_own_kernel_and_axles(site, capsys):
+    assert main(["predict", "corrugation", "--vehicle-class", "freight", "--passes-per-day", "10", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    est = CorrugationEstimator(site, corrugation_config({}))
+    cls = site.vehicle("freight")
+    v = cls.speed_mean_mps * (1 + cls.speed_sd_mps / cls.speed_mean_mps * np.linspace(-3, 3, 121))
+    w = np.exp(-0.5 * ((v - cls.speed_mean_mps) / cls.speed_sd_mps) ** 2)
+    want = advice.evaluate(est, v, w, FRICTION_DRY, 10.0, "freight")
+    mix = advice.evaluate(est, v, w, FRICTION_DRY, 10.0)
+    assert doc["kernel_vehicle_class"] == "freight" and doc["axles_per_train"] == cls.mean_axles_per_train
+    assert doc["peak_growth"] == pytest.approx(want.peak_growth, rel=1e-12) and want.peak_growth != mix.peak_growth
+    assert doc["days_to_threshold"] == pytest.approx(want.days_to_threshold, rel=1e-9)
+    # The traffic-weighted mean axles per train of the site (80 % EMU of 4.5 cars: 22.8), not the
+    # classes' plain mean (39.3).
+    assert site.mean_axles_per_train == pytest.approx(
+        sum(c.traffic_share * c.mean_axles_per_train for c in site.vehicles.values())
+        / sum(c.traffic_share for c in site.vehicles.values()))
+
+
+def test_advice_needs_a_history_and_is_per_class_on_one(capsys):
+    from conftest import SAMPLE
+
+    assert main(["predict", "corrugation", "--advise"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--history" in err
+    assert main(["predict", "corrugation", "--history", str(SAMPLE), "--advise", "--json"]) == 0
+    adv = json.loads(capsys.readouterr().out)["advice"]
+    assert adv["vehicle_class"] == ["emu", "dmu", "freight"] and len(adv["summary"]) == 4
+    assert adv["grinding_interval_factor"] >= 1.0
+    assert max(n - c for n, c in zip(adv["noise_recommended_dba"], adv["noise_current_dba"], strict=True)) <= 0.5
 
 
 def test_an_unreadable_history_is_one_line_and_exit_2(tmp_path, capsys):

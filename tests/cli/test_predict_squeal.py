@@ -58,3 +58,27 @@ def test_a_site_case_gives_the_level_and_risk_the_squeal_node_gives(capsys):
         int(node["regime"][0])]
     assert main(["predict", "squeal", "--vehicle-class", "emu", "--aoa-mrad", "13"]) == 0
     assert "level [dB(A)]" in capsys.readouterr().out
+
+
+def test_a_history_gives_a_row_per_friction_state_as_the_squeal_node_predicts(capsys, site_values, sample_passes):
+    # The per-state table of the README's squeal section: its shares are the squeal model's on the
+    # sample, and the onset follows the friction peaks (saturation creepage ~ mu0, reduced_kalker).
+    from rail_monitor.core.passes import FRICTION_BY_NAME, rejection_reasons, with_class_defaults
+    from rail_monitor.core.site import site_from_values
+    from rail_monitor.squeal.config import squeal_config
+    from rail_monitor.squeal.predict import predict
+
+    from conftest import SAMPLE
+
+    assert main(["predict", "squeal", "--history", str(SAMPLE), "--json"]) == 0
+    rows = {r["friction_state"]: r for r in json.loads(capsys.readouterr().out)["friction_states"]}
+    site = site_from_values(site_values)
+    table = with_class_defaults(sample_passes.take(rejection_reasons(sample_passes, site) == ""), site)
+    unstable = predict(squeal_config(site_values), site, table)["unstable"]
+    for name, r in rows.items():
+        sel = table.friction_state == FRICTION_BY_NAME[name]
+        assert r["passes"] == sel.sum() and r["unstable_share"] == pytest.approx(unstable[sel].mean(), abs=1e-12)
+    onset = [rows[n]["onset_mrad"] for n in ("contaminated", "wet", "dry", "friction_modifier")]
+    assert onset == sorted(onset)
+    assert rows["friction_modifier"]["unstable_share"] == 0.0
+    assert 6.3 <= rows["dry"]["friction_modifier_cut_dba"] <= 22.8       # Eadie & Santoro 2006's range

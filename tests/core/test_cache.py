@@ -64,5 +64,5 @@ def test_the_rail_receptance_from_the_cache_equals_a_fresh_one(tmp_path, monkeyp
     growth._rail_receptance.cache_clear()
     f2, r2 = growth._rail_receptance(tr.Track())  # from the file
     assert np.array_equal(r, r2) and np.array_equal(f, f2)
-    assert np.array_equal(r, tr.bay_averaged_receptance(f, tr.Track()))
+    assert np.array_equal(r, tr.discrete_receptance(f, tr.Track(), position=growth.BAY_POSITIONS))
     growth._rail_receptance.cache_clear()

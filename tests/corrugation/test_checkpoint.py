@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -96,6 +98,8 @@ def _crafted(est, path, change: dict) -> None:
     lambda est: {"recent_class_idx": np.full(len(est.kept), 7)},             # a class the site does not have
     lambda est: {"recent_stamp_ns": np.array(["x"] * len(est.kept))},         # strings for stamps
     lambda est: {"grinding_amplitude": np.zeros(len(est.bands))},             # post-grinding amplitudes of zero
+    lambda est: {"recent_regime": np.full(len(est.kept), 2)},                # a contact regime that does not exist
+    lambda est: {"recent_load": np.full(len(est.kept), np.inf)},             # a load that is not finite
 ])
 def test_a_crafted_checkpoint_is_refused_and_leaves_the_state_as_it_was(site_, tables, tmp_path, change):
     est = _estimator(site_, tables)
@@ -109,3 +113,23 @@ def test_a_crafted_checkpoint_is_refused_and_leaves_the_state_as_it_was(site_, t
     assert "\n" not in str(err.value) and str(path) in str(err.value)
     np.testing.assert_array_equal(fresh.log_components, before)
     assert fresh.total_pass_count == 0 and len(fresh.kept) == 0
+
+
+def test_a_version_2_checkpoint_resumes_with_its_passes_in_partial_slip(site_, tables, tmp_path):
+    # Version 2 (rail_monitor 0.2) kept no contact regime: every pass was counted in partial slip,
+    # and the kept passes are read so, at their class's nominal load, with the state as it was.
+    est = _estimator(site_, tables)
+    est.advance(_passes(site_, [19.0] * 150))
+    path = tmp_path / "v2.npz"
+    checkpoint.save(est, path)
+    with np.load(path, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files if k not in ("recent_regime", "recent_load", "recent_creepage")}
+    meta = json.loads(str(data["meta"]))
+    data["meta"] = np.array(json.dumps({**meta, "version": 2}))
+    with open(path, "wb") as fh:
+        np.savez(fh, **data)
+    again = _estimator(site_, tables)
+    checkpoint.load(again, path)
+    np.testing.assert_array_equal(again.log_components, est.log_components)
+    assert not again.kept.regime.any() and np.all(again.kept.load == site_.vehicle("emu").wheel_load_n)
+    np.testing.assert_allclose(again.recent_growth(), est.recent_growth(), rtol=1e-12)

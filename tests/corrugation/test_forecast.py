@@ -3,10 +3,13 @@ span, the lead time and the sample history."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from corrugation.conftest import _estimator, _passes
+from rail_monitor.core.contact import REGIME_FULL_SLIDING
 from rail_monitor.core.timeutil import NS_PER_DAY
 
 
@@ -53,11 +56,38 @@ def test_lead_time_makes_grinding_due_before_the_threshold(site_, tables):
 
 
 def test_the_sample_history_gives_a_plausible_forecast(site_, tables, sample):
-    # 90 days of the bundled history (96 trains a day): the worst band is a 50-80 mm one and
-    # grinding is a year or more away with the default K_b (a metro curve is ground every 1-3 years).
-    est = _estimator(site_, tables)
+    # 90 days of the bundled history (96 trains a day). With every pass in partial slip (as the
+    # UQ paper's K_b of order 1e-5 assumes; k3 = 1 N puts saturation far beyond any creepage) the
+    # worst band is a 50-80 mm one and grinding is 1-3 years away with the default K_b (a metro
+    # curve is ground every 1-3 years).
+    partial = dataclasses.replace(site_, contact=dataclasses.replace(site_.contact, k3_n=1.0))
+    est = _estimator(partial, tables)
     assert est.advance(sample).all()
+    assert not est.kept.regime.any()
     fc = est.forecast()
     assert 0.05 <= est.bands[fc.worst_band] <= 0.08
     assert 365 <= fc.days_to_threshold <= 3 * 365
     assert fc.passes_per_day == pytest.approx(96.2, rel=0.01)
+    # With the site's contact the passes whose creepage exceeds saturation fully slide, and their
+    # negative K_b (docs/models.md, Sliding) takes growth off the 50-80 mm bands: the worst in the
+    # 50-80 mm band, grinding later.
+    real = _estimator(site_, tables)
+    real.advance(sample)
+    sliding = real.kept.regime == REGIME_FULL_SLIDING
+    assert 0.1 < sliding.mean() < 0.6
+    fc_real = real.forecast()
+    assert 0.05 <= real.bands[fc_real.worst_band] <= 0.08
+    assert fc_real.days_to_threshold > fc.days_to_threshold
+
+
+def test_a_forecast_beyond_any_time_stamp_has_no_date():
+    # A band that barely grows (full-sliding passes nearly balancing the others) can be 1e12 days
+    # away: the days stay, the date is 0 ("never"), and nothing overflows a 64-bit stamp.
+    from rail_monitor.corrugation.forecast import MAX_DATED_DAYS, forecasts
+
+    log_z = np.full((1, 2, 3), np.log(1e-6))
+    growth = np.full((1, 2, 3), 1e-18)
+    fc = forecasts(log_z, growth, np.array([100.0]), np.array([20.0]), np.array([1_790_000_000 * 10**9]),
+                   np.full(2, 1e-5), 60.0, 20.0)
+    assert fc.days_to_threshold[0] > MAX_DATED_DAYS and np.isfinite(fc.days_to_threshold[0])
+    assert fc.grinding_due_ns[0] == 0 and not fc.grinding_due[0]

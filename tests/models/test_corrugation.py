@@ -142,22 +142,3 @@ def test_band_limits_share_each_range_equally():
     for (lo, hi), limit in cg.GRASSIE_1999_LIMITS[:4]:
         inside = (bands >= lo * (1 - 1e-9)) & (bands < hi * (1 - 1e-9))
         assert np.sqrt(np.sum(lim[inside] ** 2)) == pytest.approx(limit, rel=1e-12)
-
-
-def test_speed_optimiser_finds_the_minimax_of_a_brute_force_scan():
-    # Three bins, two equality constraints: one free parameter, scanned densely as the check.
-    rng = np.random.default_rng(3)
-    v = np.array([10.0, 15.0, 20.0])
-    growth = rng.normal(1e-6, 5e-7, (12, 3))
-    best = cg.optimise_speed_distribution(growth, v, 16.0)
-    t = np.linspace(0, 1, 200_001)                   # p = (t, 1 - t - q, q) with mean 16
-    q = (16.0 - 15.0 + 5.0 * t) / 5.0                # from 10 t + 15 (1 - t - q) + 20 q = 16
-    p = np.stack([t, 1 - t - q, q], axis=1)
-    ok = np.all(p >= 0, axis=1)
-    brute = (p[ok] @ growth.T).max(axis=1).min()
-    assert best.peak_growth == pytest.approx(brute, rel=1e-5)
-    assert best.probability @ v == pytest.approx(16.0, rel=1e-9) and best.probability.sum() == pytest.approx(1.0)
-    capped = cg.optimise_speed_distribution(growth, v, 16.0, max_share=0.4)
-    assert capped.probability.max() <= 0.4 + 1e-9 and capped.peak_growth >= best.peak_growth - 1e-15
-    with pytest.raises(ValueError, match="no distribution"):
-        cg.optimise_speed_distribution(growth, v, 25.0)

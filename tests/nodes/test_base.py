@@ -15,9 +15,10 @@ from conftest import run_cmd
 
 def test_an_unknown_parameter_name_is_refused_with_the_nearest_known_one(ros_context, site_values):
     params = [Parameter(k, value=v) for k, v in site_values.items()]
-    want = r"unknown parameter 'squeal\.modal_mas'; did you mean 'squeal\.modal_mass_kg'"
+    want = r"unknown parameter 'squeal\.receiver_distanc'; did you mean 'squeal\.receiver_distance_m'"
     with pytest.raises(ConfigError, match=want):
-        SquealRiskNode(context=ros_context, parameter_overrides=[*params, Parameter("squeal.modal_mas", value=1.0)])
+        SquealRiskNode(context=ros_context,
+                       parameter_overrides=[*params, Parameter("squeal.receiver_distanc", value=1.0)])
     node = SquealRiskNode(context=ros_context, parameter_overrides=params)  # the site file alone is fine
     node.destroy_node()
 

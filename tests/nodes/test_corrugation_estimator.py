@@ -9,6 +9,8 @@ from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from rail_monitor.advice import plan
+from rail_monitor.advice.consequences import Consequences
 from rail_monitor.bagio.messages import train_pass_fields
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.corrugation import advice
@@ -17,6 +19,9 @@ from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STREAM_QOS
+from rail_monitor.noise.config import noise_config
+from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.squeal.config import squeal_config
 from rail_msgs.msg import CorrugationState, RoughnessSurvey, SpeedAdvisory, TrainPass
 from rail_msgs.srv import EvaluateSpeedDistribution
 
@@ -94,6 +99,12 @@ def test_node_state_rejections_identity_surveys_service_and_advisory(ros_context
         assert res.success and len(res.growth_per_axle_pass) == len(pure.bands)
         want = advice.evaluate(pure, np.array([14.0, 18.0, 22.0]), np.array([1.0, 2.0, 1.0]))
         assert res.peak_growth == pytest.approx(want.peak_growth, rel=1e-12)
+        # ... with what the distribution does to noise and squeal against the recent passes
+        cons = Consequences(site, RollingNoiseModel(site, noise_config(site_values)), squeal_config(site_values))
+        side = plan.evaluate_consequences(pure, cons, np.array([14.0, 18.0, 22.0]), np.array([1.0, 2.0, 1.0]))
+        assert list(res.noise_model) == side.noise_model
+        np.testing.assert_allclose(res.noise_change_dba, side.noise_change_dba, rtol=1e-12)
+        assert (res.squeal_share_current, res.squeal_share) == (side.squeal_share_current, side.squeal_share)
         refused = probe.evaluate([14.0, -1.0], [1.0, 1.0])
         assert not refused.success and "speeds" in refused.message
 
@@ -101,6 +112,11 @@ def test_node_state_rejections_identity_surveys_service_and_advisory(ros_context
         adv = probe.advisories[-1]
         assert sum(adv.recommended_probability) == pytest.approx(1.0)
         assert adv.grinding_interval_factor >= 1.0 and adv.peak_growth_reduction >= 0.0
+        want_adv = plan.advise(pure, cons)
+        assert list(adv.vehicle_class) == want_adv.vehicle_class == ["emu"]
+        np.testing.assert_allclose(adv.band_recommended_share, want_adv.band_recommended_share, atol=1e-9)
+        assert list(adv.noise_model) == want_adv.noise_model
+        assert adv.squeal_share_recommended <= adv.squeal_share_current + 1e-9
 
         grind = RoughnessSurvey(kind=RoughnessSurvey.KIND_GRINDING)
         grind.header.stamp = time_msg(int(good.stamp_ns[-1]) + 10**9)

@@ -141,3 +141,24 @@ def test_noise_parameters_are_checked(site_values):
         noise_config({**site_values, "noise.modle": "cnossos"})
     with pytest.raises(ConfigError, match=r"noise\.model"):
         noise_config({**site_values, "noise.model": "twins"})
+
+
+def test_the_mechanics_contact_filter_takes_each_passs_own_patch(model):
+    # Two EMU passes alike but for the wheel load (65 and 130 kN): the Hertz patch grows as
+    # W^(1/3), so the heavier pass's contact filter cuts short wavelengths more. Independent
+    # method: the band-averaged |F|^2 of models.wheel_rail_noise at each pass's semi-axis from
+    # models.hertz; the effective roughness differs by exactly that, and CNOSSOS (the Directive's
+    # table for the class) not at all.
+    from rail_monitor.models import wheel_rail_noise as wrn
+    from rail_monitor.models.levels import level
+
+    passes = _passes(model.site, "emu", [20.0, 20.0])
+    passes.wheel_load_n = np.array([65e3, 130e3])
+    a = model.site.contact_patch(0.42, passes.wheel_load_n).a
+    want = level(wrn.contact_filter_power(20.0, model.band, a[1], model.cfg.band_points)) \
+        - level(wrn.contact_filter_power(20.0, model.band, a[0], model.cfg.band_points))
+    mech = model.predict(passes, "mechanics")
+    np.testing.assert_allclose(mech.roughness_db[1] - mech.roughness_db[0], want, rtol=0, atol=1e-9)
+    assert want[-1] < -1.0                                               # 10 kHz: the heavier patch filters more
+    cnossos = model.predict(passes, "cnossos")
+    np.testing.assert_allclose(cnossos.roughness_db[1], cnossos.roughness_db[0], rtol=0, atol=1e-12)

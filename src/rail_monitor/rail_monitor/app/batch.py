@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from rail_monitor.advice.consequences import Consequences
+from rail_monitor.advice.plan import SpeedAdvice, advise_or_none
 from rail_monitor.alerts.config import alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager
 from rail_monitor.bagio import messages as fields
@@ -30,10 +32,9 @@ from rail_monitor.core.node_params import STAMP_SPECS, StampParams
 from rail_monitor.core.params import resolve, section, values_of
 from rail_monitor.core.passes import PassTable, publishable, reject_ahead, rejection_reasons, with_class_defaults
 from rail_monitor.core.site import Site, site_from_values
-from rail_monitor.corrugation.advice import advise_or_none
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.corrugation.records import Advice, Trajectory
+from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
 from rail_monitor.noise.state_of_pass import state_index
@@ -58,7 +59,7 @@ class BatchResult:
     noise: dict[str, NoisePrediction]  # per source model
     alerts: list[Alert]
     standing: list[Alert]
-    advice: Advice | None
+    advice: SpeedAdvice | None
     estimator: CorrugationEstimator   # the final state
     receiver: Any
     left_out: dict[str, int]          # passes the replayer would not send, by reason
@@ -92,7 +93,8 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     alerts = AlertManager(alert_config(values, est.cfg.lead_time_days))
     events = _feed_alerts(alerts, table, reasons, accepted, squeal, traj, noise)
     return BatchResult(site, table, reasons, accepted, squeal, traj, state_of_pass, noise, events,
-                       sorted(alerts.standing.values(), key=_alert_key), advise_or_none(est), est, model.receiver,
+                       sorted(alerts.standing.values(), key=_alert_key),
+                       advise_or_none(est, Consequences(site, model, squeal_config(values))), est, model.receiver,
                        left_out)
 
 

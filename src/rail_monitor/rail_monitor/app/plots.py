@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from rail_monitor.models.squeal import REGIME_STICK_SLIP_BOUND
+from rail_monitor.models.squeal import REGIME_REVERSE_SLIP
 
 
 def squeal_sweep(rows: dict[str, np.ndarray], path: str | Path, title: str = "") -> Path:
@@ -20,13 +20,13 @@ def squeal_sweep(rows: dict[str, np.ndarray], path: str | Path, title: str = "")
     vc = rows["crabbing_velocity_mps"]
     amp = rows["velocity_amplitude_mps"]
     fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 6.0), constrained_layout=True)
-    ax1.plot(vc, amp, "-", label="closed form (energy balance)")
+    ax1.plot(vc, amp, "-", label="energy balance")
     if "ode_amplitude_mps" in rows:
         ax1.plot(vc, rows["ode_amplitude_mps"], "o", mfc="none", label="time integration")
     ax1.plot(vc, vc, ":", color="grey", label="A w = Vc")
-    bound = rows["regime"] == REGIME_STICK_SLIP_BOUND
-    if np.any(bound):
-        ax1.plot(vc[bound], amp[bound], "x", color="tab:red", label="stick-slip bound")
+    reverse = rows["regime"] == REGIME_REVERSE_SLIP
+    if np.any(reverse):
+        ax1.plot(vc[reverse], amp[reverse], "x", color="tab:red", label="with reverse slip (whole curve)")
     ax1.set_ylabel("velocity amplitude A w [m/s]")
     ax1.legend(loc="upper left")
     ax1.grid(True, alpha=0.3)

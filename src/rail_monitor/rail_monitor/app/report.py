@@ -103,6 +103,11 @@ def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12)
     if len(run.alerts) > max_alerts:
         lines.append(f"  ... and {len(run.alerts) - max_alerts} more (alerts topic, report page)")
     lines += _grinding_lines(run)
+    if run.advisory is not None and len(run.advisory.vehicle_class):
+        from rail_monitor.advice.plan import advice_of_message
+
+        lines.append("speed advice (per class, at its recent mean speed):")
+        lines += ["  " + line for line in advice_of_message(run.advisory).lines()]
     for model, nz in run.noise.items():
         top = np.argsort(-nz["lpaeq_tp_dba"], kind="stable")[:3]
         cls = dict(zip(p.train_id.tolist(), p.vehicle_class.tolist(), strict=True))

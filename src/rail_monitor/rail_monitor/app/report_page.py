@@ -140,7 +140,7 @@ def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_ext
               "noise": report_tables.noise_percentiles(t, lim, models),
               "classes": report_tables.by_class(t, lim, models),
               "friction": report_tables.friction_comparison(t, lim, zone),
-              "squealers": report_tables.squealing_trains(t, lim)}
+              "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run)}
     head = headline(run, t, lim, tables, zone)
     figures = [("timeline", "Passes and squealing passes per day, and the day's highest pass-by level against "
                 "the limit.", report_plots.timeline(report_tables.daily(t, lim, models, zone), models, lim, zone))]
@@ -154,9 +154,9 @@ def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_ext
     if len(run.squeal.get("risk", ())):
         figures.append(("squeal", "Squeal amplitude against crabbing velocity: every pass and the model per "
                         "friction state.", report_plots.squeal(run.squeal, figures_extra["curves"])))
-    figures.append(("speeds", "Speed distributions, axle-weighted: the history, the recent passes, and the "
-                    "advised distribution.", report_plots.speeds(run.passes.speed_mps, run.passes.axle_count,
-                                                                 run.advisory)))
+    figures.append(("speeds", "Speed distributions, shares of train passes: the history, the recent passes, "
+                    "and the advised distribution (per class in the speed advice table).",
+                    report_plots.speeds(run.passes.speed_mps, run.advisory)))
     generated = datetime.now(UTC)
     meta = {"site_id": site.site_id, "time_zone": zone, "software_version": __version__,
             "generated_utc": generated.strftime("%Y-%m-%dT%H:%M:%SZ"),
@@ -195,6 +195,8 @@ def _pdf_text_pages(head, tables, lim, meta, run) -> list:
     lines += ["", "Grinding outlook per band:", *_text_table(tables["outlook"], 8)]
     if tables["friction"]:
         lines += ["", "Friction modifier, before and after:", *_text_table(tables["friction"])]
+    if tables["advice"]:
+        lines += ["", "Speed advice per class (at its recent mean speed):", *_text_table(tables["advice"])]
     lines += ["", f"Loudest squealing trains (of {len(tables['squealers'])}, all in squealing_trains.csv):"]
     lines += _text_table(tables["squealers"], 15)
     per_page = 58
@@ -224,6 +226,10 @@ def _html(run, values, head, tables, lim, figures, meta) -> str:
 
     friction = (f"<h2>Friction modifier: before and after</h2>{_html_table(tables['friction'])}"
                 if tables["friction"] else "")
+    advice = (f"<h2>Speed advice per class</h2>{_html_table(tables['advice'])}<p class=\"meta\">Shares of each "
+              "class's trains per speed band at its recent mean speed, cutting the peak corrugation growth "
+              "without raising the mean noise by more than the limit or the squealing share.</p>"
+              if tables["advice"] else "")
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>rail_monitor report: {e(meta['site_id'])}</title>
 <style>{PAGE_CSS}</style></head><body>
@@ -244,7 +250,7 @@ forecast, the others the fastest growth rate of the band.</p>
 {friction}
 <h2>Squealing trains (loudest first)</h2>{_html_table(tables['squealers'], 25)}
 <h1>Appendix for engineers</h1>
-{fig('corrugation')}{fig('noise')}{fig('squeal')}{fig('speeds')}
+{fig('corrugation')}{fig('noise')}{fig('squeal')}{advice}{fig('speeds')}
 <h2>Alerts (raise and clear events)</h2>{_html_table(alerts)}
 <h2>Site parameters</h2><p class="meta">As in the site file{': ' + e(meta['site_file']) if meta['site_file'] else ''};
 every other parameter at its default.</p>{_html_table(params)}

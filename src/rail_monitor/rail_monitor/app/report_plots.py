@@ -139,9 +139,9 @@ def squeal(squeal_data: Mapping[str, np.ndarray], curves: dict) -> Figure:
     return fig
 
 
-def speeds(speed_mps: np.ndarray, axles: np.ndarray, advisory) -> Figure:
-    """Axle-weighted speed distributions in km/h: the whole history, the advisory's recent passes and
-    its advised distribution (same mean speed, least peak corrugation growth)."""
+def speeds(speed_mps: np.ndarray, advisory) -> Figure:
+    """Speed distributions in km/h, shares of train passes: the whole history, the advisory's recent
+    passes and its advised distribution (every class; the plan is per class)."""
     fig, ax = plt.subplots(figsize=(8.0, 4.2), constrained_layout=True)
     if advisory is not None and len(advisory.speed_bin_centres_mps):
         c = KMH_PER_MPS * np.asarray(advisory.speed_bin_centres_mps)
@@ -152,11 +152,11 @@ def speeds(speed_mps: np.ndarray, axles: np.ndarray, advisory) -> Figure:
         bins = np.append(c - width / 2, c[-1] + width / 2)
     else:
         bins = 30
-    hist, edges = np.histogram(KMH_PER_MPS * speed_mps, bins=bins, weights=axles)
+    hist, edges = np.histogram(KMH_PER_MPS * speed_mps, bins=bins)
     ax.stairs(hist / max(hist.sum(), 1), edges, color="k", label="whole history")
     ax.set_xlabel("pass speed [km/h]")
-    ax.set_ylabel("share of axle passes [-]")
-    ax.set_title("Speed distribution (axle-weighted, as corrugation grows per axle)", fontsize="medium")
+    ax.set_ylabel("share of train passes [-]")
+    ax.set_title("Speed distribution (every class; the advice keeps each class's mean speed)", fontsize="medium")
     ax.legend(fontsize="small")
     ax.grid(True, alpha=0.3)
     return fig

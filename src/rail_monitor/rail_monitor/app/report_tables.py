@@ -15,7 +15,7 @@ import numpy as np
 
 from rail_monitor.alerts.config import alert_config, counts_as_squeal
 from rail_monitor.app.report import RunData
-from rail_monitor.core.passes import FRICTION_MODIFIER, FRICTION_NAMES
+from rail_monitor.core.passes import FRICTION_MODIFIER, FRICTION_NAMES, KMH_PER_MPS
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
 from rail_monitor.corrugation.config import corrugation_config
 
@@ -185,3 +185,24 @@ def _date(newest_ns: int, days: float, zone: str) -> str:
     if not np.isfinite(days) or days > 3650:
         return "not within 10 years"
     return format_local_ns(newest_ns + int(days * NS_PER_DAY), zone)[:10]
+
+
+def speed_advice(run: Any) -> list[dict]:
+    """The last speed advisory's plan: a row per class and band, with the class's noise and squeal
+    consequences (empty without an advisory)."""
+    if run.advisory is None or not len(run.advisory.vehicle_class):
+        return []
+    from rail_monitor.advice.plan import advice_of_message
+
+    a = advice_of_message(run.advisory)
+    rows = []
+    for c, name in enumerate(a.vehicle_class):
+        change = a.noise_change(c)
+        for i in (i for i, n in enumerate(a.band_vehicle_class) if n == name):
+            rows.append({"class": name, "band [km/h]": f"{KMH_PER_MPS * a.band_low_mps[i]:.0f}-"
+                         f"{KMH_PER_MPS * a.band_high_mps[i]:.0f}", "recent [%]": 100.0 * a.band_current_share[i],
+                         "advised [%]": 100.0 * a.band_recommended_share[i],
+                         **{f"noise change {m} [dB(A)]": float(change[j]) for j, m in enumerate(a.noise_model)},
+                         "squealing recent [%]": 100.0 * a.class_squeal_share_current[c],
+                         "squealing advised [%]": 100.0 * a.class_squeal_share_recommended[c]})
+    return rows

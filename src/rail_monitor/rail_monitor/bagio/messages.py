@@ -11,17 +11,20 @@ rosbags' deserialised objects alike (the two have the same attribute names).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rail_monitor.alerts.config import NOISE_METRICS
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.core.timeutil import TIME_MSG_END_NS, fits_time_msg, from_sec_nanosec, to_sec_nanosec
-from rail_monitor.corrugation.records import Advice, Forecast, StateSnapshot
+from rail_monitor.corrugation.records import Forecast, StateSnapshot
 from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.predict import Corrugation, NoisePrediction
 from rail_monitor.squeal.config import RISK_HIGH
+
+if TYPE_CHECKING:
+    from rail_monitor.advice.plan import SpeedAdvice
 
 Fields = dict[str, Any]
 
@@ -95,11 +98,16 @@ def corrugation_state_fields(snap: StateSnapshot, fc: Forecast, frame_id: str) -
         "k_b_by_friction": [float(k) for k in snap.k_b]}
 
 
-def speed_advisory_fields(advice: Advice, stamp_ns: int, frame_id: str) -> Fields:
+def speed_advisory_fields(advice: SpeedAdvice, stamp_ns: int, frame_id: str) -> Fields:
     """Speed advice as SpeedAdvisory fields (the message's fields are the record's)."""
     out: Fields = {"header": header_fields(stamp_ns, frame_id)}
     for name, value in vars(advice).items():
-        out[name] = value.tolist() if hasattr(value, "tolist") and getattr(value, "ndim", 0) else float(value)
+        if isinstance(value, list):
+            out[name] = [str(v) for v in value]
+        elif isinstance(value, np.ndarray):
+            out[name] = value.astype(float).tolist()
+        else:
+            out[name] = float(value)
     return out
 
 

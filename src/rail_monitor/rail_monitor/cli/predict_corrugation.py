@@ -21,13 +21,15 @@ def add_parser(models: argparse._SubParsersAction) -> None:
                    "from it")
     g.add_argument("--speeds", type=float, nargs="+", help="speed histogram bin centres [m/s]")
     c.add_argument("--weights", type=float, nargs="+", help="weights of --speeds (default: equal)")
-    c.add_argument("--vehicle-class", help="vehicle class without --history (default: the site's first)")
+    c.add_argument("--vehicle-class", help="vehicle class without --history: its speeds, kernel and axles per train "
+                   "(default: the site's traffic mix, at the first class's speeds)")
     c.add_argument("--speed-mean", type=float, help="mean speed of a normal distribution [m/s] (default: the class's)")
     c.add_argument("--speed-cv", type=float, help="its coefficient of variation [-] (default: the class's sd/mean)")
     c.add_argument("--friction", choices=tuple(FRICTION_BY_NAME),
                    help="friction state (default: dry, or the history's mix)")
     c.add_argument("--passes-per-day", type=float, help="train passes per day (default: the history's)")
-    c.add_argument("--advise", action="store_true", help="also propose a speed distribution with the same mean")
+    c.add_argument("--advise", action="store_true", help="with --history: also propose speed bands per vehicle "
+                   "class at each class's mean speed (noise and squeal not raised)")
     c.add_argument("--json", action="store_true", help="print JSON instead of a table")
     c.add_argument("--plot-receptance", metavar="PNG", help="save the track and wheel receptances to this PNG")
     c.add_argument("--plot-growth", metavar="PNG", help="save growth against wavelength (current and advised)")
@@ -66,15 +68,11 @@ def _print_table(r, data: dict) -> None:
               f"{1e6 * b['threshold_m']:10.3f}")
     print(f"peak g {ev.peak_growth:.3e} per axle pass at {1e3 * ev.peak_wavelength_m:.1f} mm; worst band "
           f"{1e3 * est.bands[fc.worst_band]:.1f} mm reaches its limit in {fc.passes_to_threshold:.4g} train passes"
-          f" = {fc.days_to_threshold:.4g} days at {fc.passes_per_day:.4g} passes/day")
+          f" = {fc.days_to_threshold:.4g} days at {fc.passes_per_day:.4g} passes/day of {r.axles_per_train:.3g} axles")
     if advice is not None:
-        used = advice.recommended_probability > 1e-6
-        mix = zip(advice.speed_bin_centres_mps[used], advice.recommended_probability[used], strict=True)
-        factor = advice.grinding_interval_factor
-        print(f"advice: same mean {advice.mean_speed_mps:.2f} m/s, speeds "
-              + ", ".join(f"{v:.2f} ({100 * p:.0f} %)" for v, p in mix)
-              + f"; peak growth -{100 * advice.peak_growth_reduction:.0f} %, grinding interval x{factor:.2f}, "
-              f"grinding cost -{100 * (1 - 1 / factor):.0f} %")
+        print("advice:")
+        for line in advice.lines():
+            print(f"  {line}")
 
 
 def _plot_receptance(r, path: str) -> None:
@@ -92,8 +90,9 @@ def _plot_growth(r, path: str) -> None:
 
     curves = {"current speeds": r.evaluation.growth_per_axle_pass}
     if r.advice is not None:
-        curves["advised speeds"] = evaluate(r.estimator, r.advice.speed_bin_centres_mps,
-                                            r.advice.recommended_probability, r.friction_state).growth_per_axle_pass
+        curves["advised speeds (every class's shares)"] = evaluate(
+            r.estimator, r.advice.speed_bin_centres_mps, r.advice.recommended_probability,
+            r.friction_state).growth_per_axle_pass
     print(f"plot: {corrugation_growth(r.estimator.bands, curves, path, title=r.where)}", file=sys.stderr)
 
 

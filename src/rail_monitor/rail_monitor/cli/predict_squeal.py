@@ -21,6 +21,8 @@ def add_parser(models: argparse._SubParsersAction) -> None:
 
     q = models.add_parser("squeal", help="squeal amplitude and level for a crabbing velocity, or a sweep")
     q.add_argument("--rig", action="store_true", help="the UQ paper's two-disc rig (Figure 5) instead of a site")
+    q.add_argument("--history", help="pass history (bag folder, .mcap, .db3 or .csv): a table per friction state "
+                   "(creep curve, unstable share, onset, mean level, friction-modifier cut) instead of one case")
     add_site_option(q)
     q.add_argument("--vehicle-class", help="vehicle class of the site (default: its first)")
     q.add_argument("--friction", default="dry", choices=tuple(FRICTION_BY_NAME), help="friction state")
@@ -32,7 +34,7 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     g.add_argument("--sweep", type=float, nargs=3, metavar=("VC_START", "VC_STOP", "N"),
                    help="sweep the crabbing velocity [m/s]")
     q.add_argument("--k3-convention", choices=K3_CONVENTIONS,
-                   help="how k3 follows from Kalker's C22 (default: the site's squeal.k3_convention)")
+                   help="how k3 follows from Kalker's C22 (default: the site's contact.k3_convention)")
     for dest, (flag, unit) in OVERRIDES.items():
         q.add_argument(flag, dest=dest, type=float, help=f"override [{unit}]")
     q.add_argument("--reference", type=float, help="A w_ref of the relative level [m/s] (default: the largest A w)")
@@ -50,6 +52,8 @@ def run(ns: argparse.Namespace) -> int:
     from rail_monitor.squeal.config import squeal_config
     from rail_monitor.squeal.whatif import crabbing_velocities, squeal_case, sweep
 
+    if ns.history:
+        return _friction_table(ns)
     overrides = {k: getattr(ns, k) for k in OVERRIDES if getattr(ns, k) is not None}
     values = None if ns.rig else site_values(ns.site)
     case, where = squeal_case(values, ns.vehicle_class, ns.friction, ns.speed, ns.load, ns.k3_convention, **overrides)
@@ -69,12 +73,12 @@ def run(ns: argparse.Namespace) -> int:
         if site_level:
             print(f"# level at the site's receiver, {rows['frequency_hz'][0]:.0f} Hz mode; risk from the site's "
                   "dB(A) limits (squeal.risk_medium_dba, squeal.risk_high_dba); '-': no squeal")
-        head = f"{'Vc [m/s]':>9} {'AoA [mrad]':>10} {'A w [m/s]':>10} {'rel [dB]':>9} {'regime':<16}"
+        head = f"{'Vc [m/s]':>9} {'AoA [mrad]':>10} {'A w [m/s]':>10} {'rel [dB]':>9} {'regime':<26}"
         print(head + (f" {'level [dB(A)]':>13} {'risk':<6}" if site_level else "")
               + (f" {'ODE A w':>9}" if ns.ode else ""))
         for i in range(len(vc)):
             line = (f"{vc[i]:9.4f} {rows['angle_of_attack_mrad'][i]:10.2f} {rows['velocity_amplitude_mps'][i]:10.4f} "
-                    f"{rows['relative_level_db'][i]:9.2f} {REGIME_NAMES[int(rows['regime'][i])]:<16}")
+                    f"{rows['relative_level_db'][i]:9.2f} {REGIME_NAMES[int(rows['regime'][i])]:<26}")
             if site_level:
                 level = rows["level_dba"][i]
                 line += f" {level:13.1f}" if np.isfinite(level) else f" {'-':>13}"
@@ -84,4 +88,28 @@ def run(ns: argparse.Namespace) -> int:
         from rail_monitor.app.plots import squeal_sweep
 
         print(f"plot: {squeal_sweep(rows, ns.plot, title=where)}", file=sys.stderr)
+    return 0
+
+
+def _friction_table(ns: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.core.errors import RailMonitorError
+    from rail_monitor.squeal.whatif import friction_states
+
+    if ns.rig:
+        raise RailMonitorError("--history is a site's: leave out --rig")
+    rows = friction_states(site_values(ns.site), read_passes(Path(ns.history)))
+    if ns.json:
+        print_json({"history": ns.history, "friction_states": rows})
+        return 0
+    print(f"{'friction state':<18} {'k1':>5} {'k2':>8} {'passes':>7} {'unstable':>9} {'onset':>10} "
+          f"{'mean level':>11} {'FM cut':>8}")
+    for r in rows:
+        level, cut = r["mean_level_dba"], r["friction_modifier_cut_dba"]
+        print(f"{r['friction_state']:<18} {r['k1']:5.2f} {r['k2']:8.4f} {r['passes']:7d} "
+              f"{100 * r['unstable_share']:8.1f}% {r['onset_mrad']:5.2f} mrad "
+              + (f"{level:6.1f} dB(A)" if np.isfinite(level) else f"{'-':>11}")
+              + (f" {cut:5.1f} dB" if np.isfinite(cut) else f" {'-':>8}"))
     return 0

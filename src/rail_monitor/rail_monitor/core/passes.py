@@ -14,20 +14,19 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from rail_monitor.core.friction import (  # noqa: F401  (re-exported: the pass table's friction codes)
+    FRICTION_BY_NAME,
+    FRICTION_CONTAMINATED,
+    FRICTION_DRY,
+    FRICTION_MODIFIER,
+    FRICTION_NAMES,
+    FRICTION_UNSET,
+    FRICTION_WET,
+)
 from rail_monitor.core.site import Site
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, fits_time_msg
 
 KMH_PER_MPS = 3.6  # speeds for people (CSV columns, exports, report) are in km/h
-
-# TrainPass.FRICTION_* values and their names in CSV files and site parameters.
-FRICTION_UNSET, FRICTION_DRY, FRICTION_WET, FRICTION_MODIFIER, FRICTION_CONTAMINATED = range(5)
-FRICTION_NAMES: dict[int, str] = {
-    FRICTION_DRY: "dry",
-    FRICTION_WET: "wet",
-    FRICTION_MODIFIER: "friction_modifier",
-    FRICTION_CONTAMINATED: "contaminated",
-}
-FRICTION_BY_NAME: dict[str, int] = {v: k for k, v in FRICTION_NAMES.items()}
 
 # Plausibility limits that separate a malformed event from an unusual pass.
 MAX_SPEED_MPS = 120.0           # above any line speed at a curve

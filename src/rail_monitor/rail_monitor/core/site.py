@@ -14,10 +14,12 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, resolve, section
+from rail_monitor.core.friction import FRICTION_NAMES
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 from rail_monitor.core.timeutil import time_zone
 from rail_monitor.models import hertz
 from rail_monitor.models.cnossos import BRAKE_TYPES
+from rail_monitor.models.squeal import K3_CONVENTIONS, RIG_PEAK_FRICTION
 from rail_monitor.models.track import Track
 
 SITE_ID = ParamSpec("site_id", "site", "Site identifier, written to header.frame_id of every message.")
@@ -30,14 +32,42 @@ SITE_SPECS: tuple[ParamSpec, ...] = (
               "and exports; stamps stay UTC."),
 )
 
-# Wheel-rail contact, under contact.: one geometry for every model (squeal's k3, the corrugation
-# kernel's contact stiffness and contact filter, rolling noise).
+# Creep curves per friction state (k1 = friction peak, k2 = sliding slope per unit xi'; the UQ
+# paper's piecewise-linear curve, models.squeal). Dry: the UQ seminar paper's rig values
+# (k1 = 0.27, k2 = -0.02, its section 3.3) rounded to a rail steel peak of 0.3. Friction modifier:
+# mu about 0.35 with a positive slope (the paper's section 2.1 and its ref. [12]). Wet (0.2) and
+# contaminated by a leaf film (0.1): lower peaks with dry rail's relative fall k2/k1 = -1/15 (the
+# same curve shape scaled by the friction level; no measured curve per state is cited here: set a
+# site's own). The saturation creepage scales with k1 (contact.k3_convention reduced_kalker).
+CREEP_DEFAULTS: dict[str, tuple[float, float]] = {
+    "dry": (0.30, -0.02),
+    "wet": (0.20, -0.0133),
+    "friction_modifier": (0.35, 0.01),
+    "contaminated": (0.10, -0.0067),
+}
+
+# Wheel-rail contact, under contact.: one contact for every model (rail_monitor.core.contact: the
+# contact state of a pass, from which squeal, the corrugation kernel and its regime follow).
 CONTACT_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("young_modulus_pa", 210.0e9, "Young's modulus of wheel and rail steel [Pa].", 1.0e9, 1.0e12),
     ParamSpec("poisson_ratio", 0.28, "Poisson's ratio of wheel and rail steel [-].", 0.0, 0.5),
     ParamSpec("rail_head_radius_m", 0.3, "Transverse radius of the rail head at the contact [m].", 0.01, 100.0),
     ParamSpec("wheel_transverse_radius_m", 1.0e6, "Transverse radius of the wheel tread at the contact [m] "
               "(1e6: a conical tread).", 0.05, 1.0e9),
+    ParamSpec("k3_convention", "reduced_kalker", "How the lateral creep stiffness k3 follows from Kalker's C22 "
+              "(models.squeal.lateral_creep_stiffness).", choices=K3_CONVENTIONS),
+    ParamSpec("creep_reduction_factor", RIG_PEAK_FRICTION, "Reduction factor k_A on Kalker's creep slope of the "
+              "reduced_kalker convention [-] (0.27: calibrated on the UQ paper's rig).", 0.01, 1.0),
+    ParamSpec("k3_n", 0.0, "Lateral creep stiffness k3 given directly [N]; 0: from contact mechanics.", 0.0, 1.0e12),
+    *(
+        spec
+        for state, (k1, k2) in CREEP_DEFAULTS.items()
+        for spec in (
+            ParamSpec(f"creep.{state}.k1", k1, f"Friction peak k1 of the {state} creep curve [-].", 0.01, 1.5),
+            ParamSpec(f"creep.{state}.k2", k2, f"Sliding-branch slope k2 of the {state} creep curve, per unit "
+                      "normalised creepage [-] (< 0 falling).", -0.5, 0.5),
+        )
+    ),
 )
 
 # Track, under track.: one track model for corrugation and rolling noise (models.track.Track;
@@ -77,6 +107,13 @@ VEHICLE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("speed_sd_mps", 1.5, "Standard deviation of the pass speed [m/s].", 0.0, 30.0),
     ParamSpec("speed_min_mps", 8.0, "Lowest pass speed (the distribution is truncated) [m/s].", 0.5, 100.0),
     ParamSpec("speed_max_mps", 22.0, "Highest pass speed (line speed at the curve) [m/s].", 0.5, 100.0),
+    # The squealing wheel mode (one lateral/axial mode at the contact, models.squeal) and its radiation.
+    ParamSpec("squeal_mode_hz", 1200.0, "Natural frequency of the wheel's squealing mode [Hz].", 50.0, 2.0e4),
+    ParamSpec("squeal_modal_mass_kg", 40.0, "Modal mass of that mode at the contact, lateral [kg].", 0.01, 1.0e4),
+    ParamSpec("squeal_damping_ratio", 1.0e-4, "Modal damping ratio of that mode [-] (1e-4: an untreated wheel; a "
+              "wheel damper raises it).", 0.0, 0.5),
+    ParamSpec("wheel_radiating_area_m2", 0.9, "Radiating area of the wheel, both sides [m2].", 0.001, 10.0),
+    ParamSpec("squeal_radiation_efficiency", 1.0, "Radiation efficiency of the squealing mode [-].", 0.0, 2.0),
 )
 
 
@@ -99,6 +136,11 @@ class VehicleClass:
     speed_sd_mps: float
     speed_min_mps: float
     speed_max_mps: float
+    squeal_mode_hz: float
+    squeal_modal_mass_kg: float
+    squeal_damping_ratio: float
+    wheel_radiating_area_m2: float
+    squeal_radiation_efficiency: float
 
     @property
     def mean_axles_per_train(self) -> float:
@@ -106,14 +148,20 @@ class VehicleClass:
         return self.axles_per_vehicle * (self.vehicles_min + self.vehicles_max) / 2
 
 
-@dataclass(frozen=True)
-class ContactGeometry:
-    """Materials and transverse radii of the wheel-rail contact (units as in CONTACT_SPECS)."""
+def _creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """k1, k2 [-] per pass for TrainPass.FRICTION_* values (NaN for an unknown value)."""
+    k1 = np.full(np.shape(friction_state), np.nan)
+    k2 = np.full(np.shape(friction_state), np.nan)
+    for code, name in FRICTION_NAMES.items():
+        sel = np.asarray(friction_state) == code
+        k1[sel], k2[sel] = getattr(self, f"creep_{name}_k1"), getattr(self, f"creep_{name}_k2")
+    return k1, k2
 
-    young_modulus_pa: float
-    poisson_ratio: float
-    rail_head_radius_m: float
-    wheel_transverse_radius_m: float
+
+WheelRailContact = values_type(
+    "WheelRailContact", CONTACT_SPECS, "Materials, transverse radii and creep curves of the wheel-rail contact "
+    "(units as in CONTACT_SPECS; creep.dry.k1 is creep_dry_k1), and creep(friction_state), the creep curve of each "
+    "pass.", __name__, creep=_creep)
 
 
 @dataclass(frozen=True)
@@ -123,8 +171,8 @@ class Site:
     site_id: str
     curve_radius_m: float
     vehicles: Mapping[str, VehicleClass]
-    contact: ContactGeometry = field(default_factory=lambda: ContactGeometry(**{s.name: s.default
-                                                                                for s in CONTACT_SPECS}))
+    contact: WheelRailContact = field(default_factory=lambda: values_of(WheelRailContact,
+                                                                        {s.name: s.default for s in CONTACT_SPECS}))
     track: Track = field(default_factory=Track)
     time_zone: str = "UTC"
 
@@ -134,6 +182,15 @@ class Site:
         c = self.contact
         return hertz.contact_ellipse(wheel_radius_m, c.wheel_transverse_radius_m, np.inf, c.rail_head_radius_m,
                                      hertz.contact_modulus(c.young_modulus_pa, c.poisson_ratio), load_n)
+
+    @property
+    def mean_axles_per_train(self) -> float:
+        """Axles per train over the rolling-stock table, weighted by the classes' traffic shares
+        (equally when every share is 0) [-]."""
+        vs = list(self.vehicles.values())
+        share = np.array([v.traffic_share for v in vs])
+        w = share / share.sum() if share.sum() > 0 else np.full(len(vs), 1.0 / len(vs))
+        return float(w @ np.array([v.mean_axles_per_train for v in vs]))
 
     def vehicle(self, name: str) -> VehicleClass:
         """The vehicle class called name, or a ConfigError listing the known ones."""
@@ -158,6 +215,6 @@ def site_from_values(values: Mapping[str, Any]) -> Site:
     time_zone(top["time_zone"])
     return Site(site_id=top["site_id"], curve_radius_m=top["curve_radius_m"], vehicles=vehicles,
                 time_zone=top["time_zone"],
-                contact=ContactGeometry(**resolve(CONTACT_SPECS, section(values, "contact."), "contact.",
-                                                  strict=True)),
+                contact=values_of(WheelRailContact, resolve(CONTACT_SPECS, section(values, "contact."), "contact.",
+                                                            strict=True)),
                 track=Track(**resolve(TRACK_SPECS, section(values, "track."), "track.", strict=True)))

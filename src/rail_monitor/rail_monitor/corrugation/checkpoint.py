@@ -20,8 +20,11 @@ from rail_monitor.core.errors import ConfigError
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.history import COLUMNS, KeptPasses
 
-VERSION = 2
-READABLE_VERSIONS = (1, 2)  # 1: before grinding_amplitude (read as the post-grinding default)
+VERSION = 3
+# 1: before grinding_amplitude (read as the post-grinding default); 1-2: before the contact regime
+# (their kept passes read as in partial slip, at their class's nominal load, as they were counted).
+READABLE_VERSIONS = (1, 2, 3)
+CONTACT_COLUMNS = ("regime", "load", "creepage")
 _COUNTS = ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns", "last_survey_ns")
 
 
@@ -71,7 +74,9 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
         with np.load(path, allow_pickle=False) as z:
             data = {k: z[k] for k in z.files}  # zip member CRCs are checked as each is read
         meta = json.loads(str(data["meta"]))
-        missing = {"bands", "log_components", "k_b", "survey_log_amplitude", *(f"recent_{n}" for n in COLUMNS)} \
+        wanted = COLUMNS if isinstance(meta, dict) and meta.get("version") == VERSION else \
+            tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
+        missing = {"bands", "log_components", "k_b", "survey_log_amplitude", *(f"recent_{n}" for n in wanted)} \
             - set(data)
         if missing:
             raise KeyError(f"arrays missing: {', '.join(sorted(missing))}")
@@ -122,17 +127,24 @@ def _state(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarray]) -
     if not (np.all(np.isfinite(log_components)) and np.all(np.isfinite(k_b)) and np.all(k_b >= 0)
             and np.all(np.isfinite(grinding)) and np.all(grinding > 0)):
         raise ValueError("state arrays not finite, or K_b negative, or post-grinding amplitudes not positive")
-    cols = {n: np.asarray(data[f"recent_{n}"]) for n in COLUMNS}
+    cols = {n: np.asarray(data[f"recent_{n}"]) for n in COLUMNS if f"recent_{n}" in data}
     cols["train_id"] = cols["train_id"].astype(str).astype(object)
+    if "regime" not in cols:  # versions 1-2
+        nominal = np.array([est.site.vehicle(c).wheel_load_n for c in est.tables.classes])
+        cls = cols["class_idx"].astype(np.int64, casting="same_kind")
+        cols.update(regime=np.zeros(len(cls), np.int64), load=nominal[np.clip(cls, 0, len(nominal) - 1)],
+                    creepage=np.zeros(len(cls)))
     for n, dtype in (("stamp_ns", np.int64), ("class_idx", np.int64), ("friction", np.int64), ("axles", np.int64),
-                     ("speed", np.float64)):
+                     ("speed", np.float64), ("regime", np.int64), ("load", np.float64), ("creepage", np.float64)):
         cols[n] = cols[n].astype(dtype, casting="same_kind")
     n = len(cols["stamp_ns"])
     if any(c.ndim != 1 or len(c) != n for c in cols.values()):
         raise ValueError("kept-pass columns differ in length")
     if n and (cols["class_idx"].min() < 0 or cols["class_idx"].max() >= len(est.tables.classes)
-              or cols["friction"].min() < 1 or cols["friction"].max() > 4 or not np.all(np.isfinite(cols["speed"]))):
-        raise ValueError("kept passes hold an unknown class, friction state or speed")
+              or cols["friction"].min() < 1 or cols["friction"].max() > 4 or not np.all(np.isfinite(cols["speed"]))
+              or not np.all(np.isin(cols["regime"], (0, 1))) or not np.all(np.isfinite(cols["load"]))
+              or not np.all(np.isfinite(cols["creepage"]))):
+        raise ValueError("kept passes hold an unknown class, friction state, regime, speed, load or creepage")
     counts = {key: int(meta[key]) for key in _COUNTS}
     if any(v < 0 for v in counts.values()):
         raise ValueError("negative counts")

@@ -35,6 +35,9 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("points_per_band", 5, "Wavelengths across each band over which its growth is averaged [-].", 1, 50),
     *(ParamSpec(f"k_b.{state}", value, f"Wear sensitivity K_b with {state} rail, per axle pass [-] (re-fitted "
                 "from roughness surveys).", 0.0, 1.0e-2) for state, value in K_B_DEFAULTS.items()),
+    ParamSpec("sliding_wear_ratio", 1.0, "Mean wear per pass in full sliding over that in partial slip at the same "
+              "friction state [-]; K_b in full sliding is -2/3 of this times K_b (docs/models.md, Sliding).",
+              0.0, 100.0),
     ParamSpec("acceptance_factor", 1.0, "Multiplier on the Grassie et al. (1999) post-grinding acceptance limits "
               "[-].", 0.01, 100.0),
     ParamSpec("intervention_factor", 3.0, "Intervention threshold as a multiple of the acceptance limit [-].",
@@ -50,8 +53,12 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
               "minimum of the rolling-stock table).", 0.0, MAX_SPEED_MPS),
     ParamSpec("advice_max_speed_mps", 0.0, "Highest speed the advice may use [m/s] (0: the line speed, the "
               "highest class maximum).", 0.0, MAX_SPEED_MPS),
-    ParamSpec("advice_bin_mps", 0.5, "Width of the speed bins of the advice [m/s].", 0.05, 10.0),
-    ParamSpec("advice_max_share", 0.2, "Largest share of traffic the advice puts in one speed bin [-].", 0.01, 1.0),
+    ParamSpec("advice_band_kmh", 10.0, "Width of the speed bands the advice publishes per class [km/h] (km/h: "
+              "what an operator signs).", 0.5, 50.0),
+    ParamSpec("advice_max_share", 0.5, "Largest share of a class's trains the advice puts in one band (raised "
+              "to the recent share, or to one over the class's bands, where that is more) [-].", 0.01, 1.0),
+    ParamSpec("advice_noise_rise_dba", 0.5, "Most the advice may raise the pass-weighted mean rolling noise "
+              "(LpAFmax of each noise model) [dB(A)].", 0.0, 20.0),
 )
 
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rail_monitor.core.contact import contact_state
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.site import Site
@@ -65,13 +66,14 @@ class CorrugationEstimator:
         """
         return self._advance(passes)[0]
 
-    def _growth(self, class_idx: np.ndarray, friction: np.ndarray, speed: np.ndarray,
+    def _growth(self, class_idx: np.ndarray, friction: np.ndarray, regime: np.ndarray, speed: np.ndarray,
                 axles: np.ndarray) -> np.ndarray:
         """Log growth of each component (N, B, P) over the axles of N passes."""
-        return self.tables.at(class_idx, friction, speed) * axles[:, None, None]
+        return self.tables.at(class_idx, friction, regime, speed) * axles[:, None, None]
 
-    def _advance(self, passes: PassTable) -> tuple[np.ndarray, np.ndarray]:
-        """advance(), also returning ln Z after each counted pass (counted, B, P)."""
+    def _advance(self, passes: PassTable) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+        """advance(), also returning ln Z after each counted pass and each one's log growth, both
+        (counted, B, P)."""
         counted = np.zeros(len(passes), bool)
         horizon = self.newest_ns - self.history_ns
         seen = self.kept.seen
@@ -83,10 +85,11 @@ class CorrugationEstimator:
             counted[i] = True
             horizon = max(horizon, stamp - self.history_ns)
         if not counted.any():
-            return counted, np.zeros((0, *self.log_components.shape))
+            return counted, (np.zeros((0, *self.log_components.shape)), np.zeros((0, *self.log_components.shape)))
         new = passes.take(counted)
         cls = self.tables.class_index(new.vehicle_class)
-        growth = self._growth(cls, new.friction_state, new.speed_mps, new.axle_count)
+        contact = contact_state(self.site, new)
+        growth = self._growth(cls, new.friction_state, contact.regime, new.speed_mps, new.axle_count)
         # Sequential sum (cumsum), so a batch adds as the same passes one by one would.
         steps = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[1:]
         self.log_components = steps[-1].copy()
@@ -99,10 +102,11 @@ class CorrugationEstimator:
         i_new = len(new) - 1 - int(np.argmax(new.stamp_ns[::-1]))  # the last of equal stamps, as one by one
         if int(new.stamp_ns[i_new]) >= self.newest_ns:
             self.newest_ns, self.newest_train_id = int(new.stamp_ns[i_new]), str(new.train_id[i_new])
-        self.kept.extend(stamp_ns=new.stamp_ns, train_id=new.train_id, class_idx=cls,
-                         friction=new.friction_state, speed=new.speed_mps, axles=new.axle_count)
+        self.kept.extend(stamp_ns=new.stamp_ns, train_id=new.train_id, class_idx=cls, friction=new.friction_state,
+                         regime=contact.regime.astype(np.int64), speed=new.speed_mps, axles=new.axle_count,
+                         load=contact.load_n, creepage=contact.creepage)
         self._prune()
-        return counted, steps
+        return counted, (steps, growth)
 
     def advance_history(self, passes: PassTable) -> Trajectory:
         """advance() over one pass or a history, returning the state and forecast after every
@@ -116,15 +120,13 @@ class CorrugationEstimator:
         k = self.kept
         if len(stamps) and (np.any(np.diff(stamps) < 0) or stamps[0] < self.newest_ns):
             return self._history_one_by_one(passes)
-        kept_growth = self._growth(k.class_idx, k.friction, k.speed, k.axles)
+        kept_growth = self._growth(k.class_idx, k.friction, k.regime, k.speed, k.axles)
         kept_stamps, kept_axles = k.stamp_ns.copy(), k.axles.copy()
         before = self.snapshot()
-        counted, steps = self._advance(passes)
+        counted, (steps, new_growth) = self._advance(passes)
         new = passes.take(counted)
         m, k0 = len(new), len(kept_stamps)
         all_stamps = np.concatenate([kept_stamps, new.stamp_ns])
-        new_growth = self._growth(self.tables.class_index(new.vehicle_class), new.friction_state, new.speed_mps,
-                                  new.axle_count)
         g_prefix = np.concatenate([np.zeros((1, *steps.shape[1:])), np.cumsum(
             np.concatenate([kept_growth, new_growth]), axis=0)])
         a_prefix = np.concatenate([[0], np.cumsum(np.concatenate([kept_axles, new.axle_count]))])
@@ -161,8 +163,8 @@ class CorrugationEstimator:
         k = self.kept
         gone = k.stamp_ns < self.newest_ns - self.history_ns
         if gone.any():
-            self._growth_sum -= np.einsum("n,nbp->bp", k.axles[gone], self.tables.at(k.class_idx[gone],
-                                                                                     k.friction[gone], k.speed[gone]))
+            self._growth_sum -= np.einsum("n,nbp->bp", k.axles[gone], self.tables.at(
+                k.class_idx[gone], k.friction[gone], k.regime[gone], k.speed[gone]))
             self._axle_sum -= int(k.axles[gone].sum())
             k.drop(gone)
 
@@ -174,7 +176,8 @@ class CorrugationEstimator:
     def resum(self) -> None:
         """Recompute the running sums from the kept passes (after K_b changes or a load)."""
         k = self.kept
-        self._growth_sum = np.einsum("n,nbp->bp", k.axles, self.tables.at(k.class_idx, k.friction, k.speed)) \
+        self._growth_sum = np.einsum("n,nbp->bp", k.axles, self.tables.at(k.class_idx, k.friction, k.regime,
+                                                                          k.speed)) \
             if len(k) else np.zeros_like(self.log_components)
         self._axle_sum = int(k.axles.sum())
 
@@ -206,21 +209,24 @@ class CorrugationEstimator:
         """Recent traffic (see :func:`.forecast.traffic`)."""
         return fcst.traffic(self.kept, self.cfg.min_traffic_days)
 
-    def forecast(self, growth: np.ndarray | None = None, passes_per_day: float | None = None) -> Forecast:
+    def forecast(self, growth: np.ndarray | None = None, passes_per_day: float | None = None,
+                 axles_per_train: float | None = None) -> Forecast:
         """Time to the intervention threshold per band at growth g and the traffic.
 
         growth: g per component (B, P) [1/axle pass] (default: the recent passes');
-        passes_per_day: train passes [1/day] (default: the recent rate).
+        passes_per_day: train passes [1/day] (default: the recent rate); axles_per_train [-]
+        (default: the recent passes', else the site's traffic-weighted mean).
         """
         g = self.recent_growth() if growth is None else np.asarray(growth, float)
         rate, axles = self.traffic()
         if passes_per_day:
             rate = passes_per_day
+        if axles_per_train:
+            axles = axles_per_train
         return fcst.single(self._forecasts(self.log_components[None], g[None], np.array([rate]), np.array([axles]),
                                            np.array([self.newest_ns])))
 
     def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
                    newest_ns: np.ndarray) -> Forecast:
-        fallback = float(np.mean([v.mean_axles_per_train for v in self.site.vehicles.values()]))
         return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
-                              self.cfg.lead_time_days, fallback)
+                              self.cfg.lead_time_days, self.site.mean_axles_per_train)

@@ -14,13 +14,18 @@ from rail_monitor.corrugation.history import KeptPasses
 from rail_monitor.corrugation.records import Forecast
 from rail_monitor.models import corrugation as cg
 
+# Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
+# passes nearly balancing the others) can be 1e12 days away, past any 64-bit time stamp.
+MAX_DATED_DAYS = 36_525.0
+
 
 def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
               newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
               fallback_axles: float) -> Forecast:
     """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
     day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
-    band thresholds (B,) [m]; a Forecast of arrays."""
+    band thresholds (B,) [m]; a Forecast of arrays (grinding_due_ns 0: no date, the forecast
+    being infinite or beyond MAX_DATED_DAYS)."""
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
     log_threshold = np.log(threshold)
     margin = log_threshold - np.log(cg.band_amplitude(log_components))
@@ -33,7 +38,7 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
         days = np.where(np.isfinite(rate) & (rate > 0), passes / rate, np.inf)
     days = np.where(passes == 0.0, 0.0, days)
     due = (margin.min(axis=1) <= 0) | (days <= lead_time_days)
-    due_ns = np.array([int(t) + int(d * NS_PER_DAY) if np.isfinite(d) else 0
+    due_ns = np.array([int(t) + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0
                        for t, d in zip(newest_ns.tolist(), days.tolist(), strict=True)], np.int64)
     return Forecast(growth.max(axis=2), worst, passes, days, rate, due, due_ns)
 

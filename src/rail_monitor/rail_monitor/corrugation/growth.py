@@ -2,9 +2,14 @@
 
 Each 1/3-octave band is tracked as components at wavelengths spread across it; per axle pass a
 component grows by ln Z += ln|1 + K_b F^2 H(V / lambda)| (the paper's eqs. 1-2 with the contact
-filter F; docs/models.md), where H uses the site's track (bay-averaged discrete-support
-receptance), the class's unsprung mass and the Hertz contact of the class's wheel at its nominal
-load. The growths are tabulated once per site on a 0.1 m/s speed grid and interpolated linearly.
+filter F; docs/models.md), where H uses the site's track (discrete-support receptance), the
+class's unsprung mass and the Hertz contact of the class's wheel at its nominal load.
+
+The wheel rolls over every position of the sleeper bay, and the roughness at each position grows
+with the kernel there: the log growth is averaged over positions in the bay (the growth of the
+geometric-mean amplitude along the track), not computed from a bay-averaged receptance, which would
+average the receptance's phase before the nonlinear kernel (docs/models.md, "Bay positions").
+The growths are tabulated once per site on a 0.1 m/s speed grid and interpolated linearly.
 """
 
 from __future__ import annotations
@@ -22,16 +27,26 @@ from rail_monitor.models import corrugation as cg
 from rail_monitor.models import track as tr
 from rail_monitor.models.contact_filter import hertzian_line_filter
 
+# Positions in the bay (fraction of the sleeper spacing from a support): the midpoints of eight
+# equal slices of a bay; the receptance is symmetric about mid-span, so the four of the first half
+# stand for all eight with equal weight.
+BAY_POSITIONS = (np.arange(4) + 0.5) / 8
+# Frequencies of the tabulated receptance (log spaced, 0.05 Hz-20 kHz): steps of 0.46 %, a
+# quarter of the half-power bandwidth of the pinned-pinned peak at mid-span (rail loss factor 0.02).
+RECEPTANCE_POINTS = 2800
+
 
 @lru_cache(maxsize=8)
 def _rail_receptance(track: tr.Track) -> tuple[np.ndarray, np.ndarray]:
-    """Bay-averaged discrete-support rail receptance [m/N] on a log frequency grid [Hz]: about a
-    second to build, so kept on disk per track (rail_monitor.core.cache) and in memory."""
-    def build() -> dict[str, np.ndarray]:
-        f = np.geomspace(0.05, 2.0e4, 700)
-        return {"frequency_hz": f, "receptance_m_per_n": tr.bay_averaged_receptance(f, track)}
+    """Discrete-support rail receptance [m/N] at BAY_POSITIONS (F, X) on a log frequency grid
+    [Hz]: about a second to build, so kept on disk per track (rail_monitor.core.cache) and in memory."""
+    grid = {"lowest_hz": 0.05, "highest_hz": 2.0e4, "points": RECEPTANCE_POINTS, "positions": BAY_POSITIONS.tolist()}
 
-    got = cached_arrays("rail_receptance", dataclasses.asdict(track), build)
+    def build() -> dict[str, np.ndarray]:
+        f = np.geomspace(grid["lowest_hz"], grid["highest_hz"], grid["points"])
+        return {"frequency_hz": f, "receptance_m_per_n": tr.discrete_receptance(f, track, position=BAY_POSITIONS)}
+
+    got = cached_arrays("rail_receptance_in_bay", {**dataclasses.asdict(track), **grid}, build)
     return got["frequency_hz"], got["receptance_m_per_n"]
 
 
@@ -44,42 +59,57 @@ def _interp_log(x: np.ndarray, xp: np.ndarray, yp: np.ndarray) -> np.ndarray:
 class GrowthTables:
     """Per-axle-pass log growth of each band component, per vehicle class, over the speed grid.
 
-    ``filtered_kernel`` is F^2 H at the components' wavelengths (C, B, V, P); ``set_k_b``
-    tabulates ln|1 + K_b F^2 H| (C, 4, B, V, P) for the K_b of each friction state.
+    ``filtered_kernel`` is F^2 H at the components' wavelengths and the bay positions
+    (X, C, B, V, P); ``set_k_b`` tabulates ln|1 + K_b F^2 H| averaged over X (C, 4, 2, B, V, P)
+    for the K_b of each friction state, in partial slip (regime 0) and in full sliding (regime 1,
+    K_b times -2/3 sliding_wear_ratio: :func:`rail_monitor.models.corrugation.sliding_wear_sensitivity`).
     """
 
     def __init__(self, site: Site, cfg: CorrugationConfig) -> None:
+        self.sliding_wear_ratio = cfg.sliding_wear_ratio
         self.bands = cg.wavelength_bands(cfg.shortest_wavelength_m, cfg.longest_wavelength_m)
         self.classes = list(site.vehicles)
         self.speeds = np.arange(1, round(MAX_SPEED_MPS / SPEED_STEP_MPS) + 1) * SPEED_STEP_MPS
         sub = cg.band_sub_wavelengths(self.bands, cfg.points_per_band)
         f_rail, r_rail = _rail_receptance(site.track)
+        freq = self.speeds[None, :, None] / sub[:, None, :]
         kernels = []
         for name in self.classes:
             v = site.vehicle(name)
             patch = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
             kc, a = float(patch.stiffness), float(patch.a)
-            h = cg.growth_kernel(kc, r_rail + tr.wheel_receptance(f_rail, v.unsprung_mass_kg))
-            freq = self.speeds[None, :, None] / sub[:, None, :]
+            h = cg.growth_kernel(kc, r_rail + tr.wheel_receptance(f_rail, v.unsprung_mass_kg)[:, None])
             filt = hertzian_line_filter(sub, a)[:, None, :]
-            kernels.append(filt * filt * _interp_log(freq, f_rail, h))
-        self.filtered_kernel = np.stack(kernels)          # (C, B, V, P)
+            kernels.append([filt * filt * _interp_log(freq, f_rail, h[:, x]) for x in range(h.shape[1])])
+        self.filtered_kernel = np.stack(kernels, axis=1)  # (X, C, B, V, P)
         self.table = np.empty(0)
         self.k_b = np.full(4, np.nan)
 
     def set_k_b(self, k_b: np.ndarray) -> None:
-        """Tabulate the growth for K_b per friction state (4,) [-/axle pass]."""
+        """Tabulate the growth for K_b per friction state (4,) [-/axle pass] in partial slip, and
+        the K_b in full sliding that follows from each."""
         self.k_b = np.asarray(k_b, float).copy()
-        self.table = np.stack([cg.filtered_log_growth(kb, self.filtered_kernel, 1.0) for kb in self.k_b], axis=1)
+        sliding = cg.sliding_wear_sensitivity(self.k_b, self.sliding_wear_ratio)
+        self.table = np.stack([np.stack([self._bay_mean(kb) for kb in pair], axis=1)
+                               for pair in zip(self.k_b, sliding, strict=True)], axis=1)
+
+    def _bay_mean(self, k_b: float) -> np.ndarray:
+        """ln|1 + K_b F^2 H| averaged over the bay positions (C, B, V, P)."""
+        out = cg.filtered_log_growth(k_b, self.filtered_kernel[0], 1.0)
+        for x in range(1, len(self.filtered_kernel)):
+            out += cg.filtered_log_growth(k_b, self.filtered_kernel[x], 1.0)
+        return out / len(self.filtered_kernel)
 
     def class_index(self, names: np.ndarray) -> np.ndarray:
         lookup = {n: i for i, n in enumerate(self.classes)}
         return np.array([lookup[n] for n in names], dtype=np.int64)
 
-    def at(self, class_idx: np.ndarray, friction: np.ndarray, speed: np.ndarray) -> np.ndarray:
-        """Per-axle-pass log growth (N, B, P) for passes of class index, friction state (1-4), speed [m/s]."""
+    def at(self, class_idx: np.ndarray, friction: np.ndarray, regime: np.ndarray, speed: np.ndarray) -> np.ndarray:
+        """Per-axle-pass log growth (N, B, P) for passes of class index, friction state (1-4), contact
+        regime (rail_monitor.core.contact.REGIME_*) and speed [m/s]."""
         x = np.clip(np.asarray(speed, float) / SPEED_STEP_MPS - 1.0, 0.0, len(self.speeds) - 1.0)
         j = np.minimum(x.astype(np.int64), len(self.speeds) - 2)
         w = (x - j)[:, None, None]
         fi = np.asarray(friction, np.int64) - 1
-        return (1.0 - w) * self.table[class_idx, fi, :, j, :] + w * self.table[class_idx, fi, :, j + 1, :]
+        ri = np.asarray(regime, np.int64)
+        return (1.0 - w) * self.table[class_idx, fi, ri, :, j, :] + w * self.table[class_idx, fi, ri, :, j + 1, :]

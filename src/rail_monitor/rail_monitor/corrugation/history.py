@@ -1,5 +1,6 @@
 """The passes a corrugation state keeps: their identity (so none is counted twice) and what the
-forecast and the advice need (class, friction state, speed, axles)."""
+forecast and the advice need (class, friction state, contact regime, speed, axles, and the wheel
+load and lateral creepage from which the regime follows in another friction state)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-COLUMNS = ("stamp_ns", "train_id", "class_idx", "friction", "speed", "axles")
+COLUMNS = ("stamp_ns", "train_id", "class_idx", "friction", "regime", "speed", "axles", "load", "creepage")
 
 
 @dataclass
@@ -19,8 +20,11 @@ class KeptPasses:
     train_id: np.ndarray = field(default_factory=lambda: np.zeros(0, object))
     class_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     friction: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    regime: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))    # core.contact.REGIME_*
     speed: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))   # [m/s]
     axles: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    load: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))    # wheel load [N]
+    creepage: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))  # lateral [-]
     seen: set[tuple[int, str]] = field(default_factory=set)
 
     def __post_init__(self) -> None:

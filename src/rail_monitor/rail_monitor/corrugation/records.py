@@ -111,21 +111,3 @@ class Evaluation:
     peak_wavelength_m: float
     grinding_interval_factor: float
     days_to_threshold: float
-
-
-@dataclass
-class Advice:
-    """Speed advice (units as in rail_msgs/SpeedAdvisory)."""
-
-    mean_speed_mps: float
-    min_speed_mps: float
-    max_speed_mps: float
-    speed_bin_centres_mps: np.ndarray
-    current_probability: np.ndarray
-    recommended_probability: np.ndarray
-    current_peak_growth: float
-    recommended_peak_growth: float
-    peak_growth_reduction: float
-    grinding_interval_factor: float
-    current_peak_wavelength_m: float
-

@@ -15,7 +15,7 @@ from rail_monitor.core.site import site_from_values
 from rail_monitor.corrugation import advice as adv
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.corrugation.records import Advice, Evaluation, Forecast
+from rail_monitor.corrugation.records import Evaluation, Forecast
 
 
 @dataclass
@@ -27,9 +27,11 @@ class CorrugationWhatIf:
     speeds: np.ndarray              # [m/s]
     weights: np.ndarray             # relative weights of the speeds [-]
     friction_state: int             # 0: the history's mix
+    vehicle_class: str | None       # the kernel's class without a history (None: the site's traffic mix)
+    axles_per_train: float          # of the forecast [-]
     evaluation: Evaluation
     forecast: Forecast
-    advice: Advice | None
+    advice: Any                     # rail_monitor.advice.plan.SpeedAdvice, or None
 
 
 def speed_distribution(mean_mps: float, cv: float) -> tuple[np.ndarray, np.ndarray]:
@@ -51,11 +53,14 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
     With a history, the state, speeds (axle-weighted) and traffic come from it; otherwise the
     post-grinding rail with the given speeds and weights, or a normal distribution of the
     class's mean and sd (overridden by speed_mean_mps [m/s] and speed_cv [-]), on dry rail
-    unless friction names a state. RailMonitorError for unusable inputs.
+    unless friction names a state; the kernel and axles per train are then vehicle_class's when
+    given, else the site's traffic mix and its traffic-weighted axles per train. RailMonitorError
+    for unusable inputs.
     """
     site = site_from_values(values)
     est = CorrugationEstimator(site, corrugation_config(values))
     state = FRICTION_BY_NAME[friction] if friction else 0
+    kernel_class = None
     if history is not None:
         ok = rejection_reasons(history, site) == ""
         est.advance(with_class_defaults(history.take(ok), site))
@@ -64,6 +69,7 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
             raise RailMonitorError(f"{history_name}: no valid pass for site {site.site_id}")
         v, w = est.kept.speed, est.kept.axles.astype(float)
     else:
+        kernel_class = vehicle_class
         cls = site.vehicle(vehicle_class or next(iter(site.vehicles)))
         if speeds is not None:
             v = np.asarray(speeds, float)
@@ -74,14 +80,33 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
             v, w = speed_distribution(speed_mean_mps or cls.speed_mean_mps,
                                       speed_cv if speed_cv is not None else cls.speed_sd_mps / cls.speed_mean_mps)
         state = state or FRICTION_BY_NAME["dry"]
-        where = f"site {site.site_id}, post-grinding rail, {friction or 'dry'}"
+        mix = f"class {vehicle_class}" if vehicle_class else "the site's traffic mix (" + ", ".join(
+            f"{n} {100 * c.traffic_share:.0f} %" for n, c in site.vehicles.items()) + ")"
+        where = f"site {site.site_id}, post-grinding rail, {friction or 'dry'}, kernel of {mix}"
+    if advise and history is None:
+        raise RailMonitorError("--advise needs --history: the advice is per vehicle class, from the passes' speeds, "
+                               "friction and angles of attack")
     try:
-        ev = adv.evaluate(est, v, w, state, passes_per_day or 0.0)
-        advice = adv.advise(est, None if history is not None and not friction else v, w, state) if advise else None
+        ev = adv.evaluate(est, v, w, state, passes_per_day or 0.0, kernel_class)
+        advice = _advise(values, est) if advise else None
     except ValueError as exc:
         raise RailMonitorError(str(exc)) from None
-    fc = est.forecast(adv.growth_at_speeds(est, v, state) @ (w / w.sum()), passes_per_day)
-    return CorrugationWhatIf(where, est, v, w, state, ev, fc, advice)
+    axles = adv.axles_per_train(est, kernel_class)
+    fc = est.forecast(adv.growth_at_speeds(est, v, state, kernel_class) @ (w / w.sum()), passes_per_day, axles)
+    axles = axles or (est.traffic()[1] if len(est.kept) else site.mean_axles_per_train)
+    return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice)
+
+
+def _advise(values: Mapping[str, Any], est: CorrugationEstimator) -> Any:
+    """The speed advice on the history (noise and squeal of the site weighed)."""
+    from rail_monitor.advice.consequences import Consequences
+    from rail_monitor.advice.plan import advise
+    from rail_monitor.noise.config import noise_config
+    from rail_monitor.noise.predict import RollingNoiseModel
+    from rail_monitor.squeal.config import squeal_config
+
+    return advise(est, Consequences(est.site, RollingNoiseModel(est.site, noise_config(values)),
+                                    squeal_config(values)))
 
 
 def summary(r: CorrugationWhatIf) -> dict[str, Any]:
@@ -91,9 +116,11 @@ def summary(r: CorrugationWhatIf) -> dict[str, Any]:
         "where": r.where, "peak_growth": ev.peak_growth, "peak_wavelength_m": ev.peak_wavelength_m,
         "worst_wavelength_m": float(est.bands[fc.worst_band]), "passes_to_threshold": fc.passes_to_threshold,
         "days_to_threshold": fc.days_to_threshold, "passes_per_day": fc.passes_per_day,
+        "kernel_vehicle_class": r.vehicle_class, "axles_per_train": r.axles_per_train,
         "k_b_by_friction": est.k_b.tolist()}
     if r.advice is not None:
         out["advice"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in vars(r.advice).items()}
+        out["advice"]["summary"] = r.advice.lines()
     out["bands"] = [{"wavelength_m": float(est.bands[i]), "growth_per_axle_pass": float(ev.growth_per_axle_pass[i]),
                      "amplitude_m": float(est.amplitude[i]), "threshold_m": float(est.threshold[i])}
                     for i in range(len(est.bands))]

@@ -25,8 +25,8 @@ Two additions to the UQ paper's kernel, both cited where they are defined:
   and tends to grow at the rate of its fastest component, so a resonance between band centres
   is not missed.
 
-Grinding limits (Grassie, Saxon & Smith, J. Sound Vib. 227 (1999) 949-964) and the speed-
-distribution optimiser (a linear programme) are here too.
+Grinding limits (Grassie, Saxon & Smith, J. Sound Vib. 227 (1999) 949-964) are here too; the
+speed plan (a linear programme) is :mod:`rail_monitor.models.speed_plan`.
 
 References
 ----------
@@ -41,7 +41,6 @@ References
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -121,6 +120,22 @@ def single_mode_growth_max(wear_sensitivity: ArrayLike, contact_ratio: ArrayLike
     kc = np.asarray(contact_ratio, float)
     z = np.asarray(damping_ratio, float) / np.sqrt(1.0 + kc)
     return np.asarray(wear_sensitivity) * (1.0 + kc / (4.0 * z * (1.0 + z) * (1.0 + kc)))
+
+
+SLIDING_WEAR_EXPONENT = 2.0 / 3.0  # beta = d ln w / d ln N in full sliding (docs/models.md, "Sliding")
+
+
+def sliding_wear_sensitivity(wear_sensitivity: ArrayLike, wear_ratio: ArrayLike = 1.0) -> FloatArray:
+    """K_b in full sliding [-] from K_b in partial slip: -(2/3) K_b w_slide / w_slip.
+
+    Wear proportional to frictional power gives K_b = -beta k_c w / N with beta = d ln w / d ln N
+    (w the mean wear per pass at the static load N, k_c the contact stiffness). In partial slip at
+    a prescribed tangential force more load means less slip, beta = -1 and K_b = k_c w / N > 0;
+    in full sliding the wear depth is mu p times the slip distance, p ~ N / (a b) and a, b ~ N^(1/3),
+    so w ~ N^(2/3), beta = +2/3 and K_b = -(2/3) k_c w / N. wear_ratio [-] is the mean wear per
+    pass in full sliding over that in partial slip at the same friction state (1: equal).
+    """
+    return -SLIDING_WEAR_EXPONENT * np.asarray(wear_ratio, float) * np.asarray(wear_sensitivity, float)
 
 
 def filtered_log_growth(wear_sensitivity: ArrayLike, kernel: ArrayLike, contact_filter: ArrayLike) -> FloatArray:
@@ -212,47 +227,3 @@ def band_limits(centres: ArrayLike, ranges=GRASSIE_1999_LIMITS) -> FloatArray:
         n = int(inside(wavelength_bands(lo, hi), lo, hi).sum())
         out[inside(c, lo, hi)] = limit / np.sqrt(n)
     return out
-
-
-@dataclass(frozen=True)
-class SpeedAdvice:
-    """A pass-speed distribution that minimises the peak of g over the bands."""
-
-    speeds: FloatArray          # bin centres [m/s]
-    probability: FloatArray     # recommended share per bin [-] (sums to 1)
-    peak_growth: float          # max over rows of sum_i p_i G[row, i] [1/pass]
-    growth: FloatArray          # per row [1/pass]
-
-
-def optimise_speed_distribution(growth: ArrayLike, speeds: ArrayLike, mean_speed: float,
-                                max_share: float = 1.0) -> SpeedAdvice:
-    """Minimise max_b sum_i p_i G[b, i] over p with sum p = 1, sum p v = mean_speed, 0 <= p <= max_share.
-
-    growth G: per-pass log growth of each wavelength (rows) at each speed bin (columns) [1/pass],
-    e.g. from :func:`filtered_log_growth`; speeds [m/s], the bins allowed (within the speed limits). Because g is
-    linear in p (UQ paper eq. 2), the minimax is the linear programme min t s.t. G p <= t, solved
-    exactly (HiGHS, scipy.optimize.linprog). max_share caps any one bin so the advice is a spread,
-    not a single speed. Raises ValueError when no distribution meets the constraints.
-    """
-    g = np.asarray(growth, float)
-    v = np.asarray(speeds, float)
-    nb, ns = g.shape
-    if ns != len(v):
-        raise ValueError("growth must have one column per speed bin")
-    if not v.min() <= mean_speed <= v.max() or max_share * ns < 1.0:
-        raise ValueError(f"no distribution over {v.min():g}-{v.max():g} m/s with mean {mean_speed:g} m/s "
-                         f"and at most {max_share:g} per bin")
-    scale = float(np.max(np.abs(g))) or 1.0  # G is of order 1e-5: scale it for the solver's tolerances
-    cost = np.r_[np.zeros(ns), 1.0]
-    a_ub = np.c_[g / scale, -np.ones(nb)]
-    a_eq = np.vstack([np.r_[np.ones(ns), 0.0], np.r_[v / mean_speed, 0.0]])
-    from scipy.optimize import linprog  # lazy: scipy.optimize costs 0.3 s to import
-
-    res = linprog(cost, A_ub=a_ub, b_ub=np.zeros(nb), A_eq=a_eq, b_eq=[1.0, 1.0],
-                  bounds=[(0.0, max_share)] * ns + [(None, None)], method="highs")
-    if res.status != 0:
-        raise ValueError(f"speed optimisation failed: {res.message}")
-    p = np.clip(res.x[:ns], 0.0, None)
-    p /= p.sum()
-    per_band = g @ p
-    return SpeedAdvice(v, p, float(per_band.max()), per_band)

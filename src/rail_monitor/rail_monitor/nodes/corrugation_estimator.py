@@ -18,6 +18,8 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
+from rail_monitor.advice import plan
+from rail_monitor.advice.consequences import Consequences
 from rail_monitor.bagio.messages import corrugation_state_fields, speed_advisory_fields, time_ns
 from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
 from rail_monitor.core.params import values_of
@@ -31,19 +33,27 @@ from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS
+from rail_monitor.noise.config import NOISE_SPECS, noise_config
+from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
 from rail_msgs.msg import CorrugationState, RoughnessSurvey, SpeedAdvisory, TrainPass
 from rail_msgs.srv import EvaluateSpeedDistribution
 
 
 class CorrugationEstimatorNode(PassConsumerNode):
     EXECUTABLE = "corrugation_estimator"
-    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("", ESTIMATOR_SPECS), ("corrugation.", CORRUGATION_SPECS))
+    # noise.* and squeal.*: what the speed advice weighs besides corrugation (rail_monitor.advice).
+    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("", ESTIMATOR_SPECS), ("corrugation.", CORRUGATION_SPECS),
+                  ("noise.", NOISE_SPECS), ("squeal.", SQUEAL_SPECS))
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("corrugation_estimator", **kwargs)
         self.params = values_of(EstimatorParams, declare(self, ESTIMATOR_SPECS))
         cfg = corrugation_config(declare(self, CORRUGATION_SPECS, prefix="corrugation."), prefix="")
         self.est = CorrugationEstimator(self.site, cfg)
+        self._noise_cfg = noise_config(declare(self, NOISE_SPECS, prefix="noise."), prefix="")
+        self._squeal_cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
+        self._consequences: Consequences | None = None
         self.checkpoint = self.params.checkpoint_path
         self.counts: Counter[str] = Counter()
         self.sent = Sent()
@@ -95,11 +105,19 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.sent.publish(self.state_pub, to_msg(CorrugationState, corrugation_state_fields(
             self.est, self.est.forecast(), self.site.site_id)))
 
+    def consequences(self) -> Consequences:
+        """The noise model and squeal parameters the advice weighs (built at the first use: the
+        noise model's tables are not needed until then)."""
+        if self._consequences is None:
+            self._consequences = Consequences(self.site, RollingNoiseModel(self.site, self._noise_cfg),
+                                              self._squeal_cfg)
+        return self._consequences
+
     def publish_advisory(self) -> None:
         if not len(self.est.kept):
             return
         try:
-            advised = advice.advise(self.est)
+            advised = plan.advise(self.est, self.consequences())
         except ValueError as exc:
             self.get_logger().warning(f"no speed advice: {exc}", throttle_duration_sec=60.0)
             return
@@ -134,9 +152,12 @@ class CorrugationEstimatorNode(PassConsumerNode):
                      res: EvaluateSpeedDistribution.Response) -> EvaluateSpeedDistribution.Response:
         try:
             ev = advice.evaluate(self.est, req.speed_mps, req.probability, req.friction_state, req.passes_per_day)
+            side = plan.evaluate_consequences(self.est, self.consequences(), req.speed_mps, req.probability)
         except ValueError as exc:
             res.success, res.message = False, str(exc)
             return res
+        res.noise_model, res.noise_change_dba = side.noise_model, side.noise_change_dba.tolist()
+        res.squeal_share_current, res.squeal_share = side.squeal_share_current, side.squeal_share
         res.success = True
         res.wavelength_m = self.est.bands.tolist()
         res.growth_per_axle_pass = ev.growth_per_axle_pass.tolist()

@@ -2,8 +2,8 @@
 
 Subscribes ``train_pass``; publishes ``noise/squeal`` (rail_msgs/SquealPrediction). Parameters:
 the site and its rolling-stock table, and ``squeal.*`` (:data:`rail_monitor.squeal.config.
-SQUEAL_SPECS`: wheel mode, k3 convention, creep curves per friction state, receiver, risk
-thresholds).
+SQUEAL_SPECS`: wheel mode, receiver, friction-modifier reach, risk thresholds); the creep curves
+and k3 are the site's contact (``contact.*``).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ class SquealRiskNode(PassConsumerNode):
         self.listen()
 
     def key_parameters(self) -> dict[str, Any]:
-        return {"k3": self.cfg.k3_convention}
+        return {"k3": self.site.contact.k3_convention}
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         values = predict(self.cfg, self.site, table)

@@ -13,9 +13,12 @@ octave). The level increase due to roughness growth since grinding is LpAeq,Tp w
 state minus LpAeq,Tp with the state's post-grinding amplitudes. The wheel roughness is
 CNOSSOS-EU's for the class's brake type.
 
-Per pass: the class's wheel (diameter, nominal load: Hertz contact of ``site.contact``),
-axles and length from the pass (class defaults filled), speed from the pass. Sound power per
-metre of train: L_W' = L_R,TOT + L_H + 10 lg(axles / length) per band.
+Per pass: the class's wheel (diameter; the transfers use the Hertz contact stiffness at its
+nominal load, tabulated per class; the mechanics model's contact filter takes the pass's own
+patch from its contact state, rail_monitor.core.contact; CNOSSOS's is the Directive's table for
+the class's nominal load and diameter), axles and length from the pass (class defaults filled),
+speed from the pass. Sound power per metre of train: L_W' = L_R,TOT + L_H + 10 lg(axles / length)
+per band.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from rail_monitor.core.contact import contact_state
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
@@ -101,7 +105,6 @@ class _ClassTerms:
 
     wheel_db: np.ndarray                 # on the CNOSSOS wavelength grid [dB re 1 um]
     a3_db: np.ndarray                    # CNOSSOS contact filter on the grid [dB]
-    semi_length_m: float                 # Hertz semi-axis along the rail [m]
     cnossos: dict[str, np.ndarray]       # L_H per component [dB per axle], 24 bands
     mechanics: dict[str, np.ndarray]     # L_H,mech per component [dB per axle]
 
@@ -133,7 +136,7 @@ class RollingNoiseModel:
                 cnossos["bridge"] = self.bridge_db
             mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
                                      v.wheel_diameter_m, cfg.radiators, cfg.band_points)
-            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type), a3, float(contact.a), cnossos, mech)
+            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type), a3, cnossos, mech)
 
     @property
     def models(self) -> tuple[str, ...]:
@@ -173,6 +176,8 @@ class RollingNoiseModel:
         if model not in MODELS:
             raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
         filters: dict[str, np.ndarray] = {}  # the contact filter per class: the same on both rails
+        if model == "mechanics":  # its contact filter takes each pass's patch (the pass's wheel load)
+            filters["semi_length_m"] = contact_state(self.site, passes).patch.a
         roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filters)
         pb = self._pass_by(components, passes)
         names = list(components)
@@ -204,7 +209,8 @@ class RollingNoiseModel:
         for name in set(passes.vehicle_class.tolist()):
             rows = passes.vehicle_class == name
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
-            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model, filters, name)
+            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model, filters, name,
+                                            rows)
             roughness[rows] = lr
             for comp, lh in transfers.items():
                 components[comp][rows] = lr + lh + per_metre[rows]
@@ -215,7 +221,8 @@ class RollingNoiseModel:
                        self.vertical_db, time_weighted)
 
     def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray, model: str,
-                   filters: dict[str, np.ndarray], name: str) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+                   filters: dict[str, np.ndarray], name: str,
+                   rows: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
         rule = self.cfg.interpolation
         if model == "cnossos":
@@ -223,7 +230,8 @@ class RollingNoiseModel:
             return cn.at_band_frequencies(lr, speed, self.band_hz, rule), terms.cnossos
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         if name not in filters:
-            filters[name] = level(wrn.contact_filter_power(speed, self.band, terms.semi_length_m, self.cfg.band_points))
+            filters[name] = level(wrn.contact_filter_power(speed, self.band, filters["semi_length_m"][rows],
+                                                           self.cfg.band_points))
         lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + filters[name]
         return lr, terms.mechanics
 

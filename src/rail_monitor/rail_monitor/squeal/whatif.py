@@ -10,12 +10,13 @@ from typing import Any
 
 import numpy as np
 
+from rail_monitor.core.contact import creep_stiffness
 from rail_monitor.core.errors import RailMonitorError
-from rail_monitor.core.passes import FRICTION_BY_NAME
+from rail_monitor.core.passes import FRICTION_BY_NAME, PassTable
 from rail_monitor.core.site import Site, site_from_values
-from rail_monitor.models import hertz, squeal
+from rail_monitor.models import hertz, squeal, squeal_ode
 from rail_monitor.squeal.config import SquealConfig, squeal_config
-from rail_monitor.squeal.predict import creep_stiffness, kalker_lateral_force, level_and_risk
+from rail_monitor.squeal.predict import WheelMode, level_and_risk, wheel_mode
 
 
 @dataclass(frozen=True)
@@ -30,6 +31,8 @@ class SquealCase:
     k1: float
     k2: float
     k3_n: float
+    radiating_area_m2: float = 0.9      # of the wheel, both sides
+    radiation_efficiency: float = 1.0
 
 
 # The paper's Figure 5 (two-disc rig): radii of the lower wheel (rolling, transverse) and the upper
@@ -40,7 +43,7 @@ RIG = {"young_modulus_pa": 175e9, "poisson_ratio": 0.28, "load_n": 1000.0, "mass
        "stiffness_npm": 1.6e8, "speed_mps": 17.8, "k1": 0.27, "k2": -0.02}
 
 
-def rig_case(convention: str = "kalker_unit") -> SquealCase:
+def rig_case(convention: str = "reduced_kalker") -> SquealCase:
     """The paper's rig (Figure 5) with k3 from its Hertz contact and Kalker's C22 (convention)."""
     e, nu = RIG["young_modulus_pa"], RIG["poisson_ratio"]
     contact = hertz.contact_ellipse(*RIG_RADII_M, hertz.contact_modulus(e, nu), RIG["load_n"])
@@ -54,11 +57,12 @@ def site_case(cfg: SquealConfig, site: Site, vehicle_class: str, friction_state:
     """The site's wheel mode, contact and creep curve for one vehicle class and friction state."""
     vehicle = site.vehicle(vehicle_class)
     load = load_n or vehicle.wheel_load_n
-    k1, k2 = (float(x[0]) for x in cfg.creep(np.array([friction_state])))
-    kalker_force = kalker_lateral_force(cfg, site, np.array([vehicle.wheel_diameter_m / 2.0]), np.array([load]))
-    k3 = float(creep_stiffness(cfg, kalker_force, np.array([k1]))[0])
-    return SquealCase(speed_mps, load, cfg.modal_mass_kg, cfg.modal_damping_nspm, cfg.modal_stiffness_npm,
-                      k1, k2, k3)
+    k1, k2 = site.contact.creep(np.array([friction_state]))
+    k3 = float(creep_stiffness(site, site.contact_patch(vehicle.wheel_diameter_m / 2.0, load), k1)[0])
+    k1, k2 = float(k1[0]), float(k2[0])
+    mode = wheel_mode(site, np.array([vehicle_class], object))
+    return SquealCase(speed_mps, load, float(mode.mass_kg[0]), float(mode.damping_nspm[0]),
+                      float(mode.stiffness_npm[0]), k1, k2, k3, float(mode.area_m2[0]), float(mode.efficiency[0]))
 
 
 def sweep(case: SquealCase, crabbing_mps: np.ndarray, reference_mps: float | None = None,
@@ -84,11 +88,13 @@ def sweep(case: SquealCase, crabbing_mps: np.ndarray, reference_mps: float | Non
     }
     if cfg is not None:
         freq = np.broadcast_to(squeal.squeal_frequency(case.mass_kg, case.stiffness_npm), vc.shape)
-        lev, out["risk"] = level_and_risk(cfg, lc.amplitude, lc.unstable, freq)
+        mode = WheelMode(freq, np.full(vc.shape, case.mass_kg), np.full(vc.shape, case.damping_nspm),
+                         np.full(vc.shape, case.radiating_area_m2), np.full(vc.shape, case.radiation_efficiency))
+        lev, out["risk"] = level_and_risk(cfg, mode, lc.amplitude, lc.unstable)
         out["level_db"], out["level_dba"], out["frequency_hz"] = lev.level_db, lev.level_dba, freq
     if ode:
         out["ode_amplitude_mps"] = np.array([
-            squeal.simulate_limit_cycle(case.speed_mps, float(v), case.load_n, case.mass_kg, case.damping_nspm,
+            squeal_ode.simulate_limit_cycle(case.speed_mps, float(v), case.load_n, case.mass_kg, case.damping_nspm,
                                         case.stiffness_npm, case.k1, case.k2, case.k3_n).amplitude for v in vc])
     return out
 
@@ -103,11 +109,11 @@ def squeal_case(values: Mapping[str, Any] | None, vehicle_class: str | None = No
     if values is None:
         if load_n:
             raise RailMonitorError("--load does not apply to --rig: the rig's k3 is for its 1000 N (Figure 5)")
-        case, where = rig_case(k3_convention or "kalker_unit"), "the paper's rig (Figure 5)"
+        case, where = rig_case(k3_convention or "reduced_kalker"), "the paper's rig (Figure 5)"
     else:
         values = dict(values)
         if k3_convention:
-            values["squeal.k3_convention"] = k3_convention
+            values["contact.k3_convention"] = k3_convention
         site = site_from_values(values)
         cls = vehicle_class or next(iter(site.vehicles))
         case = site_case(squeal_config(values), site, cls, FRICTION_BY_NAME[friction],
@@ -128,3 +134,35 @@ def crabbing_velocities(case: SquealCase, sweep_range: tuple[float, float, float
     if crabbing_mps is not None:
         return np.array([crabbing_mps])
     return np.array([case.speed_mps * np.sin(1e-3 * (aoa_mrad if aoa_mrad is not None else 10.0))])
+
+
+def friction_states(values: Mapping[str, Any], passes: PassTable) -> list[dict[str, Any]]:
+    """Per friction state of the valid passes of a history: its creep curve, how many passes, the
+    share unstable, the median onset angle of attack [mrad] (arcsin of the saturation creepage),
+    the mean level of the unstable ones [dB(A)], and the friction modifier's cut of the squealing
+    passes' energy-mean level with the background [dB(A)] (NaN where none squeals)."""
+    from rail_monitor.core.contact import contact_state
+    from rail_monitor.core.passes import FRICTION_NAMES, rejection_reasons, with_class_defaults
+    from rail_monitor.squeal.predict import predict
+
+    site, cfg = site_from_values(values), squeal_config(values)
+    table = with_class_defaults(passes.take(rejection_reasons(passes, site) == ""), site)
+    out, cs = predict(cfg, site, table), contact_state(site, table)
+    bg = 10.0 ** (cfg.background_level_dba / 10.0)
+    rows = []
+    for code, name in FRICTION_NAMES.items():
+        sel = table.friction_state == code
+        if not sel.any():
+            continue
+        sq = sel & out["unstable"]
+        with np.errstate(divide="ignore"):
+            before = 10.0 ** (out["level_dba"][sq] / 10.0) + bg
+        after = before / 10.0 ** (out["friction_modifier_benefit_db"][sq] / 10.0)
+        k1, k2 = (float(x[0]) for x in site.contact.creep(np.array([code])))
+        rows.append({"friction_state": name, "k1": k1, "k2": k2, "passes": int(sel.sum()),
+                     "unstable_share": float(out["unstable"][sel].mean()),
+                     "onset_mrad": float(1e3 * np.median(np.arcsin(np.clip(cs.saturation_creepage[sel], 0, 1)))),
+                     "mean_level_dba": float(np.mean(out["level_dba"][sq])) if sq.any() else float("nan"),
+                     "friction_modifier_cut_dba": float(10.0 * np.log10(before.mean() / after.mean()))
+                     if sq.any() and code != FRICTION_BY_NAME["friction_modifier"] else float("nan")})
+    return rows

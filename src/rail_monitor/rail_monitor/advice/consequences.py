@@ -1,0 +1,63 @@
+"""What a speed plan does besides corrugation: the rolling noise of each class's trains and the
+share of its passes at a squeal risk, tabulated on a speed grid.
+
+Noise: a train of the class (its mean number of vehicles, dry rail, the site's noise models) at
+each speed on the current rail roughness, LpAFmax at the site's receiver (the metric of the
+noise limit, ISO 3095's maximum level). Squeal: the class's kept passes (their angle of attack,
+wheel load and friction state) run at each speed through the squeal model; the share at risk
+medium or above. Both are linear in a distribution of speeds, which is what the plan needs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rail_monitor.core.passes import PassTable, with_class_defaults
+from rail_monitor.core.site import Site
+from rail_monitor.corrugation.history import KeptPasses
+from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.noise.whatif import synthetic_passes
+from rail_monitor.squeal.config import RISK_MEDIUM, SquealConfig
+from rail_monitor.squeal.predict import predict as predict_squeal
+
+NOISE_METRIC = "lpafmax_dba"
+
+
+@dataclass
+class Consequences:
+    """The site's noise model and squeal parameters, evaluated per class on a speed grid."""
+
+    site: Site
+    noise: RollingNoiseModel
+    squeal: SquealConfig
+
+    def noise_dba(self, classes: list[str], speeds: np.ndarray, corrugation: Corrugation | None) -> np.ndarray:
+        """LpAFmax [dB(A)] (models, C, G) of a train of each class at each speed [m/s]."""
+        out = np.empty((len(self.noise.models), len(classes), len(speeds)))
+        for j, name in enumerate(classes):
+            cls = self.site.vehicle(name)
+            table = synthetic_passes(self.site, cls, np.asarray(speeds, float),
+                                     round((cls.vehicles_min + cls.vehicles_max) / 2))
+            for i, model in enumerate(self.noise.models):
+                out[i, j] = getattr(self.noise.predict(table, model, corrugation), NOISE_METRIC)
+        return out
+
+    def squeal_share(self, kept: KeptPasses, name: str, class_idx: int, speeds: np.ndarray | None) -> np.ndarray:
+        """Share of a class's kept passes at squeal risk medium or above (G,) if run at each speed
+        [m/s]; with speeds None, (1,) at their own speeds. 0 for a class without kept passes."""
+        rows = np.flatnonzero(kept.class_idx == class_idx)
+        g = 1 if speeds is None else len(speeds)
+        if not len(rows):
+            return np.zeros(g)
+        n = len(rows)
+        v = kept.speed[rows] if speeds is None else np.repeat(np.asarray(speeds, float), n)
+        table = with_class_defaults(PassTable(
+            stamp_ns=np.arange(n * g, dtype=np.int64) + 1, train_id=[""] * (n * g), vehicle_class=[name] * (n * g),
+            vehicle_count=[1] * (n * g), axle_count=[0] * (n * g), speed_mps=v,
+            angle_of_attack_rad=np.tile(np.arcsin(np.clip(kept.creepage[rows], 0.0, 1.0)), g),
+            wheel_load_n=np.tile(kept.load[rows], g), friction_state=np.tile(kept.friction[rows], g),
+            train_length_m=[0.0] * (n * g)), self.site)
+        risk = predict_squeal(self.squeal, self.site, table)["risk"]
+        return (risk >= RISK_MEDIUM).reshape(g, n).mean(axis=1)

@@ -1,0 +1,247 @@
+"""Speed advice per vehicle class: shares of each class's trains in speed bands an operator can
+publish ("emu 60-70 km/h: 40 %"), at each class's recent mean speed, that cut the peak corrugation
+growth without raising the pass-weighted mean rolling noise by more than a limit or the share of
+passes at a squeal risk (:func:`rail_monitor.models.speed_plan.optimise_speed_plan`).
+
+Bands are ``advice_band_kmh`` wide on a grid from 0, clipped to each class's speed range (its
+speed_min/speed_max, within the advice's limits); a band's growth, noise and squeal are averaged
+over speeds across it, since trains told "60-70 km/h" run anywhere in it. The traffic is the
+kept passes: each class's friction states and contact regimes (axle-weighted) for the growth,
+its passes' angles of attack, loads and friction for squeal. Shares are of each class's passes
+(trains); the growth weighs the classes by their axle passes. Current and advised distributions
+are evaluated by the same band model, so the cut and the interval factor compare like with like.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.advice.consequences import Consequences
+from rail_monitor.core.passes import KMH_PER_MPS
+from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.models.speed_plan import optimise_speed_plan, plan_growth
+from rail_monitor.noise.predict import Corrugation
+
+POINTS_PER_BAND = 5  # speeds across a band over which its growth, noise and squeal are averaged
+
+
+@dataclass(frozen=True)
+class SpeedAdvice:
+    """Speed advice (units and meaning as in rail_msgs/SpeedAdvisory, whose fields these are)."""
+
+    mean_speed_mps: float
+    min_speed_mps: float
+    max_speed_mps: float
+    speed_bin_centres_mps: np.ndarray
+    current_probability: np.ndarray
+    recommended_probability: np.ndarray
+    current_peak_growth: float
+    recommended_peak_growth: float
+    peak_growth_reduction: float
+    grinding_interval_factor: float
+    current_peak_wavelength_m: float
+    vehicle_class: list[str]
+    class_mean_speed_mps: np.ndarray
+    class_pass_share: np.ndarray
+    class_squeal_share_current: np.ndarray
+    class_squeal_share_recommended: np.ndarray
+    noise_model: list[str]
+    class_noise_current_dba: np.ndarray      # (classes x models), row-major
+    class_noise_recommended_dba: np.ndarray
+    noise_current_dba: np.ndarray            # per model
+    noise_recommended_dba: np.ndarray
+    noise_rise_limit_dba: float
+    squeal_share_current: float
+    squeal_share_recommended: float
+    band_vehicle_class: list[str]
+    band_low_mps: np.ndarray
+    band_high_mps: np.ndarray
+    band_current_share: np.ndarray
+    band_recommended_share: np.ndarray
+
+    def noise_change(self, c: int | None = None) -> np.ndarray:
+        """Change of the mean LpAFmax per noise model [dB(A)]: of class index c, or of every class."""
+        if c is None:
+            return self.noise_recommended_dba - self.noise_current_dba
+        m = len(self.noise_model)
+        return self.class_noise_recommended_dba[c * m:(c + 1) * m] - self.class_noise_current_dba[c * m:(c + 1) * m]
+
+    def lines(self) -> list[str]:
+        """The plan for people: one line per class, then the consequences."""
+        def noise(change: np.ndarray) -> str:
+            return ", ".join(f"{m} {d:+.2f}" for m, d in zip(self.noise_model, change, strict=True))
+
+        out = []
+        for c, name in enumerate(self.vehicle_class):
+            rows = [i for i, n in enumerate(self.band_vehicle_class)
+                    if n == name and self.band_recommended_share[i] > 5e-3]
+            bands = ", ".join(f"{KMH_PER_MPS * self.band_low_mps[i]:.0f}-{KMH_PER_MPS * self.band_high_mps[i]:.0f} "
+                              f"km/h {100 * self.band_recommended_share[i]:.0f} %" for i in rows)
+            out.append(f"{name} (mean {KMH_PER_MPS * self.class_mean_speed_mps[c]:.0f} km/h): {bands}; noise "
+                       f"{noise(self.noise_change(c))} dB(A); squealing {100 * self.class_squeal_share_current[c]:.1f}"
+                       f" -> {100 * self.class_squeal_share_recommended[c]:.1f} %")
+        out.append(f"peak growth -{100 * self.peak_growth_reduction:.0f} %, grinding interval "
+                   f"x{self.grinding_interval_factor:.2f}; mean noise {noise(self.noise_change())} dB(A) (limit "
+                   f"+{self.noise_rise_limit_dba:g}); squealing passes {100 * self.squeal_share_current:.1f} -> "
+                   f"{100 * self.squeal_share_recommended:.1f} %")
+        return out
+
+
+def advice_of_message(msg: Any) -> SpeedAdvice:
+    """A SpeedAdvice from a decoded rail_msgs/SpeedAdvisory (its fields are the record's)."""
+    values = {}
+    for f in fields(SpeedAdvice):
+        v = getattr(msg, f.name)
+        values[f.name] = [str(x) for x in v] if f.type == "list[str]" else \
+            np.asarray(v, float) if f.type == "np.ndarray" else float(v)
+    return SpeedAdvice(**values)
+
+
+def _bands(est: CorrugationEstimator, classes: list[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Common band edges (S + 1,) [m/s] and each class's band limits (C, S) low, high [m/s]: the
+    grid clipped to the class's speed range, a clipped end under half a band wide joined to its
+    neighbour (nobody publishes "60-60.1 km/h"); low == high for a band the class does not use."""
+    cfg = est.cfg
+    width = cfg.advice_band_kmh / KMH_PER_MPS
+    lo = np.array([max(est.site.vehicle(c).speed_min_mps, cfg.advice_min_speed_mps) for c in classes])
+    hi = np.array([min(est.site.vehicle(c).speed_max_mps, cfg.advice_max_speed_mps or np.inf) for c in classes])
+    if np.any(hi <= lo):
+        raise ValueError("a class's speed range lies outside the advice's speed limits")
+    edges = np.arange(np.floor(lo.min() / width), np.ceil(hi.max() / width) + 1) * width
+    low = np.clip(edges[None, :-1], lo[:, None], hi[:, None])
+    high = np.clip(edges[None, 1:], lo[:, None], hi[:, None])
+    for c in range(len(classes)):
+        used = np.flatnonzero(high[c] > low[c])
+        if len(used) > 1 and high[c, used[-1]] - low[c, used[-1]] < 0.5 * width:
+            high[c, used[-2]], low[c, used[-1]] = high[c, used[-1]], high[c, used[-1]]
+        if len(used) > 1 and high[c, used[0]] - low[c, used[0]] < 0.5 * width:
+            low[c, used[1]], high[c, used[0]] = low[c, used[0]], low[c, used[0]]
+    return edges, low, high
+
+
+def _points(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """Speeds across each band (C, S, POINTS_PER_BAND) [m/s]: midpoints of equal slices."""
+    u = (np.arange(POINTS_PER_BAND) + 0.5) / POINTS_PER_BAND
+    return low[..., None] + (high - low)[..., None] * u
+
+
+def advise(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice:
+    """The plan for the kept passes (ValueError when there are none, or no plan fits the limits)."""
+    k = est.kept
+    if not len(k):
+        raise ValueError("no recent passes to advise on")
+    cfg = est.cfg
+    present = np.unique(k.class_idx)
+    classes = [est.tables.classes[i] for i in present]
+    edges, low, high = _bands(est, classes)
+    allowed = high > low + 1e-9
+    pts = _points(low, high)
+    nc, ns = low.shape
+    growth, noise, squeal_share = [], [], []
+    state = Corrugation(est.bands, est.amplitude, est.grinding_amplitude)
+    passes = np.zeros(nc)
+    axles = np.zeros(nc)
+    current = np.zeros((nc, ns))
+    for c, ci in enumerate(present):
+        rows = k.class_idx == ci
+        passes[c], axles[c] = rows.sum(), k.axles[rows].sum()
+        keys, inverse = np.unique(np.stack([k.friction[rows], k.regime[rows]]), axis=1, return_inverse=True)
+        weight = np.bincount(inverse.ravel(), weights=k.axles[rows]) / axles[c]
+        speeds = pts[c].ravel()
+        per = est.tables.at(np.full(len(speeds) * keys.shape[1], ci), np.repeat(keys[0], len(speeds)),
+                            np.repeat(keys[1], len(speeds)), np.tile(speeds, keys.shape[1]))
+        mixed = np.einsum("k,kvbp->vbp", weight, per.reshape(keys.shape[1], len(speeds), *per.shape[1:]))
+        growth.append(mixed.reshape(ns, POINTS_PER_BAND, -1).mean(axis=1).T)          # (R, S)
+        noise.append(consequences.noise_dba([classes[c]], speeds, state)[:, 0].reshape(-1, ns, POINTS_PER_BAND)
+                     .mean(axis=2))                                                    # (M, S)
+        squeal_share.append(consequences.squeal_share(k, classes[c], ci, speeds)
+                            .reshape(ns, POINTS_PER_BAND).mean(axis=1))                 # (S,)
+        used = np.flatnonzero(allowed[c])
+        v = np.clip(k.speed[rows], low[c, used[0]], high[c, used[-1]])
+        band = used[np.clip(np.searchsorted(low[c, used], v, side="right") - 1, 0, len(used) - 1)]
+        current[c] = np.bincount(band, minlength=ns) / passes[c]
+    g = np.stack(growth)                       # (C, R, S)
+    lp = np.stack(noise, axis=1)               # (M, C, S)
+    sq = np.stack(squeal_share)                # (C, S)
+    centres = 0.5 * (low + high)
+    mean = (current * centres).sum(axis=1)
+    pass_w, axle_w = passes / passes.sum(), axles / axles.sum()
+    cap = np.maximum.reduce([np.full(nc, cfg.advice_max_share), 1.0 / allowed.sum(axis=1), current.max(axis=1)])
+    limits = [(pass_w[:, None] * lp[m], float((pass_w[:, None] * lp[m] * current).sum()) + cfg.advice_noise_rise_dba)
+              for m in range(len(lp))]
+    limits.append((pass_w[:, None] * sq, float((pass_w[:, None] * sq * current).sum()) + 1e-12))
+    plan = optimise_speed_plan(g, axle_w, centres, allowed, mean, cap, limits)
+    now = plan_growth(g, axle_w, current)
+    cur_peak, rec_peak = float(now.max()), min(plan.peak_growth, float(now.max()))
+    rec = plan.share
+    per_band = g.shape[1] // len(est.bands)
+    show = allowed & ((current > 1e-6) | (rec > 1e-6))
+    ci_rows = np.nonzero(show)[0]
+    return SpeedAdvice(
+        float(pass_w @ mean), float(low.min()), float(high.max()), 0.5 * (edges[:-1] + edges[1:]),
+        pass_w @ current, pass_w @ rec, cur_peak, rec_peak,
+        1.0 - rec_peak / cur_peak if cur_peak > 0 else 0.0, cur_peak / rec_peak if rec_peak > 0 else float("inf"),
+        float(est.bands[int(np.argmax(now)) // per_band]),
+        classes, mean, pass_w, (sq * current).sum(axis=1), (sq * rec).sum(axis=1),
+        list(consequences.noise.models), (lp * current).sum(axis=2).T.ravel(), (lp * rec).sum(axis=2).T.ravel(),
+        (lp * current).sum(axis=2) @ pass_w, (lp * rec).sum(axis=2) @ pass_w, cfg.advice_noise_rise_dba,
+        float(pass_w @ (sq * current).sum(axis=1)), float(pass_w @ (sq * rec).sum(axis=1)),
+        [classes[c] for c in ci_rows], low[show], high[show], current[show], rec[show])
+
+
+def advise_or_none(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice | None:
+    """The advice on the kept passes, or None when there is nothing to advise on or no plan fits."""
+    if not len(est.kept):
+        return None
+    try:
+        return advise(est, consequences)
+    except ValueError:
+        return None
+
+
+@dataclass(frozen=True)
+class SideEffects:
+    """What a site-wide speed distribution does to noise and squeal against the recent passes
+    (units as in rail_srvs EvaluateSpeedDistribution's response)."""
+
+    noise_model: list[str]
+    noise_change_dba: np.ndarray      # per model [dB(A)]
+    squeal_share_current: float
+    squeal_share: float
+
+
+GRID_STEP_MPS = 0.5  # speed grid of the side effects, interpolated linearly
+
+
+def evaluate_consequences(est: CorrugationEstimator, consequences: Consequences, speeds: np.ndarray,
+                          probability: np.ndarray) -> SideEffects:
+    """Noise and squeal of every class at the distribution (speeds [m/s], weights) against the
+    kept passes at their own speeds, both on one speed grid per class (ValueError without kept
+    passes)."""
+    k = est.kept
+    if not len(k):
+        raise ValueError("no recent passes to compare with")
+    v = np.asarray(speeds, float)
+    p = np.asarray(probability, float) / np.sum(probability)
+    state = Corrugation(est.bands, est.amplitude, est.grinding_amplitude)
+    models = list(consequences.noise.models)
+    noise_now, noise_new = np.zeros(len(models)), np.zeros(len(models))
+    sq_now = sq_new = 0.0
+    for ci in np.unique(k.class_idx):
+        rows = k.class_idx == ci
+        share = rows.mean()
+        name = est.tables.classes[ci]
+        lo, hi = min(v.min(), k.speed[rows].min()), max(v.max(), k.speed[rows].max())
+        grid = np.arange(lo, hi + GRID_STEP_MPS, GRID_STEP_MPS)
+        lp = consequences.noise_dba([name], grid, state)[:, 0]               # (M, G)
+        sq = consequences.squeal_share(k, name, ci, grid)                    # (G,)
+        for m in range(len(models)):
+            noise_now[m] += share * np.interp(k.speed[rows], grid, lp[m]).mean()
+            noise_new[m] += share * p @ np.interp(v, grid, lp[m])
+        sq_now += share * float(consequences.squeal_share(k, name, ci, None)[0])
+        sq_new += share * p @ np.interp(v, grid, sq)
+    return SideEffects(models, noise_new - noise_now, float(sq_now), float(sq_new))
+
