@@ -226,8 +226,8 @@ class RollingNoiseModel:
         """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
         rule = self.cfg.interpolation
         if model == "cnossos":
-            lr = cn.total_roughness(rail_db, terms.wheel_db, terms.a3_db, self.impact_db)
-            return cn.at_band_frequencies(lr, speed, self.band_hz, rule), terms.cnossos
+            return cn.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
+                                     self.impact_db), terms.cnossos
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         if name not in filters:
             filters[name] = level(wrn.contact_filter_power(speed, self.band, filters["semi_length_m"][rows],
