@@ -45,5 +45,6 @@ def test_a_speed_out_of_range_is_one_line_and_exit_2(capsys):
 def test_the_table_names_each_component(capsys):
     assert main(["predict", "noise", "--speed", "20", "--model", "both"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].startswith("# site curve_250, emu") and len(out) == 4
-    assert "rail" in out[3] and "track" in out[2]
+    assert out[0].startswith("# site curve_250, emu") and len(out) == 5
+    assert "since grinding" in out[1] and "baseline rail roughness" in out[1]   # the increase's reference
+    assert "rail" in out[4] and "track" in out[3]

@@ -162,3 +162,23 @@ def test_the_mechanics_contact_filter_takes_each_passs_own_patch(model):
     assert want[-1] < -1.0                                               # 10 kHz: the heavier patch filters more
     cnossos = model.predict(passes, "cnossos")
     np.testing.assert_allclose(cnossos.roughness_db[1], cnossos.roughness_db[0], rtol=0, atol=1e-12)
+
+
+def test_a_freshly_ground_state_is_the_baseline_and_only_growth_is_added(model):
+    # The baseline roughness (noise.rail_roughness) is the rail as ground, without corrugation: a
+    # state at its post-grinding amplitudes adds nothing, whatever those are, and a state above them
+    # adds only its growth (amplitude^2 - post-grinding^2) in energy. So the same pass has the same
+    # level on day 0 with or without a corrugation state (version 0.2 added the post-grinding
+    # amplitudes on top, 2-6 dB at 250 Hz-2 kHz).
+    bands = wavelength_bands(0.01, 1.0)
+    post = 0.5 * band_limits(bands)
+    passes = _passes(model.site, "emu", [20.0])
+    np.testing.assert_allclose(model.rail_roughness_db(Corrugation(bands, post, post)), model.baseline_db, atol=1e-12)
+    for name in MODELS:
+        assert model.predict(passes, name, Corrugation(bands, post, post)).lpaeq_tp_dba[0] == pytest.approx(
+            model.predict(passes, name).lpaeq_tp_dba[0], abs=1e-12)
+    grown = Corrugation(bands, 2 * post, post)
+    wl = cn.tables().wavelength_m
+    i = int(np.argmin(np.abs(wl - bands[8])))                       # a table wavelength on a state band
+    want = 10 * np.log10(10 ** (model.baseline_db[i] / 10) + (3 * post[8] ** 2) / 1e-12)
+    assert model.rail_roughness_db(grown)[i] == pytest.approx(want, abs=1e-9)

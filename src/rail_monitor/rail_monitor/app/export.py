@@ -24,6 +24,7 @@ from rail_monitor.core.passes import FRICTION_NAMES, KMH_PER_MPS, rejection_reas
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import format_iso_ns, format_local_ns
 from rail_monitor.models.squeal import REGIME_NAMES
+from rail_monitor.noise.predict import INCREASE_REFERENCE
 
 FORMATS = ("csv", "parquet", "xlsx")
 SEVERITY_NAMES = ("info", "warning", "critical")
@@ -113,8 +114,8 @@ def pass_table(run: RunData, values: Mapping[str, Any]) -> Table:
                    _pick(nz["lpafmax_dba"], i)),
             Column(f"{model}_tel_dba", "dB(A)", f"rolling noise ({model}): transit exposure level (ISO 3095)",
                    _pick(nz["tel_dba"], i)),
-            Column(f"{model}_increase_since_grinding_db", "dB", f"rolling noise ({model}): LpAeq,Tp minus the same "
-                   "pass on the post-grinding rail", _pick(nz["roughness_growth_increase_db"], i)),
+            Column(f"{model}_increase_since_grinding_db", "dB", f"rolling noise ({model}): LpAeq,Tp minus "
+                   f"{INCREASE_REFERENCE}", _pick(nz["roughness_growth_increase_db"], i)),
         ]
     cols += _state_columns(run, p.stamp_ns)
     return Table("passes", cols)

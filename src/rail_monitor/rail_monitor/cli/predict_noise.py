@@ -57,15 +57,18 @@ def run(ns: argparse.Namespace) -> int:
 
 
 def _print_table(r) -> None:
+    from rail_monitor.noise.predict import INCREASE_REFERENCE
+
     print(f"# {r.where}")
-    print(f"{'model':>9} {'days':>6} {'v [m/s]':>8} {'LpAeq,Tp':>9} {'LpAFmax':>8} {'TEL':>6} {'growth':>7}"
+    print(f"# since grinding: LpAeq,Tp minus {INCREASE_REFERENCE}")
+    print(f"{'model':>9} {'days':>6} {'v [m/s]':>8} {'LpAeq,Tp':>9} {'LpAFmax':>8} {'TEL':>6} {'since grinding':>14}"
           "  components [dB(A)]")
     for (name, days), out in r.results.items():
         for i in range(len(r.speeds)):
             comps = ", ".join(f"{c} {x:.1f}" for c, x in zip(out.component_names, out.component_lpaeq_dba[i],
                                                              strict=True))
             print(f"{name:>9} {days:6g} {r.speeds[i]:8.2f} {out.lpaeq_tp_dba[i]:9.1f} {out.lpafmax_dba[i]:8.1f} "
-                  f"{out.tel_dba[i]:6.1f} {out.roughness_growth_increase_db[i]:7.1f}  {comps}")
+                  f"{out.tel_dba[i]:6.1f} {out.roughness_growth_increase_db[i]:14.1f}  {comps}")
 
 
 def _plot(r, path: str) -> None:

@@ -7,11 +7,13 @@ with the corrugation model, so pad stiffness and corrugation change the noise fo
 reasons). Both share one roughness input and one propagation (:mod:`rail_monitor.models.passby`).
 
 Roughness. The rail roughness is the site's baseline (ISO 3095 class E, CNOSSOS class M, or a
-measured spectrum in dB re 1 um on 1/3-octave wavelength bands) plus, in energy, the corrugation
-state's r.m.s. amplitude in each of its bands (the nearest baseline wavelength within 1/6
-octave). The level increase due to roughness growth since grinding is LpAeq,Tp with the current
-state minus LpAeq,Tp with the state's post-grinding amplitudes. The wheel roughness is
-CNOSSOS-EU's for the class's brake type.
+measured spectrum in dB re 1 um on 1/3-octave wavelength bands): the rail as ground, without
+corrugation. The corrugation state adds, in energy, its growth since grinding in each of its
+bands (its r.m.s. amplitude squared minus its post-grinding amplitude squared, at the nearest
+baseline wavelength within 1/6 octave), so a freshly ground state is the baseline itself and a
+measured baseline is not counted twice. The increase since grinding is LpAeq,Tp with the current
+state minus LpAeq,Tp on the baseline (INCREASE_REFERENCE). The wheel roughness is CNOSSOS-EU's
+for the class's brake type.
 
 Per pass: the class's wheel (diameter; the transfers use the Hertz contact stiffness at its
 nominal load, tabulated per class; the mechanics model's contact filter takes the pass's own
@@ -36,6 +38,10 @@ from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import PassBy, pass_by
 from rail_monitor.noise.config import MODELS, NoiseConfig
+
+# What roughness_growth_increase_db is measured against, for every label that shows it.
+INCREASE_REFERENCE = ("the same pass on the site's baseline rail roughness (noise.rail_roughness: as ground, "
+                      "no corrugation)")
 
 
 def roughness_power(amplitude_m: np.ndarray) -> np.ndarray:
@@ -150,19 +156,21 @@ class RollingNoiseModel:
         wl = np.asarray(self.cfg.rail_roughness_wavelength_m, float)
         return np.interp(self.grid, wl, np.asarray(self.cfg.rail_roughness_db, float))
 
-    def rail_roughness_db(self, corrugation: Corrugation | None = None, post_grinding: bool = False) -> np.ndarray:
-        """Rail roughness on the CNOSSOS wavelength grid [dB re 1 um]: baseline plus the corrugation
-        state (or its post-grinding amplitudes) in energy; (grid,) or, for a state per pass, (passes, grid)."""
+    def rail_roughness_db(self, corrugation: Corrugation | None = None) -> np.ndarray:
+        """Rail roughness on the CNOSSOS wavelength grid [dB re 1 um]: the baseline plus, in energy,
+        the corrugation state's growth since grinding (module docstring); (grid,) or, for a state
+        per pass, (passes, grid)."""
         if corrugation is None:
             return self.baseline_db
-        amp = corrugation.post_grinding_m if post_grinding else corrugation.amplitude_m
         wl = np.asarray(corrugation.wavelength_m, float)
         if not len(wl):
             return self.baseline_db
         octaves = np.abs(np.log2(self.grid[:, None] / wl[None, :]))
         nearest = np.argmin(octaves, axis=1)
         inside = octaves[np.arange(len(self.grid)), nearest] <= 1.0 / 6.0
-        extra = np.where(inside, roughness_power(amp)[..., nearest], 0.0)
+        grown = np.maximum(roughness_power(corrugation.amplitude_m) - roughness_power(corrugation.post_grinding_m),
+                           0.0)
+        extra = np.where(inside, grown[..., nearest], 0.0)
         return level(power(self.baseline_db) + extra)
 
     def predict(self, passes: PassTable, model: str | None = None,
@@ -183,8 +191,7 @@ class RollingNoiseModel:
         names = list(components)
         growth = np.zeros(len(passes))
         if corrugation is not None:
-            _, ground = self._sources(self.rail_roughness_db(corrugation, post_grinding=True), passes, model,
-                                      filters)
+            _, ground = self._sources(self.baseline_db, passes, model, filters)
             growth = pb.lpaeq_tp_dba - self._pass_by(ground, passes, False).lpaeq_tp_dba
         return NoisePrediction(
             model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,

@@ -13,7 +13,7 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.passes import FRICTION_BY_NAME, MAX_SPEED_MPS, PassTable, with_class_defaults
 from rail_monitor.core.site import Site, VehicleClass, site_from_values
 from rail_monitor.noise.config import noise_config
-from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
+from rail_monitor.noise.predict import INCREASE_REFERENCE, Corrugation, NoisePrediction, RollingNoiseModel
 
 SINGLE_NUMBERS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "pass_by_time_s", "roughness_growth_increase_db")
 
@@ -94,6 +94,7 @@ def summary(r: NoiseWhatIf) -> dict[str, Any]:
                 "lp_db": out.lp_db[i].tolist(), "lw_db_per_m": out.lw_db[i].tolist(),
                 "roughness_db": out.roughness_db[i].tolist()}
 
-    return {"where": r.where, "band_centre_hz": r.model.band_hz.tolist(), "results": [
+    return {"where": r.where, "band_centre_hz": r.model.band_hz.tolist(),
+            "roughness_growth_increase_reference": f"LpAeq,Tp minus {INCREASE_REFERENCE}", "results": [
         {"model": name, "growth_days": days, "passes": [row(out, i) for i in range(len(r.speeds))]}
         for (name, days), out in r.results.items()]}
