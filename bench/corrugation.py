@@ -21,10 +21,7 @@ from rail_monitor.corrugation import advice, checkpoint
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.growth import GrowthTables, _rail_receptance
-from rail_monitor.noise.config import noise_config
-from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.site_file import load_parameter_file
-from rail_monitor.squeal.config import squeal_config
 
 
 def passes(site, n: int, seed: int = 1, start: int = 0) -> PassTable:
@@ -100,7 +97,7 @@ def main() -> None:
     v = np.linspace(10, 22, 25)
     p = np.exp(-0.5 * ((v - 17) / 2) ** 2)
     t_ev = best_of(lambda: advice.evaluate(est, v, p), 20)
-    cons = Consequences(site, RollingNoiseModel(site, noise_config(values)), squeal_config(values))
+    cons = Consequences.of_values(site, values)
     t_adv = best_of(lambda: plan.advise(est, cons), 3)
     print(f"what-if evaluation, 25 speed bins:          {t_ev * 1e3:10.2f} ms")
     print(f"speed advice per class (noise, squeal, LP): {t_adv * 1e3:10.2f} ms")

@@ -10,16 +10,19 @@ medium or above. Both are linear in a distribution of speeds, which is what the 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from rail_monitor.core.passes import PassTable, with_class_defaults
 from rail_monitor.core.site import Site
 from rail_monitor.corrugation.history import KeptPasses
+from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 from rail_monitor.noise.whatif import synthetic_passes
-from rail_monitor.squeal.config import RISK_MEDIUM, SquealConfig
+from rail_monitor.squeal.config import RISK_MEDIUM, SquealConfig, squeal_config
 from rail_monitor.squeal.predict import predict as predict_squeal
 
 NOISE_METRIC = "lpafmax_dba"
@@ -33,13 +36,17 @@ class Consequences:
     noise: RollingNoiseModel
     squeal: SquealConfig
 
+    @classmethod
+    def of_values(cls, site: Site, values: Mapping[str, Any]) -> Consequences:
+        """From a site's flat parameter values (its noise.* and squeal.* sections)."""
+        return cls(site, RollingNoiseModel(site, noise_config(values)), squeal_config(values))
+
     def noise_dba(self, classes: list[str], speeds: np.ndarray, corrugation: Corrugation | None) -> np.ndarray:
         """LpAFmax [dB(A)] (models, C, G) of a train of each class at each speed [m/s]."""
         out = np.empty((len(self.noise.models), len(classes), len(speeds)))
         for j, name in enumerate(classes):
             cls = self.site.vehicle(name)
-            table = synthetic_passes(self.site, cls, np.asarray(speeds, float),
-                                     round((cls.vehicles_min + cls.vehicles_max) / 2))
+            table = synthetic_passes(self.site, cls, np.asarray(speeds, float), round(cls.mean_vehicles))
             for i, model in enumerate(self.noise.models):
                 out[i, j] = getattr(self.noise.predict(table, model, corrugation), NOISE_METRIC)
         return out

@@ -21,6 +21,7 @@ import numpy as np
 
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.core.passes import KMH_PER_MPS
+from rail_monitor.corrugation.advice import growth_at_speeds
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.models.speed_plan import optimise_speed_plan, plan_growth
 from rail_monitor.noise.predict import Corrugation
@@ -69,6 +70,10 @@ class SpeedAdvice:
         m = len(self.noise_model)
         return self.class_noise_recommended_dba[c * m:(c + 1) * m] - self.class_noise_current_dba[c * m:(c + 1) * m]
 
+    def band_label(self, i: int) -> str:
+        """Band row i in km/h, as an operator signs it ("60-70")."""
+        return f"{KMH_PER_MPS * self.band_low_mps[i]:.0f}-{KMH_PER_MPS * self.band_high_mps[i]:.0f}"
+
     def lines(self) -> list[str]:
         """The plan for people: one line per class, then the consequences."""
         def noise(change: np.ndarray) -> str:
@@ -78,8 +83,7 @@ class SpeedAdvice:
         for c, name in enumerate(self.vehicle_class):
             rows = [i for i, n in enumerate(self.band_vehicle_class)
                     if n == name and self.band_recommended_share[i] > 5e-3]
-            bands = ", ".join(f"{KMH_PER_MPS * self.band_low_mps[i]:.0f}-{KMH_PER_MPS * self.band_high_mps[i]:.0f} "
-                              f"km/h {100 * self.band_recommended_share[i]:.0f} %" for i in rows)
+            bands = ", ".join(f"{self.band_label(i)} km/h {100 * self.band_recommended_share[i]:.0f} %" for i in rows)
             out.append(f"{name} (mean {KMH_PER_MPS * self.class_mean_speed_mps[c]:.0f} km/h): {bands}; noise "
                        f"{noise(self.noise_change(c))} dB(A); squealing {100 * self.class_squeal_share_current[c]:.1f}"
                        f" -> {100 * self.class_squeal_share_recommended[c]:.1f} %")
@@ -148,13 +152,9 @@ def advise(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice
     for c, ci in enumerate(present):
         rows = k.class_idx == ci
         passes[c], axles[c] = rows.sum(), k.axles[rows].sum()
-        keys, inverse = np.unique(np.stack([k.friction[rows], k.regime[rows]]), axis=1, return_inverse=True)
-        weight = np.bincount(inverse.ravel(), weights=k.axles[rows]) / axles[c]
         speeds = pts[c].ravel()
-        per = est.tables.at(np.full(len(speeds) * keys.shape[1], ci), np.repeat(keys[0], len(speeds)),
-                            np.repeat(keys[1], len(speeds)), np.tile(speeds, keys.shape[1]))
-        mixed = np.einsum("k,kvbp->vbp", weight, per.reshape(keys.shape[1], len(speeds), *per.shape[1:]))
-        growth.append(mixed.reshape(ns, POINTS_PER_BAND, -1).mean(axis=1).T)          # (R, S)
+        mixed = growth_at_speeds(est, speeds, vehicle_class=classes[c])                 # (B, P, S x points)
+        growth.append(mixed.reshape(-1, ns, POINTS_PER_BAND).mean(axis=2))              # (R, S)
         noise.append(consequences.noise_dba([classes[c]], speeds, state)[:, 0].reshape(-1, ns, POINTS_PER_BAND)
                      .mean(axis=2))                                                    # (M, S)
         squeal_share.append(consequences.squeal_share(k, classes[c], ci, speeds)
@@ -194,8 +194,6 @@ def advise(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice
 
 def advise_or_none(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice | None:
     """The advice on the kept passes, or None when there is nothing to advise on or no plan fits."""
-    if not len(est.kept):
-        return None
     try:
         return advise(est, consequences)
     except ValueError:

@@ -15,7 +15,7 @@ import numpy as np
 
 from rail_monitor.alerts.config import alert_config, counts_as_squeal
 from rail_monitor.app.report import RunData
-from rail_monitor.core.passes import FRICTION_MODIFIER, FRICTION_NAMES, KMH_PER_MPS
+from rail_monitor.core.passes import FRICTION_MODIFIER, FRICTION_NAMES
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
 from rail_monitor.corrugation.config import corrugation_config
 
@@ -199,8 +199,7 @@ def speed_advice(run: Any) -> list[dict]:
     for c, name in enumerate(a.vehicle_class):
         change = a.noise_change(c)
         for i in (i for i, n in enumerate(a.band_vehicle_class) if n == name):
-            rows.append({"class": name, "band [km/h]": f"{KMH_PER_MPS * a.band_low_mps[i]:.0f}-"
-                         f"{KMH_PER_MPS * a.band_high_mps[i]:.0f}", "recent [%]": 100.0 * a.band_current_share[i],
+            rows.append({"class": name, "band [km/h]": a.band_label(i), "recent [%]": 100.0 * a.band_current_share[i],
                          "advised [%]": 100.0 * a.band_recommended_share[i],
                          **{f"noise change {m} [dB(A)]": float(change[j]) for j, m in enumerate(a.noise_model)},
                          "squealing recent [%]": 100.0 * a.class_squeal_share_current[c],

@@ -53,8 +53,7 @@ class ContactState(NamedTuple):
 
 def wheel_radius(site: Site, vehicle_class: np.ndarray) -> np.ndarray:
     """Rolling radius [m] of each pass's class (half its nominal wheel diameter)."""
-    radius = {name: v.wheel_diameter_m / 2.0 for name, v in site.vehicles.items()}
-    return np.array([radius[c] for c in vehicle_class], dtype=np.float64)
+    return site.per_pass(vehicle_class, "wheel_diameter_m").astype(np.float64) / 2.0
 
 
 def creep_stiffness(site: Site, patch: HertzContact, k1: np.ndarray) -> np.ndarray:

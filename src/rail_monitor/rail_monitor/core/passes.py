@@ -257,10 +257,11 @@ def with_class_defaults(table: PassTable, site: Site) -> PassTable:
     Rows must be valid for the site (see :func:`rejection_reasons`).
     """
     out = table.take(slice(None))
-    cls = [site.vehicle(c) for c in table.vehicle_class]
-    axles = np.array([c.axles_per_vehicle for c in cls], dtype=np.int64)
-    load = np.array([c.wheel_load_n for c in cls], dtype=np.float64)
-    length = np.array([c.vehicle_length_m for c in cls], dtype=np.float64)
+    for c in set(table.vehicle_class.tolist()):
+        site.vehicle(c)  # a ConfigError naming the known classes for an unknown one
+    axles = site.per_pass(table.vehicle_class, "axles_per_vehicle").astype(np.int64)
+    load = site.per_pass(table.vehicle_class, "wheel_load_n").astype(np.float64)
+    length = site.per_pass(table.vehicle_class, "vehicle_length_m").astype(np.float64)
     out.axle_count = np.where(out.axle_count == 0, out.vehicle_count * axles, out.axle_count)
     out.vehicle_count = np.where(out.vehicle_count == 0, -(-out.axle_count // axles), out.vehicle_count)
     out.wheel_load_n = np.where(out.wheel_load_n == 0.0, load, out.wheel_load_n)

@@ -143,9 +143,14 @@ class VehicleClass:
     squeal_radiation_efficiency: float
 
     @property
+    def mean_vehicles(self) -> float:
+        """Vehicles of a consist of the mean length (vehicles_min to vehicles_max) [-]."""
+        return (self.vehicles_min + self.vehicles_max) / 2
+
+    @property
     def mean_axles_per_train(self) -> float:
-        """Axles of a consist of the mean length (vehicles_min to vehicles_max) [-]."""
-        return self.axles_per_vehicle * (self.vehicles_min + self.vehicles_max) / 2
+        """Axles of a consist of the mean length [-]."""
+        return self.axles_per_vehicle * self.mean_vehicles
 
 
 def _creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -191,6 +196,11 @@ class Site:
         share = np.array([v.traffic_share for v in vs])
         w = share / share.sum() if share.sum() > 0 else np.full(len(vs), 1.0 / len(vs))
         return float(w @ np.array([v.mean_axles_per_train for v in vs]))
+
+    def per_pass(self, vehicle_class: Any, attribute: str) -> np.ndarray:
+        """A rolling-stock column per pass: the VehicleClass attribute of each pass's class name."""
+        column = {name: getattr(v, attribute) for name, v in self.vehicles.items()}
+        return np.array([column[c] for c in vehicle_class])
 
     def vehicle(self, name: str) -> VehicleClass:
         """The vehicle class called name, or a ConfigError listing the known ones."""

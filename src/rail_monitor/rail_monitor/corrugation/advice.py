@@ -19,18 +19,21 @@ from rail_monitor.corrugation.records import Evaluation
 def traffic_mix(est: CorrugationEstimator, friction_state: int = 0,
                 vehicle_class: str | None = None) -> tuple[np.ndarray, ...]:
     """(class index, friction state, contact regime, axle weight) of the traffic mix: the kept
-    passes', or without them the site's classes weighted by traffic share and axles per train
-    (only vehicle_class when given), on dry rail in partial slip; friction_state > 0 puts every
-    pass in that state, each in the regime its load and creepage then give (rail_monitor.core.contact)."""
+    passes' (only vehicle_class's when given), or without them the site's classes weighted by
+    traffic share and axles per train (only vehicle_class when given), on dry rail in partial slip;
+    friction_state > 0 puts every pass in that state, each in the regime its load and creepage then
+    give (rail_monitor.core.contact)."""
     k = est.kept
-    if len(k):
-        fr, regime = k.friction, k.regime
+    rows = np.ones(len(k), bool) if not vehicle_class or not len(k) else \
+        k.class_idx == est.tables.classes.index(vehicle_class)
+    if rows.any():
+        fr, regime = k.friction[rows], k.regime[rows]
         if friction_state:
-            fr = np.full_like(k.friction, friction_state)
-            regime = contact_state_of(est.site, np.array(est.tables.classes, object)[k.class_idx], fr, k.load,
-                                      k.creepage, k.speed).regime.astype(np.int64)
-        keys, inverse = np.unique(np.stack([k.class_idx, fr, regime]), axis=1, return_inverse=True)
-        weight = np.bincount(inverse.ravel(), weights=k.axles)
+            fr = np.full_like(fr, friction_state)
+            regime = contact_state_of(est.site, np.array(est.tables.classes, object)[k.class_idx[rows]], fr,
+                                      k.load[rows], k.creepage[rows], k.speed[rows]).regime.astype(np.int64)
+        keys, inverse = np.unique(np.stack([k.class_idx[rows], fr, regime]), axis=1, return_inverse=True)
+        weight = np.bincount(inverse.ravel(), weights=k.axles[rows])
         cls, fr, regime = keys
     else:
         names = [vehicle_class] if vehicle_class else est.tables.classes

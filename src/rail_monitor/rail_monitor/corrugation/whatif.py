@@ -101,12 +101,8 @@ def _advise(values: Mapping[str, Any], est: CorrugationEstimator) -> Any:
     """The speed advice on the history (noise and squeal of the site weighed)."""
     from rail_monitor.advice.consequences import Consequences
     from rail_monitor.advice.plan import advise
-    from rail_monitor.noise.config import noise_config
-    from rail_monitor.noise.predict import RollingNoiseModel
-    from rail_monitor.squeal.config import squeal_config
 
-    return advise(est, Consequences(est.site, RollingNoiseModel(est.site, noise_config(values)),
-                                    squeal_config(values)))
+    return advise(est, Consequences.of_values(est.site, values))
 
 
 def summary(r: CorrugationWhatIf) -> dict[str, Any]:

@@ -270,10 +270,10 @@ def harmonic_balance_amplitude(speed: ArrayLike, crabbing: ArrayLike, load: Arra
     refined by bisection. Units and inputs as :func:`limit_cycle_amplitude`; 0 where the mode
     is not fed at small amplitude (no squeal), NaN where no balance exists on the grid.
     """
-    v0, vc, w, c, k1, k2, k3 = (a.ravel() for a in np.broadcast_arrays(
-        *(np.abs(np.asarray(x, float)) if i == 1 else np.asarray(x, float)
-          for i, x in enumerate((speed, crabbing, load, damping, k1, k2, k3)))))
-    shape = np.broadcast_shapes(*(np.shape(x) for x in (speed, crabbing, load, damping, k1, k2, k3)))
+    arrays = np.broadcast_arrays(*(np.asarray(x, float) for x in (speed, crabbing, load, damping, k1, k2, k3)))
+    shape = arrays[0].shape
+    v0, vc, w, c, k1, k2, k3 = (a.ravel() for a in arrays)
+    vc = np.abs(vc)
     if v0.size > _BALANCE_CHUNK:  # bound the (cases, HARMONIC_POINTS) arrays' memory
         parts = [harmonic_balance_amplitude(*(a[i:i + _BALANCE_CHUNK] for a in (v0, vc, w, c, k1, k2, k3)))
                  for i in range(0, v0.size, _BALANCE_CHUNK)]

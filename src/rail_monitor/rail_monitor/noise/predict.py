@@ -183,15 +183,16 @@ class RollingNoiseModel:
         model = model or self.models[0]
         if model not in MODELS:
             raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
-        filters: dict[str, np.ndarray] = {}  # the contact filter per class: the same on both rails
-        if model == "mechanics":  # its contact filter takes each pass's patch (the pass's wheel load)
-            filters["semi_length_m"] = contact_state(self.site, passes).patch.a
-        roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filters)
+        # The mechanics model's contact filter per pass (its own patch, from its wheel load): the same
+        # on both rails. CNOSSOS's is in its tables.
+        filter_db = None if model == "cnossos" else level(wrn.contact_filter_power(
+            passes.speed_mps, self.band, contact_state(self.site, passes).patch.a, self.cfg.band_points))
+        roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filter_db)
         pb = self._pass_by(components, passes)
         names = list(components)
         growth = np.zeros(len(passes))
         if corrugation is not None:
-            _, ground = self._sources(self.baseline_db, passes, model, filters)
+            _, ground = self._sources(self.baseline_db, passes, model, filter_db)
             growth = pb.lpaeq_tp_dba - self._pass_by(ground, passes, False).lpaeq_tp_dba
         return NoisePrediction(
             model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
@@ -202,11 +203,10 @@ class RollingNoiseModel:
             roughness_growth_increase_db=growth)
 
     def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str,
-                 filters: dict[str, np.ndarray]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+                 filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness [dB re 1 um] and sound power per metre of train per component
-        [dB re 1 pW/m] (passes x bands) on a rail roughness spectrum. filters: the mechanics
-        model's contact filter level per class, computed on first use (it depends on the passes
-        only)."""
+        [dB re 1 pW/m] (passes x bands) on a rail roughness spectrum. filter_db: the mechanics
+        model's contact filter level per pass (passes x bands; None for CNOSSOS)."""
         n, nb = len(passes), len(self.band)
         per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
         roughness = np.empty((n, nb))
@@ -216,8 +216,8 @@ class RollingNoiseModel:
         for name in set(passes.vehicle_class.tolist()):
             rows = passes.vehicle_class == name
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
-            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model, filters, name,
-                                            rows)
+            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
+                                            None if filter_db is None else filter_db[rows])
             roughness[rows] = lr
             for comp, lh in transfers.items():
                 components[comp][rows] = lr + lh + per_metre[rows]
@@ -228,18 +228,14 @@ class RollingNoiseModel:
                        self.vertical_db, time_weighted)
 
     def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray, model: str,
-                   filters: dict[str, np.ndarray], name: str,
-                   rows: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+                   filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
         rule = self.cfg.interpolation
         if model == "cnossos":
             return cn.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
                                      self.impact_db), terms.cnossos
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
-        if name not in filters:
-            filters[name] = level(wrn.contact_filter_power(speed, self.band, filters["semi_length_m"][rows],
-                                                           self.cfg.band_points))
-        lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + filters[name]
+        lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + filter_db
         return lr, terms.mechanics
 
 

@@ -74,7 +74,7 @@ def predict_noise(values: Mapping[str, Any], vehicle_class: str | None = None, s
     v = np.asarray(speeds or [cls.speed_mean_mps], float)
     if np.any(~np.isfinite(v) | (v <= 0) | (v > MAX_SPEED_MPS)):
         raise RailMonitorError(f"--speed values must be in (0, {MAX_SPEED_MPS:g}] m/s")
-    n_vehicles = vehicles or round((cls.vehicles_min + cls.vehicles_max) / 2)
+    n_vehicles = vehicles or round(cls.mean_vehicles)
     table = synthetic_passes(site, cls, v, n_vehicles)
     states = growth_states(values, site, cls, float(v[0]), growth_days, passes_per_day)
     results = {(name, days): model.predict(table, name, state) for name in model.models

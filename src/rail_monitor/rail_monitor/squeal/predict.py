@@ -38,9 +38,7 @@ class WheelMode(NamedTuple):
 
 def wheel_mode(site: Site, vehicle_class: np.ndarray) -> WheelMode:
     """The vehicle classes' squealing modes (VEHICLE_SPECS squeal_*), one row per pass."""
-    names = list(site.vehicles)
-    idx = np.array([names.index(c) for c in vehicle_class], dtype=np.int64)
-    col = {k: np.array([getattr(site.vehicles[n], k) for n in names])[idx] for k in (
+    col = {k: site.per_pass(vehicle_class, k).astype(np.float64) for k in (
         "squeal_mode_hz", "squeal_modal_mass_kg", "squeal_damping_ratio", "wheel_radiating_area_m2",
         "squeal_radiation_efficiency")}
     f, m = col["squeal_mode_hz"], col["squeal_modal_mass_kg"]
