@@ -5,7 +5,8 @@ Run: ros2_ws/run python -m bench [--quick]
 Figures are measured side by side in this run only: compare ratios within a run, not absolute
 times across machines. Sections: the graph against its rclpy ceiling (the no-op graph of
 bench.bare_graph); batch mode at 1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
-per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes;
+per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes
+(the graph, the recorder, and the streamed batch);
 many sites on a local Dask cluster of 1 and 2 workers.
 """
 
@@ -28,7 +29,8 @@ from bench import noise as bn
 from bench import recorder as br
 from bench import sites as bsites
 from bench import squeal as bs
-from rail_monitor.app.batch import run_models, write_bag
+from rail_monitor.app.batch import run_models
+from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_passes
 from rail_monitor.site_file import load_parameter_file
@@ -98,6 +100,17 @@ def year_rows(values: dict, site: str, passes: int, tmp: Path) -> tuple[list[Row
     return rows, memory
 
 
+def streamed_rows(site: str, sizes: list[int]) -> list[Row]:
+    """Peak memory of the streamed batch (as rail-monitor batch runs a bag) against history length,
+    each size in a fresh process."""
+    rows: list[Row] = []
+    for size in sizes:
+        n, t, mb = bb.streamed_in_subprocess(site, size)
+        rows.append((f"batch streamed to a bag, {n:,} passes", f"{mb:,.0f} MB",
+                     f"peak RSS of the process; {rate(n, t)} with the recording"))
+    return rows
+
+
 def model_rows(site: str) -> list[Row]:
     sq = bs.costs(site)
     co = bc.costs(site)
@@ -160,7 +173,8 @@ def main() -> None:
         sections.append(("a busy site's year", year_r))
         sections.append(("models, per pass", model_rows(ns.site)))
         sections.append(("recorder", recorder_rows(values, source, tmp)))
-        sections.append(("memory against passes", memory))
+        sections.append(("memory against passes", memory + streamed_rows(
+            ns.site, [2_000, 6_000] if ns.quick else [100_000, 1_000_000])))
         sections.append(("many sites on a local Dask cluster", bsites.rows(values, ns.site, 2 if ns.quick else 4,
                                                                            1000 if ns.quick else 20_000)))
     text = f"Machine: {machine()}\n\n{table(sections)}\n"

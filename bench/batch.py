@@ -8,17 +8,23 @@ and reported as set-up.
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import tempfile
 import time
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from bench.timing import peak_rss_mb
 from rail_monitor.app.batch import BatchResult, run_models
+from rail_monitor.app.batch_bag import run_to_bag
 from rail_monitor.app.simulator import simulate, simulator_config
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.site import site_from_values
+from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns, parse_iso_ns
 
 BUSY_YEAR = 100_000  # train passes a year at a busy site
 
@@ -70,6 +76,35 @@ def live_equality(bag: str, values: Mapping[str, Any]) -> dict[str, float]:
     return out
 
 
+def busy_chunks(values: Mapping[str, Any], passes: int, chunk: int) -> Iterator[PassTable]:
+    """About ``passes`` busy-site passes as consecutive simulated periods of about ``chunk`` passes
+    each (a seed per period), in time order: a history never held whole."""
+    v = busy_values(values, chunk)
+    start = parse_iso_ns(str(values["simulator.start_time"]))
+    for k in range(max(1, round(passes / chunk))):
+        t0 = start + round(k * v["simulator.days"] * NS_PER_DAY)
+        w = {**v, "simulator.seed": 1000 + k, "simulator.start_time": format_iso_ns(t0)}
+        yield simulate(site_from_values(w), simulator_config(w))
+
+
+def streamed(values: Mapping[str, Any], passes: int, chunk: int = 5_000) -> tuple[int, float, float]:
+    """rail-monitor batch's streamed path (app.batch_bag.run_to_bag) over a simulated history recorded
+    to a temporary bag: (passes, wall time [s], peak RSS of this process [MB]). Run it in a fresh
+    process for its own peak."""
+    with tempfile.TemporaryDirectory() as tmp:
+        t = time.perf_counter()
+        n = run_to_bag(busy_chunks(values, passes, chunk), values, Path(tmp) / "bag", "site").passes
+        return n, time.perf_counter() - t, peak_rss_mb()
+
+
+def streamed_in_subprocess(site: str, passes: int) -> tuple[int, float, float]:
+    """streamed() in a fresh interpreter (its peak memory is its own)."""
+    done = subprocess.run([sys.executable, "-m", "bench.batch", "--site", site, "--streamed", str(passes)],
+                          capture_output=True, text=True, check=True)
+    n, t, mb = done.stdout.split()[-3:]
+    return int(n), float(t), float(mb)
+
+
 def main() -> None:
     import argparse
 
@@ -78,8 +113,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
     ap.add_argument("--sizes", default="1e4,1e5,1e6")
+    ap.add_argument("--streamed", type=float, help="only the streamed run of this many passes; prints passes, "
+                    "seconds and peak RSS [MB]")
     ns = ap.parse_args()
     values = load_parameter_file(ns.site)
+    if ns.streamed:
+        print(*streamed(values, int(ns.streamed)))
+        return
     print(f"set-up (site tables, once per process): {set_up_s(values):.2f} s")
     for size in (int(float(x)) for x in ns.sizes.split(",")):
         n, t, _ = timed(values, size)

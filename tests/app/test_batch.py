@@ -16,12 +16,13 @@ _NO_ROS = textwrap.dedent("""
     for name in ("rclpy", "rail_msgs", "builtin_interfaces", "std_msgs", "diagnostic_msgs", "rosgraph_msgs"):
         sys.modules[name] = None  # import raises ImportError
     import rail_monitor.app.batch as batch
+    import rail_monitor.app.batch_bag as batch_bag
     import rail_monitor.app.report
     from rail_monitor.bagio.reader import read_passes
     from rail_monitor.site_file import load_parameter_file
     values = load_parameter_file(sys.argv[1])
     result = batch.run_models(read_passes(sys.argv[2]), values)
-    batch.write_bag(result, sys.argv[3], "curve_250")
+    batch_bag.write_bag(result, sys.argv[3], "curve_250")
     assert not any(m == "rclpy" or m.startswith(("rclpy.", "rail_msgs.")) for m in sys.modules if sys.modules[m])
     print(len(result.passes), len(result.trajectory))
 """)
@@ -43,7 +44,8 @@ def test_a_bag_written_without_rclpy_decodes_with_rclpy_to_the_same_messages(tmp
     from mcap.reader import make_reader
     from rclpy.serialization import deserialize_message
 
-    from rail_monitor.app.batch import run_models, write_bag
+    from rail_monitor.app.batch import run_models
+    from rail_monitor.app.batch_bag import write_bag
     from rail_monitor.bagio.reader import read_passes
     from rail_monitor.nodes.convert import TOPICS
 
@@ -56,3 +58,86 @@ def test_a_bag_written_without_rclpy_decodes_with_rclpy_to_the_same_messages(tmp
             assert msg.header.stamp.sec > 0 and msg.header.frame_id == "curve_250"
             seen.add(name)
     assert seen == set(TOPICS)
+
+
+# -- a history in chunks -------------------------------------------------------------------------
+def _hostile_history(passes):
+    """The sample's first 4,000 passes with what makes chunking hard: duplicates (a pass sent twice,
+    adjacent once sorted), passes sharing a stamp, invalid and unknown-class passes, unset and
+    pre-1970 stamps, a far-future stamp and an unrepresentable one."""
+    import numpy as np
+
+    from rail_monitor.core.passes import PassTable
+
+    rng = np.random.default_rng(7)
+    base = passes.sorted().take(slice(0, 4000))
+    dup = base.take(rng.choice(len(base), 60, replace=False))
+    same = base.take(rng.choice(len(base), 40, replace=False))
+    same.train_id = np.array([f"{t}-b" for t in same.train_id], dtype=object)
+    bad = base.take(rng.choice(len(base), 40, replace=False))
+    bad.speed_mps[:20] = np.nan
+    bad.vehicle_class[20:] = "tram"
+    odd = base.take(np.arange(5))
+    odd.stamp_ns = np.array([0, -5_000_000_000, base.stamp_ns[-1] + 400 * 86_400 * 10**9, 2**62,
+                             base.stamp_ns[-1]], np.int64)
+    return PassTable.concat([base, dup, same, bad, odd]).sorted()
+
+
+def _chunked(passes, values, cuts):
+    from rail_monitor.app.batch import BatchRun
+
+    run = BatchRun(values)
+    parts = [run.feed(passes.take(slice(a, b))) for a, b in zip([0, *cuts], [*cuts, len(passes)], strict=True)]
+    held, advice = run.finish()
+    return run, parts, held, advice
+
+
+def test_any_chunking_of_a_history_gives_the_one_call_outputs_alerts_included(site_values, sample_passes):
+    """BatchRun carries the state, the alert windows and standing alerts, the stream's references and
+    the states a later pass is predicted on: random chunk boundaries (an empty chunk, a boundary
+    inside a run of equal stamps) give the one call's outputs bit for bit (exact equality)."""
+    import numpy as np
+
+    from rail_monitor.app.batch import run_models
+
+    history = _hostile_history(sample_passes)
+    whole = run_models(history, site_values)
+    assert len(whole.alerts) >= 4 and (whole.reasons != "").sum() >= 42 and len(whole.left_out) == 2
+    assert len(whole.trajectory) <= len(whole.accepted) - 60  # the duplicates are not counted
+    rng = np.random.default_rng(11)
+    stamps = history.stamp_ns
+    tie = int(np.flatnonzero(stamps[1:] == stamps[:-1])[5]) + 1  # between two passes of one stamp
+    for cuts in (sorted({*rng.choice(len(history), 9, replace=False).tolist(), tie, tie}),
+                 [tie, 1500, 1500, 3000], [1]):
+        run, parts, held, advice = _chunked(history, site_values, cuts)
+        assert np.array_equal(np.concatenate([p.reasons for p in parts]), whole.reasons)
+        for k, col in whole.squeal.items():
+            np.testing.assert_array_equal(np.concatenate([p.squeal[k] for p in parts]), col, err_msg=k)
+        t = whole.trajectory
+        np.testing.assert_array_equal(np.concatenate([p.trajectory.amplitude for p in parts]), t.amplitude)
+        np.testing.assert_array_equal(np.concatenate([p.trajectory.forecast.grinding_due_ns for p in parts]),
+                                      t.forecast.grinding_due_ns)
+        np.testing.assert_array_equal(np.concatenate([p.trajectory.total_pass_count for p in parts]),
+                                      t.total_pass_count)
+        for model, out in whole.noise.items():
+            for k, col in out.per_pass().items():
+                np.testing.assert_array_equal(np.concatenate([p.noise[model].per_pass()[k] for p in parts]), col,
+                                              err_msg=f"{model} {k}")
+        assert [a for p in parts for a in p.alerts] + held == whole.alerts
+        assert parts[-1].standing == whole.standing and run.left_out == whole.left_out
+        assert advice.lines() == whole.advice.lines()
+
+
+def test_a_chunk_older_than_an_earlier_one_is_refused_and_leaves_the_run_as_it_was(site_values, sample_passes):
+    import pytest
+
+    from rail_monitor.app.batch import BatchRun
+    from rail_monitor.core.errors import PassOrderError
+
+    history = sample_passes.sorted().take(slice(0, 600))
+    run = BatchRun(site_values)
+    run.feed(history.take(slice(300, 600)))
+    before = (run.estimator.total_pass_count, run.newest_ns, run.newest_sent_ns, dict(run.alerts.standing))
+    with pytest.raises(PassOrderError, match="out of time order"):
+        run.feed(history.take(slice(0, 300)))
+    assert (run.estimator.total_pass_count, run.newest_ns, run.newest_sent_ns, dict(run.alerts.standing)) == before

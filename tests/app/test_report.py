@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from rail_monitor.app.batch import run_models, write_bag
+from rail_monitor.app.batch import run_models
+from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.app.report import build_report, load_run, summary_lines
 from rail_monitor.bagio.reader import read_passes
 from rail_monitor.cli import main

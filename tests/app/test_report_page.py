@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from rail_monitor.app import report_plots, report_tables
-from rail_monitor.app.batch import run_models, write_bag
+from rail_monitor.app.batch import run_models
+from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.app.export import pass_table
 from rail_monitor.app.report import build_report, load_run
 from rail_monitor.bagio.reader import read_passes

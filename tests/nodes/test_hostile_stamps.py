@@ -10,7 +10,8 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from rail_monitor.app.batch import run_models, write_bag
+from rail_monitor.app.batch import run_models
+from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.bagio.csv_io import read_csv
 from rail_monitor.bagio.reader import read_bag_passes
 from rail_monitor.cli import main

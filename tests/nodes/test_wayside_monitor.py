@@ -21,7 +21,8 @@ from rclpy.parameter import Parameter
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.alerts.config import KIND_SQUEAL
-from rail_monitor.app.batch import run_models, write_bag
+from rail_monitor.app.batch import run_models
+from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.app.report import build_report, load_run
 from rail_monitor.bagio.reader import read_bag_passes, read_messages
 from rail_monitor.bagio.site_record import read_site_record

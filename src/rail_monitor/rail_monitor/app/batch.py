@@ -4,8 +4,9 @@ Gives what the live graph publishes, pass for pass, by calling the same function
 passes: the squeal prediction of every accepted pass; the corrugation state after every counted
 pass (CorrugationEstimator.advance_history); the rolling noise of every accepted pass on the
 corrugation state that includes it (as rolling_noise_predictor waits for it); the alerts of the
-alert manager; and the speed advice on the final state. ``write_bag`` records them under the same
-topics, types and QoS as mcap_recorder records the live graph.
+alert manager; and the speed advice on the final state. A history may be given whole
+(:func:`run_models`) or in chunks (:class:`BatchRun`, for memory flat in the history's length)
+with the same outputs; :mod:`rail_monitor.app.batch_bag` records them as the live graph is recorded.
 """
 
 from __future__ import annotations
@@ -13,8 +14,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass
-from pathlib import Path
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -23,18 +23,15 @@ from rail_monitor.advice.consequences import Consequences
 from rail_monitor.advice.plan import SpeedAdvice, advise_or_none
 from rail_monitor.alerts.config import alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager
-from rail_monitor.bagio import messages as fields
-from rail_monitor.bagio.cdr import serialize
-from rail_monitor.bagio.mcap_bag import McapBagWriter
-from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
-from rail_monitor.bagio.topics import GRAPH_TOPICS
+from rail_monitor.core.errors import PassOrderError
 from rail_monitor.core.node_params import STAMP_SPECS, StampParams
 from rail_monitor.core.params import resolve, section, values_of
 from rail_monitor.core.passes import PassTable, publishable, reject_ahead, rejection_reasons, with_class_defaults
 from rail_monitor.core.site import Site, site_from_values
+from rail_monitor.core.timeutil import fits_time_msg, format_iso_ns
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.corrugation.records import Trajectory
+from rail_monitor.corrugation.records import StateSnapshot, Trajectory
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
 from rail_monitor.noise.state_of_pass import state_index
@@ -47,55 +44,124 @@ NOISE_CHUNK = 20_000  # passes per noise prediction: bounds the (passes x time s
 
 @dataclass
 class BatchResult:
-    """Model outputs over a history. Arrays over ``accepted`` rows unless named otherwise."""
+    """Model outputs over a history, or over one chunk of it (BatchRun.feed). Arrays over
+    ``accepted`` rows unless named otherwise."""
 
     site: Site
-    passes: PassTable                 # the whole history in time order (as the replayer sends it)
+    passes: PassTable                 # the passes in time order (as the replayer sends them)
     reasons: np.ndarray               # per pass: '' accepted, else why rejected
     accepted: PassTable               # accepted passes, class defaults filled
     squeal: dict[str, np.ndarray]
     trajectory: Trajectory            # state after each counted pass (index: row of ``accepted``)
-    state_of_pass: np.ndarray         # per accepted pass: trajectory row it was predicted on (-1: none)
     noise: dict[str, NoisePrediction]  # per source model
-    alerts: list[Alert]
-    standing: list[Alert]
-    advice: SpeedAdvice | None
-    estimator: CorrugationEstimator   # the final state
+    alerts: list[Alert]               # events, in order (a chunk's: those no later chunk can precede)
+    standing: list[Alert]             # after these passes
+    advice: SpeedAdvice | None        # on the final state (None for a chunk before the last)
+    estimator: CorrugationEstimator   # the state after these passes
     receiver: Any
     left_out: dict[str, int]          # passes the replayer would not send, by reason
 
 
+@dataclass
+class _Tail:
+    """The newest corrugation states of the chunks so far: the latest state and every state of its
+    stamp, all a later pass can be predicted on (passes come in time order)."""
+
+    stamp_ns: np.ndarray
+    train_id: list[str]
+    amplitude: np.ndarray  # (K, B) [m]
+
+    def then(self, traj: Trajectory) -> _Tail:
+        stamps = np.concatenate([self.stamp_ns, traj.stamp_ns])
+        trains = self.train_id + traj.train_id.tolist()
+        amp = np.concatenate([self.amplitude.reshape(len(self.stamp_ns), -1), traj.amplitude]) if len(
+            self.stamp_ns) else traj.amplitude
+        return _Tail(stamps, trains, amp)
+
+    def last_stamp(self) -> _Tail:
+        keep = np.flatnonzero(self.stamp_ns == self.stamp_ns[-1]) if len(self.stamp_ns) else np.arange(0)
+        return _Tail(self.stamp_ns[keep], [self.train_id[k] for k in keep.tolist()], self.amplitude[keep])
+
+
+class BatchRun:
+    """Every model over a history given in chunks, carrying from one chunk to the next what one call
+    would (the corrugation state, the alert windows and standing alerts, the stream's newest pass,
+    the states a later pass may be predicted on), so any chunking gives one call's outputs.
+
+    values: the site's flat parameters; estimator: a state to continue from (e.g. a checkpoint),
+    default the post-grinding state; threads: for the independent parts (squeal beside the
+    corrugation history; the noise chunks of every model), 0: one per core. numpy releases the
+    interpreter lock in its array loops, so the threads use the cores; the chunks are the same
+    whatever the count, so the results are too.
+
+    Chunks must follow each other in time: a chunk's passes may not be older than any of an earlier
+    chunk's (stamps that builtin_interfaces/Time cannot hold aside, which are left out).
+    """
+
+    def __init__(self, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
+                 threads: int = 0) -> None:
+        self.values = values
+        self.site = site_from_values(values)
+        self.margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
+        self.estimator = estimator or CorrugationEstimator(self.site, corrugation_config(values))
+        self.model = RollingNoiseModel(self.site, noise_config(values))
+        self.alerts = AlertManager(alert_config(values, self.estimator.cfg.lead_time_days))
+        self.threads = threads or os.cpu_count() or 1
+        self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
+        self.newest_taken_ns = self.estimator.newest_ns  # the nodes' reference
+        self.newest_ns = np.iinfo(np.int64).min          # newest stamp given so far (time order check)
+        self.left_out: dict[str, int] = {}
+        self._tail = _Tail(np.zeros(0, np.int64), [], np.zeros((0, len(self.estimator.bands))))
+        self._held: list[Alert] = []                     # events a later chunk may still precede
+
+    def feed(self, passes: PassTable) -> BatchResult:
+        """The outputs of the next chunk of the history (the input error of a chunk out of time
+        order leaves the run as it was)."""
+        stamps = passes.stamp_ns[fits_time_msg(passes.stamp_ns)]
+        if len(stamps) and int(stamps.min()) < self.newest_ns:
+            raise PassOrderError(f"passes out of time order: a chunk has a pass at {format_iso_ns(int(stamps.min()))}, "
+                             f"before {format_iso_ns(self.newest_ns)} of an earlier one")
+        self.newest_ns = max(self.newest_ns, int(stamps.max(initial=self.newest_ns)))
+        table, left_out = publishable(passes, self.margins, self.newest_sent_ns)
+        for why, n in left_out.items():
+            self.left_out[why] = self.left_out.get(why, 0) + n
+        self.newest_sent_ns = max(self.newest_sent_ns, int(table.stamp_ns.max(initial=0)))
+        reasons = rejection_reasons(table, self.site)
+        self.newest_taken_ns = reject_ahead(table.stamp_ns, reasons, self.newest_taken_ns, self.margins)
+        accepted = with_class_defaults(table.take(reasons == ""), self.site)
+        with ThreadPoolExecutor(max_workers=self.threads) as pool:
+            squeal_job = pool.submit(predict_squeal, squeal_config(self.values), self.site, accepted)
+            traj = _history(self.estimator, accepted)
+            states = self._tail.then(traj)
+            on = state_index(states.stamp_ns, states.train_id, accepted.stamp_ns, accepted.train_id.tolist())
+            noise = _noise_on_states(pool, self.model, accepted, states.amplitude, traj.constants, on)
+            squeal = squeal_job.result()
+        self._tail = states.last_stamp()
+        events = sorted(self._held + _feed_alerts(self.alerts, table, reasons, accepted, squeal, traj, noise),
+                        key=_alert_key)
+        later = int(table.stamp_ns[-1]) if len(table) else np.iinfo(np.int64).min
+        self._held = [a for a in events if a.stamp_ns >= later]  # may tie with the next chunk's first pass
+        return BatchResult(self.site, table, reasons, accepted, squeal, traj, noise,
+                           [a for a in events if a.stamp_ns < later], self.standing(), None, self.estimator,
+                           self.model.receiver, dict(left_out))
+
+    def standing(self) -> list[Alert]:
+        return sorted(self.alerts.standing.values(), key=_alert_key)
+
+    def finish(self) -> tuple[list[Alert], SpeedAdvice | None]:
+        """The events held back for a later chunk, and the speed advice on the final state."""
+        held, self._held = self._held, []
+        return held, advise_or_none(self.estimator, Consequences(self.site, self.model, squeal_config(self.values)))
+
+
 def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
                threads: int = 0) -> BatchResult:
-    """Every model over ``passes`` for the site of the flat parameter ``values``.
-
-    estimator: a state to continue from (e.g. a checkpoint); default the post-grinding state.
-    threads: threads for the independent parts (squeal beside the corrugation history; the noise
-    chunks of every model), 0: one per core. numpy releases the interpreter lock in its array
-    loops, so the threads use the cores; the chunks are the same whatever the count, so the
-    results are too.
-    """
-    site = site_from_values(values)
-    margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
-    table, left_out = publishable(passes, margins)  # what the replayer sends
-    reasons = rejection_reasons(table, site)
-    est = estimator or CorrugationEstimator(site, corrugation_config(values))
-    reject_ahead(table.stamp_ns, reasons, est.newest_ns, margins)  # as every node of the graph does
-    accepted = with_class_defaults(table.take(reasons == ""), site)
-    model = RollingNoiseModel(site, noise_config(values))
-    with ThreadPoolExecutor(max_workers=threads or os.cpu_count() or 1) as pool:
-        squeal_job = pool.submit(predict_squeal, squeal_config(values), site, accepted)
-        traj = _history(est, accepted)
-        state_of_pass = state_index(traj.stamp_ns, traj.train_id.tolist(), accepted.stamp_ns,
-                                    accepted.train_id.tolist())
-        noise = _noise_on_states(pool, model, accepted, traj, state_of_pass)
-        squeal = squeal_job.result()
-    alerts = AlertManager(alert_config(values, est.cfg.lead_time_days))
-    events = _feed_alerts(alerts, table, reasons, accepted, squeal, traj, noise)
-    return BatchResult(site, table, reasons, accepted, squeal, traj, state_of_pass, noise, events,
-                       sorted(alerts.standing.values(), key=_alert_key),
-                       advise_or_none(est, Consequences(site, model, squeal_config(values))), est, model.receiver,
-                       left_out)
+    """Every model over the history ``passes`` for the site of the flat parameter ``values`` in one
+    call (estimator, threads: as for BatchRun)."""
+    run = BatchRun(values, estimator, threads)
+    out = run.feed(passes)
+    held, advice = run.finish()
+    return replace(out, alerts=out.alerts + held, advice=advice, left_out=run.left_out)
 
 
 def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:
@@ -107,14 +173,14 @@ def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:
                               for i in range(0, len(passes), HISTORY_CHUNK)])
 
 
-def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable, traj: Trajectory,
-                     state_of_pass: np.ndarray) -> dict[str, NoisePrediction]:
-    """Every model's noise of every accepted pass, each on its state (passes before any state on
-    none), as tasks of pool."""
+def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable,
+                     amplitude: np.ndarray, constants: StateSnapshot, state_of_pass: np.ndarray
+                     ) -> dict[str, NoisePrediction]:
+    """Every model's noise of every accepted pass, each on its state (row of amplitude; -1: passes
+    before any state, on none), as tasks of pool."""
     have = state_of_pass >= 0
-    c = traj.constants
     on_state = accepted.take(have)
-    state = Corrugation(c.bands, traj.amplitude[state_of_pass[have]], c.grinding_amplitude)
+    state = Corrugation(constants.bands, amplitude[state_of_pass[have]], constants.grinding_amplitude)
     jobs = {name: (_noise_chunks(pool, model, on_state, name, state),
                    None if have.all() else _noise_chunks(pool, model, accepted.take(~have), name))
             for name in model.models}
@@ -144,7 +210,8 @@ def _alert_key(a: Alert) -> tuple[int, int, str, bool]:
 
 def _feed_alerts(alerts: AlertManager, table: PassTable, reasons: np.ndarray, accepted: PassTable,
                  squeal: dict[str, np.ndarray], traj: Trajectory, noise: dict[str, NoisePrediction]) -> list[Alert]:
-    """The alert manager over each stream in its own order (streams do not interact), a stream at once."""
+    """The alert manager over each stream in its own order (streams do not interact), a stream at
+    once; the events."""
     alerts.on_train_passes(table.stamp_ns, reasons != "")
     alerts.on_squeal(accepted.stamp_ns, squeal["risk"])
     for name, out in noise.items():
@@ -152,48 +219,5 @@ def _feed_alerts(alerts: AlertManager, table: PassTable, reasons: np.ndarray, ac
     c, f = traj.constants, traj.forecast
     alerts.on_states(traj.stamp_ns, c.bands, traj.amplitude, c.threshold, f.days_to_threshold, f.grinding_due,
                      f.grinding_due_ns)
-    return sorted(alerts.events, key=_alert_key)
-
-
-# -- recording ----------------------------------------------------------------------------------
-def write_bag(result: BatchResult, folder: str | Path, namespace: str, compression: str = "zstd",
-              site: dict[str, str] | None = None) -> Path:
-    """Record the batch outputs as mcap_recorder records the live graph (log time = header stamp);
-    site: the site record stored with the bag (bagio.site_record), as the recorder stores it."""
-    ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
-    frame = result.site.site_id
-    stored = {"records": {SITE_RECORD: site}, "custom_data": custom_data(site)} if site else {}
-    with McapBagWriter(Path(folder), compression=compression, **stored) as bag:
-        for name, (typename, qos) in GRAPH_TOPICS.items():
-            bag.add_topic(f"{ns}/{name}", typename, [qos.as_metadata()])
-
-        def put(name: str, msg: dict[str, Any], stamp_ns: int) -> None:
-            bag.write(f"{ns}/{name}", serialize(GRAPH_TOPICS[name][0], msg), stamp_ns)
-
-        sent = [fields.train_pass_fields(result.passes.row(i), frame) for i in range(len(result.passes))]
-        by_accepted = [m for m, why in zip(sent, result.reasons, strict=True) if not why]
-        for msg, stamp in zip(sent, result.passes.stamp_ns.tolist(), strict=True):
-            put("train_pass", msg, max(stamp, 0))  # a log time cannot be before 1970
-        for i, msg in enumerate(by_accepted):
-            put("noise/squeal", fields.squeal_prediction_fields(result.squeal, i, msg["header"], msg["train_id"]),
-                int(result.accepted.stamp_ns[i]))
-        for k in range(len(result.trajectory)):
-            snap, fc = result.trajectory.state(k)
-            put("corrugation/state", fields.corrugation_state_fields(snap, fc, frame), snap.newest_ns)
-        for i, msg in enumerate(by_accepted):
-            for out in result.noise.values():
-                put("noise/rolling", fields.rolling_noise_fields(out, i, msg["header"], msg["train_id"],
-                                                                 result.receiver), int(result.accepted.stamp_ns[i]))
-        standing: dict[tuple[int, str], Alert] = {}
-        for a in result.alerts:
-            put("alerts", fields.wayside_alert_fields(a, frame), a.stamp_ns)
-            if a.active:
-                standing[(a.kind, a.key)] = a
-            else:
-                standing.pop((a.kind, a.key), None)
-            put("alerts/standing", fields.wayside_alert_array_fields(list(standing.values()), a.stamp_ns, frame),
-                a.stamp_ns)
-        if result.advice is not None:
-            stamp = result.estimator.newest_ns
-            put("speed_advisory", fields.speed_advisory_fields(result.advice, stamp, frame), stamp)
-    return Path(folder)
+    events, alerts.events = alerts.events, []
+    return events

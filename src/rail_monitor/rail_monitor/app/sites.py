@@ -84,23 +84,18 @@ def read_manifest(path: str | Path) -> list[SiteJob]:
 
 def run_site(job: SiteJob) -> SiteResult:
     """One site's batch run, recorded to its output (a task: imports inside, runs on a worker)."""
-    import math
-
-    from rail_monitor.app.batch import run_models, write_bag
-    from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.app.batch_bag import record_history
     from rail_monitor.bagio.site_record import site_record
     from rail_monitor.site_file import load_parameter_file
 
     t0 = time.monotonic()
     values = load_parameter_file(job.site)
-    result = run_models(read_passes(job.history), values)
     if job.output.exists():
         raise RailMonitorError(f"{job.output} exists: remove it or give another output")
-    write_bag(result, job.output, result.site.site_id, site=site_record(job.site))
-    days = float(result.trajectory.state(len(result.trajectory) - 1)[1].days_to_threshold) \
-        if len(result.trajectory) else math.inf
-    return SiteResult(result.site.site_id, str(job.output), len(result.passes), int((result.reasons != "").sum()),
-                      len(result.alerts), days, time.monotonic() - t0, _worker_name())
+    site_id = str(values.get("site_id", ""))
+    rec = record_history(job.history, values, job.output, site_id, site=site_record(job.site))
+    return SiteResult(site_id, str(job.output), rec.passes, rec.rejected, rec.alert_events, rec.days_to_threshold,
+                      time.monotonic() - t0, _worker_name())
 
 
 def _worker_name() -> str:

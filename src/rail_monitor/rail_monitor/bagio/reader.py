@@ -7,7 +7,7 @@ file and the cause; front ends print it without a traceback and exit non-zero.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Collection
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -99,9 +99,18 @@ def bag_info(path: str | Path) -> BagInfo:
 def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
     """Every TrainPass in a bag, in log-time order. topic: the topic to read (default: the one
     TrainPass topic; more than one is an error that lists them)."""
+    tables = list(iter_bag_passes(path, topic))
+    return PassTable.concat(tables) if tables else PassTable.from_rows([])
+
+
+def iter_bag_passes(path: str | Path, topic: str | None = None, chunk: int = 5_000) -> Iterator[PassTable]:
+    """The TrainPass messages of a bag (topic as for read_bag_passes) in log-time order, as tables of
+    ``chunk`` passes (the last may be shorter), so a long history is never held whole. The bag is
+    checked against its own index when opened, and its message count once every pass is read."""
     path = Path(path)
     reader = _open_bag(path)
     claims = _checked(path, reader)
+    n = 0
     try:
         conns = [c for c in reader.connections if (c.topic == topic if topic else c.msgtype == TRAIN_PASS)]
         if not conns:
@@ -114,15 +123,23 @@ def read_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
         names = sorted({c.topic for c in conns})
         if len(names) > 1:
             raise InputError(f"{path}: several TrainPass topics ({', '.join(names)}); choose one with --topic")
-        rows = [pass_row(reader.deserialize(raw, c.msgtype)) for c, _, raw in reader.messages(connections=conns)]
+        rows = []
+        for c, _, raw in reader.messages(connections=conns):
+            rows.append(pass_row(reader.deserialize(raw, c.msgtype)))
+            if len(rows) == chunk:
+                n += chunk
+                yield PassTable.from_rows(rows)
+                rows = []
+        n += len(rows)
+        claims.check_read({names[0]: n})
+        if rows:
+            yield PassTable.from_rows(rows)
     except RailMonitorError:
         raise
     except Exception as exc:
         raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
     finally:
         reader.close()
-    claims.check_read({names[0]: len(rows)})
-    return PassTable.from_rows(rows)
 
 
 def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, list[Any]]:

@@ -32,6 +32,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--overwrite", action="store_true",
                    help="replace an existing output folder that rail_monitor created")
     s.add_argument("--salvage", action="store_true", help=SALVAGE_HELP)
+    s.add_argument("--chunk", type=int, default=5_000,
+                   help="passes read, run and recorded at a time from a bag (memory: about 12 kB a pass; the "
+                   "outputs do not depend on it) (default: 5000)")
     s.add_argument("--skip-bad-rows", action="store_true",
                    help="CSV: leave malformed rows out (counted, their lines named) instead of failing")
     m = s.add_argument_group("many sites (a Dask cluster)")
@@ -49,29 +52,24 @@ def run(ns: argparse.Namespace) -> int:
         raise RailMonitorError("give a source, or --manifest for many sites (not both)")
     if ns.manifest:
         return _many_sites(ns)
-    from rail_monitor.app.batch import run_models, write_bag
-    from rail_monitor.bagio.reader import read_passes
+    if ns.chunk < 1:
+        raise RailMonitorError(f"--chunk must be a positive number of passes, not {ns.chunk}")
+    from rail_monitor.app.batch_bag import record_history
 
     t0 = time.monotonic()
     values = site_values(ns.site)
-    passes = read_passes(ns.source, ns.topic, skip_bad_rows=ns.skip_bad_rows, salvage=ns.salvage)
-    if ns.salvage:
-        print(printable(passes.salvage.line(ns.source)))
-    skipped = getattr(passes, "skipped_rows", [])
-    if skipped:
-        print(f"batch: {len(skipped)} malformed row(s) of {printable(ns.source)} left out: "
-              + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
     out = Path(ns.output) if ns.output else beside(ns.source, "_batch")
     fresh_output(out, ns.overwrite, [ns.source])
-    result = run_models(passes, values)
-    t_models = time.monotonic() - t0
-    write_bag(result, out, ns.namespace if ns.namespace is not None else str(values.get("site_id", "")),
-              site=stored_site(ns.site))
-    for why, n in result.left_out.items():
-        print(f"batch: {n} pass(es) left out: {why}")
-    print(f"batch: {len(passes)} passes through the models in {t_models:.2f} s "
-          f"({len(passes) / max(t_models, 1e-9):.0f} passes/s); recorded to {out} in "
-          f"{time.monotonic() - t0 - t_models:.1f} s")
+    rec = record_history(ns.source, values, out, ns.namespace if ns.namespace is not None else
+                         str(values.get("site_id", "")), stored_site(ns.site), ns.topic, ns.chunk, ns.skip_bad_rows,
+                         ns.salvage)
+    for line in rec.notes:
+        print(f"batch: {line}")
+    for why, count in rec.left_out.items():
+        print(f"batch: {count} pass(es) left out: {why}")
+    t = time.monotonic() - t0
+    print(f"batch: {rec.passes} passes through the models and recorded to {out} in {t:.2f} s "
+          f"({rec.passes / max(t, 1e-9):.0f} passes/s)")
     if not ns.no_report:
         print_report(str(out), ns.site, ns.report)
     return 0

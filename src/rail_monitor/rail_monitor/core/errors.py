@@ -11,3 +11,7 @@ class ConfigError(RailMonitorError):
 
 class InputError(RailMonitorError):
     """A history file (bag or CSV) cannot be read or does not hold usable train passes."""
+
+
+class PassOrderError(InputError):
+    """Passes given in chunks are not in time order (a chunk older than an earlier one)."""

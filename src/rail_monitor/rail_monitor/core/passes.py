@@ -239,13 +239,15 @@ def reject_ahead(stamp_ns: np.ndarray, reasons: np.ndarray, newest_ns: int, marg
     return newest
 
 
-def publishable(table: PassTable, margins: Any) -> tuple[PassTable, dict[str, int]]:
+def publishable(table: PassTable, margins: Any, newest_ns: int = 0) -> tuple[PassTable, dict[str, int]]:
     """What a pass source sends, in time order, and how many it leaves out, by reason: a stamp
     builtin_interfaces/Time cannot hold, or one too far ahead of the stream (margins as in
-    :func:`reject_ahead`; a replay at recorded timing would otherwise wait for it for years)."""
+    :func:`reject_ahead`; a replay at recorded timing would otherwise wait for it for years).
+    newest_ns: the newest pass sent before these (0: none)."""
     fits = fits_time_msg(table.stamp_ns)
     table = table.take(fits).sorted()
-    ahead, _ = ahead_of_stream(table.stamp_ns, table.stamp_ns > 0, 0, int(margins.max_ahead_of_stream_s * NS_PER_S))
+    ahead, _ = ahead_of_stream(table.stamp_ns, table.stamp_ns > 0, newest_ns,
+                               int(margins.max_ahead_of_stream_s * NS_PER_S))
     left_out = {"stamp not representable (builtin_interfaces/Time seconds are int32)": int((~fits).sum()),
                 ahead_reason(margins.max_ahead_of_stream_s, "stream"): int(ahead.sum())}
     return table.take(~ahead), {why: n for why, n in left_out.items() if n}

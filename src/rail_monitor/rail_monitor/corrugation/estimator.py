@@ -53,8 +53,11 @@ class CorrugationEstimator:
         self.last_survey_ns = 0                                        # last survey or grinding applied
         self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
         self.kept = KeptPasses()
-        # Running sums over the kept passes of axles x per-axle growth, and of axles (forecast).
-        self._growth_sum = np.zeros_like(self.log_components)
+        # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
+        # (B, P). A window's growth is a difference of two, so it is the same however the passes
+        # were split into calls (live backlogs, batch chunks).
+        self._growth_before = np.zeros((0, *self.log_components.shape))
+        self._growth_total = np.zeros_like(self.log_components)
         self._axle_sum = 0
 
     # -- passes ---------------------------------------------------------------------------------
@@ -72,8 +75,8 @@ class CorrugationEstimator:
         return self.tables.at(class_idx, friction, regime, speed) * axles[:, None, None]
 
     def _advance(self, passes: PassTable) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
-        """advance(), also returning ln Z after each counted pass and each one's log growth, both
-        (counted, B, P)."""
+        """advance(), also returning ln Z after each counted pass (counted, B, P) and the log growth
+        summed in counting order before each counted pass and after the last (counted + 1, B, P)."""
         counted = np.zeros(len(passes), bool)
         horizon = self.newest_ns - self.history_ns
         seen = self.kept.seen
@@ -85,15 +88,17 @@ class CorrugationEstimator:
             counted[i] = True
             horizon = max(horizon, stamp - self.history_ns)
         if not counted.any():
-            return counted, (np.zeros((0, *self.log_components.shape)), np.zeros((0, *self.log_components.shape)))
+            return counted, (np.zeros((0, *self.log_components.shape)), self._growth_total[None].copy())
         new = passes.take(counted)
         cls = self.tables.class_index(new.vehicle_class)
         contact = contact_state(self.site, new)
         growth = self._growth(cls, new.friction_state, contact.regime, new.speed_mps, new.axle_count)
-        # Sequential sum (cumsum), so a batch adds as the same passes one by one would.
+        # Sequential sums (cumsum), so a batch adds as the same passes one by one would.
         steps = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[1:]
         self.log_components = steps[-1].copy()
-        self._growth_sum += growth.sum(axis=0)
+        summed = np.cumsum(np.concatenate([self._growth_total[None], growth]), axis=0)
+        self._growth_before = np.concatenate([self._growth_before, summed[:-1]])
+        self._growth_total = summed[-1].copy()
         self._axle_sum += int(new.axle_count.sum())
         m = int(counted.sum())
         self.pass_count += m
@@ -106,7 +111,7 @@ class CorrugationEstimator:
                          regime=contact.regime.astype(np.int64), speed=new.speed_mps, axles=new.axle_count,
                          load=contact.load_n, creepage=contact.creepage)
         self._prune()
-        return counted, (steps, growth)
+        return counted, (steps, summed)
 
     def advance_history(self, passes: PassTable) -> Trajectory:
         """advance() over one pass or a history, returning the state and forecast after every
@@ -120,15 +125,13 @@ class CorrugationEstimator:
         k = self.kept
         if len(stamps) and (np.any(np.diff(stamps) < 0) or stamps[0] < self.newest_ns):
             return self._history_one_by_one(passes)
-        kept_growth = self._growth(k.class_idx, k.friction, k.regime, k.speed, k.axles)
-        kept_stamps, kept_axles = k.stamp_ns.copy(), k.axles.copy()
+        kept_stamps, kept_axles, kept_before = k.stamp_ns.copy(), k.axles.copy(), self._growth_before
         before = self.snapshot()
-        counted, (steps, new_growth) = self._advance(passes)
+        counted, (steps, summed) = self._advance(passes)
         new = passes.take(counted)
         m, k0 = len(new), len(kept_stamps)
         all_stamps = np.concatenate([kept_stamps, new.stamp_ns])
-        g_prefix = np.concatenate([np.zeros((1, *steps.shape[1:])), np.cumsum(
-            np.concatenate([kept_growth, new_growth]), axis=0)])
+        g_prefix = np.concatenate([kept_before, summed])
         a_prefix = np.concatenate([[0], np.cumsum(np.concatenate([kept_axles, new.axle_count]))])
         end = k0 + np.arange(1, m + 1)                                   # one past pass k
         start = np.searchsorted(all_stamps, new.stamp_ns - self.history_ns, side="left")
@@ -163,8 +166,7 @@ class CorrugationEstimator:
         k = self.kept
         gone = k.stamp_ns < self.newest_ns - self.history_ns
         if gone.any():
-            self._growth_sum -= np.einsum("n,nbp->bp", k.axles[gone], self.tables.at(
-                k.class_idx[gone], k.friction[gone], k.regime[gone], k.speed[gone]))
+            self._growth_before = self._growth_before[~gone]
             self._axle_sum -= int(k.axles[gone].sum())
             k.drop(gone)
 
@@ -174,11 +176,11 @@ class CorrugationEstimator:
         self.resum()
 
     def resum(self) -> None:
-        """Recompute the running sums from the kept passes (after K_b changes or a load)."""
+        """Recompute the growth sums from the kept passes (after K_b changes or a load)."""
         k = self.kept
-        self._growth_sum = np.einsum("n,nbp->bp", k.axles, self.tables.at(k.class_idx, k.friction, k.regime,
-                                                                          k.speed)) \
-            if len(k) else np.zeros_like(self.log_components)
+        summed = np.cumsum(np.concatenate([np.zeros((1, *self.log_components.shape)), self._growth(
+            k.class_idx, k.friction, k.regime, k.speed, k.axles)]), axis=0)
+        self._growth_before, self._growth_total = summed[:-1], summed[-1].copy()
         self._axle_sum = int(k.axles.sum())
 
     # -- state and forecast ---------------------------------------------------------------------
@@ -203,7 +205,7 @@ class CorrugationEstimator:
         """g per component (B, P) [1/axle pass]: the kept passes' growth, averaged per axle pass."""
         if self._axle_sum == 0:
             return np.zeros((len(self.bands), self.points))
-        return self._growth_sum / self._axle_sum
+        return (self._growth_total - self._growth_before[0]) / self._axle_sum
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic (see :func:`.forecast.traffic`)."""

@@ -1,0 +1,180 @@
+"""Recording batch outputs as mcap_recorder records the live graph: the same topics, types and QoS,
+log time = header stamp; chunk by chunk, so a long history is never held whole (no rclpy)."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rail_monitor.advice.plan import SpeedAdvice
+from rail_monitor.alerts.manager import Alert
+from rail_monitor.app.batch import BatchResult, BatchRun
+from rail_monitor.bagio import messages as fields
+from rail_monitor.bagio.cdr import serialize
+from rail_monitor.bagio.mcap_bag import McapBagWriter
+from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
+from rail_monitor.bagio.topics import GRAPH_TOPICS
+from rail_monitor.core.errors import PassOrderError
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.text import printable
+
+
+class BatchBag:
+    """A bag folder taking BatchRun's results one chunk at a time (``add``), then the held-back
+    events and the advice (``finish``). site: the site record stored with the bag
+    (bagio.site_record), as the recorder stores it."""
+
+    def __init__(self, folder: str | Path, namespace: str, frame: str, compression: str = "zstd",
+                 site: dict[str, str] | None = None) -> None:
+        self.ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
+        self.frame = frame
+        stored = {"records": {SITE_RECORD: site}, "custom_data": custom_data(site)} if site else {}
+        self.bag = McapBagWriter(Path(folder), compression=compression, **stored)
+        for name, (typename, qos) in GRAPH_TOPICS.items():
+            self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
+        self._standing: dict[tuple[int, str], Alert] = {}
+
+    def __enter__(self) -> BatchBag:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.bag.close()
+
+    def _put(self, name: str, msg: dict[str, Any], stamp_ns: int) -> None:
+        self.bag.write(f"{self.ns}/{name}", serialize(GRAPH_TOPICS[name][0], msg), stamp_ns)
+
+    def add(self, result: BatchResult) -> None:
+        """One chunk's passes and outputs, and its settled alert events."""
+        sent = [fields.train_pass_fields(result.passes.row(i), self.frame) for i in range(len(result.passes))]
+        by_accepted = [m for m, why in zip(sent, result.reasons, strict=True) if not why]
+        for msg, stamp in zip(sent, result.passes.stamp_ns.tolist(), strict=True):
+            self._put("train_pass", msg, max(stamp, 0))  # a log time cannot be before 1970
+        for i, msg in enumerate(by_accepted):
+            self._put("noise/squeal", fields.squeal_prediction_fields(result.squeal, i, msg["header"],
+                                                                      msg["train_id"]),
+                      int(result.accepted.stamp_ns[i]))
+        for k in range(len(result.trajectory)):
+            snap, fc = result.trajectory.state(k)
+            self._put("corrugation/state", fields.corrugation_state_fields(snap, fc, self.frame), snap.newest_ns)
+        for i, msg in enumerate(by_accepted):
+            for out in result.noise.values():
+                self._put("noise/rolling", fields.rolling_noise_fields(out, i, msg["header"], msg["train_id"],
+                                                                       result.receiver),
+                          int(result.accepted.stamp_ns[i]))
+        self._alerts(result.alerts)
+
+    def _alerts(self, events: list[Alert]) -> None:
+        for a in events:
+            self._put("alerts", fields.wayside_alert_fields(a, self.frame), a.stamp_ns)
+            if a.active:
+                self._standing[(a.kind, a.key)] = a
+            else:
+                self._standing.pop((a.kind, a.key), None)
+            self._put("alerts/standing", fields.wayside_alert_array_fields(list(self._standing.values()),
+                                                                           a.stamp_ns, self.frame), a.stamp_ns)
+
+    def finish(self, held: list[Alert], advice: SpeedAdvice | None, newest_ns: int) -> None:
+        """The events held back for a later chunk and the advice on the final state (stamped with its
+        newest pass)."""
+        self._alerts(held)
+        if advice is not None:
+            self._put("speed_advisory", fields.speed_advisory_fields(advice, newest_ns, self.frame), newest_ns)
+
+
+def write_bag(result: BatchResult, folder: str | Path, namespace: str, compression: str = "zstd",
+              site: dict[str, str] | None = None) -> Path:
+    """Record a whole history's outputs (run_models) in a new bag folder."""
+    with BatchBag(folder, namespace, result.site.site_id, compression, site) as bag:
+        bag.add(result)
+        bag.finish([], result.advice, result.estimator.newest_ns)
+    return Path(folder)
+
+
+@dataclass
+class Recorded:
+    """What a batch run recorded: passes read, rejected, alert events, the final forecast [day]
+    (inf: none), passes left out by reason, and lines for the user (what was skipped or salvaged)."""
+
+    passes: int = 0
+    rejected: int = 0
+    alert_events: int = 0
+    days_to_threshold: float = math.inf
+    left_out: dict[str, int] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+
+def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: str | Path, namespace: str,
+               site: dict[str, str] | None = None) -> Recorded:
+    """BatchRun over an iterable of PassTable chunks in time order, each recorded as it is done
+    (memory: one chunk's outputs)."""
+    run = BatchRun(values)
+    out = Recorded()
+    with BatchBag(folder, namespace, run.site.site_id, site=site) as bag:
+        for chunk in chunks:
+            result = run.feed(chunk)
+            bag.add(result)
+            out.passes += len(chunk)
+            out.rejected += int((result.reasons != "").sum())
+            out.alert_events += len(result.alerts)
+            if len(result.trajectory):
+                out.days_to_threshold = float(result.trajectory.forecast.days_to_threshold[-1])
+        held, advice = run.finish()
+        bag.finish(held, advice, run.estimator.newest_ns)
+    out.alert_events += len(held)
+    out.left_out = run.left_out
+    return out
+
+
+def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
+                   site: dict[str, str] | None = None, topic: str | None = None, chunk: int = 5_000,
+                   skip_bad_rows: bool = False, salvage: bool = False) -> Recorded:
+    """The batch run of a history file recorded to a new bag folder. A bag is read and recorded chunk
+    by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
+    time order is read whole and sorted. A run that fails leaves no output behind."""
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes
+
+    existed = folder.exists()
+    try:
+        if not (salvage or is_csv(Path(source))):
+            try:
+                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site)
+            except PassOrderError as exc:
+                note = f"{printable(str(source))}: {exc}; read whole to sort it"
+                _discard(folder, existed)
+                rec = _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage)
+                rec.notes.insert(0, note)
+                return rec
+        return _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage)
+    except BaseException:
+        _discard(folder, existed)
+        raise
+
+
+def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
+           site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool) -> Recorded:
+    from rail_monitor.bagio.reader import read_passes
+
+    passes = read_passes(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
+    notes = [printable(passes.salvage.line(source))] if salvage else []
+    skipped = getattr(passes, "skipped_rows", [])
+    if skipped:
+        notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "
+                     + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
+    rec = run_to_bag([passes], values, folder, namespace, site)
+    rec.notes = notes
+    return rec
+
+
+def _discard(folder: Path, existed: bool) -> None:
+    """Remove what this run wrote: the folder it made, or the files it put in an empty one."""
+    if not folder.exists():
+        return
+    if not existed:
+        shutil.rmtree(folder)
+        return
+    for f in folder.iterdir():
+        shutil.rmtree(f) if f.is_dir() else f.unlink()
