@@ -4,7 +4,8 @@ Run: ros2_ws/run python -m bench [--quick]
 
 Figures are measured side by side in this run only: compare ratios within a run, not absolute
 times across machines. Sections: the graph against its rclpy ceiling (the no-op graph of
-bench.bare_graph); batch mode at 1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
+bench.bare_graph); the live graph's start-up, idle CPU, CPU and latency (bench.live); batch mode at
+1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
 per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes
 (the graph, the recorder, and the streamed batch);
 many sites on a local Dask cluster of 1 and 2 workers.
@@ -25,6 +26,7 @@ import numpy as np
 from bench import batch as bb
 from bench import corrugation as bc
 from bench import graph as bg
+from bench import live as blive
 from bench import noise as bn
 from bench import recorder as br
 from bench import sites as bsites
@@ -164,6 +166,9 @@ def main() -> None:
             write_passes_bag(read_passes(ns.source).take(slice(0, 600)), Path(source), "")
         live_bag = tmp / "live"
         sections.append(("graph against its rclpy ceiling", graph_rows(source, ns.site, live_bag)))
+        sections.append(("live graph as a site runs it", blive.rows(ns.site, ns.source, [1.0, 20.0] if ns.quick
+                                                                     else [1.0, 100.0], 2.0 if ns.quick else 10.0,
+                                                                     2.0 if ns.quick else 10.0)))
         eq = bb.live_equality(str(live_bag), values)
         sections.append(("batch", [*batch_rows(values, sizes), (
             "batch against the live graph (same passes)", f"{eq['corrugation_rel']:.1e}",

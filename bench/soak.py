@@ -24,18 +24,10 @@ import numpy as np
 from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
-from bench.timing import header
+from bench.timing import header, rss_mb
 
 DAY_S = 86_400.0
 TRAINS_PER_HOUR = 4.0  # a flat profile: 96 trains a day at any hour
-
-
-def rss_mb(pid: int) -> float:
-    with open(f"/proc/{pid}/status") as f:
-        for line in f:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024.0
-    raise RuntimeError(f"no VmRSS for process {pid}")
 
 
 def folder_bytes(folder: Path) -> int:

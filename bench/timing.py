@@ -33,6 +33,15 @@ def header(name: str) -> None:
           f"numpy {np.__version__}")
 
 
+def rss_mb(pid: int | str = "self") -> float:
+    """Resident memory of a process now [MB] (VmRSS)."""
+    with open(f"/proc/{pid}/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    raise RuntimeError(f"no VmRSS for process {pid}")
+
+
 def peak_rss_mb(pid: int | str = "self") -> float:
     """Peak resident memory of a process [MB] (VmHWM: its own, unlike getrusage's ru_maxrss,
     which Linux carries over exec from whatever ran before in the process)."""

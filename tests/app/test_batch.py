@@ -98,7 +98,7 @@ def test_any_chunking_of_a_history_gives_the_one_call_outputs_alerts_included(si
     inside a run of equal stamps) give the one call's outputs bit for bit (exact equality)."""
     import numpy as np
 
-    from rail_monitor.app.batch import run_models
+    from rail_monitor.app.batch import BatchResult, run_models
 
     history = _hostile_history(sample_passes)
     whole = run_models(history, site_values)
@@ -110,21 +110,23 @@ def test_any_chunking_of_a_history_gives_the_one_call_outputs_alerts_included(si
     for cuts in (sorted({*rng.choice(len(history), 9, replace=False).tolist(), tie, tie}),
                  [tie, 1500, 1500, 3000], [1]):
         run, parts, held, advice = _chunked(history, site_values, cuts)
-        assert np.array_equal(np.concatenate([p.reasons for p in parts]), whole.reasons)
+        got = BatchResult.merged(parts, held, advice)
+        assert got.passes.equals(whole.passes) and got.accepted.equals(whole.accepted)
+        np.testing.assert_array_equal(got.reasons, whole.reasons)
         for k, col in whole.squeal.items():
-            np.testing.assert_array_equal(np.concatenate([p.squeal[k] for p in parts]), col, err_msg=k)
-        t = whole.trajectory
-        np.testing.assert_array_equal(np.concatenate([p.trajectory.amplitude for p in parts]), t.amplitude)
-        np.testing.assert_array_equal(np.concatenate([p.trajectory.forecast.grinding_due_ns for p in parts]),
-                                      t.forecast.grinding_due_ns)
-        np.testing.assert_array_equal(np.concatenate([p.trajectory.total_pass_count for p in parts]),
-                                      t.total_pass_count)
+            np.testing.assert_array_equal(got.squeal[k], col, err_msg=k)
+        a, b = whole.trajectory, got.trajectory
+        for name in ("index", "stamp_ns", "train_id", "amplitude", "pass_count", "axle_pass_count",
+                     "total_pass_count"):
+            np.testing.assert_array_equal(getattr(b, name), getattr(a, name), err_msg=name)
+        for name in ("growth_per_axle_pass", "worst_band", "passes_to_threshold", "days_to_threshold",
+                     "passes_per_day", "grinding_due", "grinding_due_ns"):
+            np.testing.assert_array_equal(getattr(b.forecast, name), getattr(a.forecast, name), err_msg=name)
         for model, out in whole.noise.items():
             for k, col in out.per_pass().items():
-                np.testing.assert_array_equal(np.concatenate([p.noise[model].per_pass()[k] for p in parts]), col,
-                                              err_msg=f"{model} {k}")
-        assert [a for p in parts for a in p.alerts] + held == whole.alerts
-        assert parts[-1].standing == whole.standing and run.left_out == whole.left_out
+                np.testing.assert_array_equal(got.noise[model].per_pass()[k], col, err_msg=f"{model} {k}")
+        assert got.alerts == whole.alerts and got.standing == whole.standing
+        assert got.left_out == whole.left_out == run.left_out
         assert advice.lines() == whole.advice.lines()
 
 

@@ -102,3 +102,23 @@ def test_node_publishes_both_models_rejects_bad_input_and_follows_the_corrugatio
     np.testing.assert_array_equal(first.lp_db, expected.lp_db[0])
     assert first.header.stamp == time_msg(_row(0)["stamp_ns"])
     assert list(first.component_names) == ["track", "vehicle", "superstructure"]
+
+
+def test_the_deadline_timer_runs_only_while_a_pass_waits_for_its_state(ros_context, site_values):
+    # Idle, the predictor has no timer to wake it: the deadline timer starts with a pass waiting for
+    # its corrugation state and stops once that pass is predicted (here at its state_wait_s deadline).
+    params = [Parameter(k, value=v) for k, v in site_values.items() if not k.startswith("simulator.")]
+    node = RollingNoisePredictor(context=ros_context, namespace="/curve_250",
+                                 parameter_overrides=[*params, Parameter("state_wait_s", value=0.3)])
+    probe = Probe(ros_context)
+    with spinning(ros_context, node, probe.node):
+        assert wait_until(lambda: probe.passes.get_subscription_count() >= 1)
+        assert node._waiting.is_canceled() and not node.pending
+        probe.passes.publish(to_msg(TrainPass, train_pass_fields(_row(0), "curve_250")))
+        assert wait_until(lambda: len(node.pending) == 1)  # the probe publishes states: the pass waits
+        assert not node._waiting.is_canceled()
+        assert wait_until(lambda: len(probe.noise) >= 2)
+        assert wait_until(lambda: node._waiting.is_canceled())
+        assert node.counts["predicted on the latest state (waited too long)"] == 1
+    node.destroy_node()
+    probe.node.destroy_node()

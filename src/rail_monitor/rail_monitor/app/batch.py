@@ -12,7 +12,7 @@ with the same outputs; :mod:`rail_monitor.app.batch_bag` records them as the liv
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from typing import Any
@@ -60,6 +60,24 @@ class BatchResult:
     estimator: CorrugationEstimator   # the state after these passes
     receiver: Any
     left_out: dict[str, int]          # passes the replayer would not send, by reason
+
+    @classmethod
+    def merged(cls, parts: Sequence[BatchResult], held: list[Alert], advice: SpeedAdvice | None) -> BatchResult:
+        """BatchRun's chunk results, in order, with what its finish() returned, as the one result of
+        the whole history (equal to run_models on it)."""
+        last = parts[-1]
+        starts = np.cumsum([0, *(len(p.accepted) for p in parts[:-1])]).tolist()
+        left_out: dict[str, int] = {}
+        for p in parts:
+            for why, n in p.left_out.items():
+                left_out[why] = left_out.get(why, 0) + n
+        return cls(last.site, PassTable.concat([p.passes for p in parts]), np.concatenate([p.reasons for p in parts]),
+                   PassTable.concat([p.accepted for p in parts]),
+                   {k: np.concatenate([p.squeal[k] for p in parts]) for k in last.squeal},
+                   Trajectory.concat(list(zip(starts, [p.trajectory for p in parts], strict=True))),
+                   {m: NoisePrediction.concat([p.noise[m] for p in parts]) for m in last.noise},
+                   [a for p in parts for a in p.alerts] + held, last.standing, advice, last.estimator, last.receiver,
+                   left_out)
 
 
 @dataclass

@@ -63,6 +63,10 @@ class GrowthTables:
     (X, C, B, V, P); ``set_k_b`` tabulates ln|1 + K_b F^2 H| averaged over X (C, 4, 2, B, V, P)
     for the K_b of each friction state, in partial slip (regime 0) and in full sliding (regime 1,
     K_b times -2/3 sliding_wear_ratio: :func:`rail_monitor.models.corrugation.sliding_wear_sensitivity`).
+
+    The table of the configured K_b is kept on disk (rail_monitor.core.cache, keyed by everything
+    it depends on), so a start-up loads it and never builds the kernel; the kernel is built, and
+    then kept, only when K_b changes (a survey).
     """
 
     def __init__(self, site: Site, cfg: CorrugationConfig) -> None:
@@ -70,28 +74,52 @@ class GrowthTables:
         self.bands = cg.wavelength_bands(cfg.shortest_wavelength_m, cfg.longest_wavelength_m)
         self.classes = list(site.vehicles)
         self.speeds = np.arange(1, round(MAX_SPEED_MPS / SPEED_STEP_MPS) + 1) * SPEED_STEP_MPS
-        sub = cg.band_sub_wavelengths(self.bands, cfg.points_per_band)
-        f_rail, r_rail = _rail_receptance(site.track)
-        freq = self.speeds[None, :, None] / sub[:, None, :]
-        kernels = []
+        self._sub = cg.band_sub_wavelengths(self.bands, cfg.points_per_band)
+        self._track = site.track
+        self._wheels = []  # per class: Hertz stiffness [N/m], semi-axis a [m], unsprung mass [kg]
         for name in self.classes:
             v = site.vehicle(name)
             patch = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
-            kc, a = float(patch.stiffness), float(patch.a)
-            h = cg.growth_kernel(kc, r_rail + tr.wheel_receptance(f_rail, v.unsprung_mass_kg)[:, None])
-            filt = hertzian_line_filter(sub, a)[:, None, :]
-            kernels.append([filt * filt * _interp_log(freq, f_rail, h[:, x]) for x in range(h.shape[1])])
-        self.filtered_kernel = np.stack(kernels, axis=1)  # (X, C, B, V, P)
+            self._wheels.append((float(patch.stiffness), float(patch.a), float(v.unsprung_mass_kg)))
+        self._kernel: np.ndarray | None = None
         self.table = np.empty(0)
         self.k_b = np.full(4, np.nan)
+        self._inputs = {"track": dataclasses.asdict(self._track), "wheels": self._wheels,
+                        "sub_wavelengths_m": self._sub.tolist(), "speeds_mps": [float(self.speeds[0]), SPEED_STEP_MPS,
+                                                                                len(self.speeds)],
+                        "positions": BAY_POSITIONS.tolist(), "receptance_points": RECEPTANCE_POINTS,
+                        "sliding_wear_ratio": self.sliding_wear_ratio}
+        self.set_k_b(cfg.k_b, cached=True)
 
-    def set_k_b(self, k_b: np.ndarray) -> None:
+    @property
+    def filtered_kernel(self) -> np.ndarray:
+        """F^2 H (X, C, B, V, P) [m/N], built on first use."""
+        if self._kernel is None:
+            f_rail, r_rail = _rail_receptance(self._track)
+            freq = self.speeds[None, :, None] / self._sub[:, None, :]
+            kernels = []
+            for kc, a, unsprung in self._wheels:
+                h = cg.growth_kernel(kc, r_rail + tr.wheel_receptance(f_rail, unsprung)[:, None])
+                filt = hertzian_line_filter(self._sub, a)[:, None, :]
+                kernels.append([filt * filt * _interp_log(freq, f_rail, h[:, x]) for x in range(h.shape[1])])
+            self._kernel = np.stack(kernels, axis=1)
+        return self._kernel
+
+    def set_k_b(self, k_b: np.ndarray, cached: bool = False) -> None:
         """Tabulate the growth for K_b per friction state (4,) [-/axle pass] in partial slip, and
-        the K_b in full sliding that follows from each."""
-        self.k_b = np.asarray(k_b, float).copy()
-        sliding = cg.sliding_wear_sensitivity(self.k_b, self.sliding_wear_ratio)
-        self.table = np.stack([np.stack([self._bay_mean(kb) for kb in pair], axis=1)
-                               for pair in zip(self.k_b, sliding, strict=True)], axis=1)
+        the K_b in full sliding that follows from each; cached: through the disk cache."""
+        k_b = np.asarray(k_b, float).copy()
+        if np.array_equal(k_b, self.k_b):
+            return
+        sliding = cg.sliding_wear_sensitivity(k_b, self.sliding_wear_ratio)
+
+        def build() -> dict[str, np.ndarray]:
+            return {"table": np.stack([np.stack([self._bay_mean(kb) for kb in pair], axis=1)
+                                       for pair in zip(k_b, sliding, strict=True)], axis=1)}
+
+        self.table = cached_arrays("corrugation_growth_table", {**self._inputs, "k_b": k_b.tolist()},
+                                   build)["table"] if cached else build()["table"]
+        self.k_b = k_b
 
     def _bay_mean(self, k_b: float) -> np.ndarray:
         """ln|1 + K_b F^2 H| averaged over the bay positions (C, B, V, P)."""

@@ -108,6 +108,9 @@ def params_files(argv: Sequence[str]) -> list[str]:
 # The --params-file arguments of this process's session, in order (the recorder stores the first
 # one, the site file, with its bag), and the shipped site file if the session added it.
 SESSION_PARAMS_FILES: list[str] = []
+# Guard-condition triggers that wake a spinning executor when the session is asked to stop.
+WAKERS: list[Callable[[], None]] = []
+IDLE_SPIN_TIMEOUT_S = 1.0  # the longest an idle spinner sleeps without work or a wake-up
 SESSION_DEFAULT_SITE: list[str] = []
 
 
@@ -143,6 +146,8 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
 
     def on_signal(*_: object) -> None:
         stop.set()
+        for wake in list(WAKERS):
+            wake()
         # A stop still under way after STOP_HANG_S is a hang in rcl or a node: every thread's stack
         # goes to stderr, to say where (the process goes on; a supervisor's kill ends it).
         faulthandler.dump_traceback_later(STOP_HANG_S, exit=False)
@@ -188,28 +193,38 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
             node = make()
             executor = SingleThreadedExecutor()
             executor.add_node(node)
-            spinner = None
             finished = threading.Event()
+            # The executor spins in a thread, waking for work or for this guard condition, not on a
+            # short timeout: idle, a node costs only its own timers. The main thread waits on the
+            # stop event, where signal handlers run at once.
+            wake = node.create_guard_condition(lambda: None)
+            WAKERS.append(wake.trigger)
+            spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()),
+                                       kwargs={"timeout_sec": IDLE_SPIN_TIMEOUT_S}, daemon=True)
             try:
                 def ok() -> bool:
                     return not stop.is_set() and rclpy.ok()
 
+                spinner.start()
                 job = getattr(node, "run", None)
                 if job is not None:
-                    spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()),
-                                               daemon=True)
-                    spinner.start()
                     job(ok)
                 else:
-                    spin_guarded(executor, ok)
+                    while ok() and spinner.is_alive():
+                        stop.wait(IDLE_SPIN_TIMEOUT_S)
+                    finished.set()
+                    wake.trigger()
+                    spinner.join()
                     drain = getattr(node, "drain", None)
                     if drain is not None and rclpy.ok():
                         drain(executor)
             finally:
                 finished.set()
-                shut_down(executor, 1.0)
-                if spinner is not None and spinner.is_alive():  # leave no thread inside rcl at exit
+                wake.trigger()
+                WAKERS.remove(wake.trigger)
+                if spinner.is_alive():  # leave no thread inside rcl at exit
                     spinner.join(timeout=5.0)
+                shut_down(executor, 1.0)
                 try:
                     close = getattr(node, "close", None)
                     if close is not None:

@@ -66,7 +66,9 @@ class RollingNoisePredictor(PassConsumerNode):
         self.states_rejected: Counter[str] = Counter()
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
         subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch)
-        wall_timer(self, 0.05, self._flush)
+        # Only while passes wait for their state: an idle predictor has no timer to wake it.
+        self._waiting = wall_timer(self, 0.05, self._flush)
+        self._waiting.cancel()
         self.listen()
 
     def key_parameters(self) -> dict[str, Any]:
@@ -93,7 +95,15 @@ class RollingNoisePredictor(PassConsumerNode):
         self._flush()
 
     def _flush(self) -> None:
-        """Predict the pending passes, in order, that have their state (or waited long enough)."""
+        """Predict the pending passes, in order, that have their state (or waited long enough); the
+        deadline timer runs while any is left."""
+        self._predict_ready()
+        if self.pending and self._waiting.is_canceled():
+            self._waiting.reset()
+        elif not self.pending and not self._waiting.is_canceled():
+            self._waiting.cancel()
+
+    def _predict_ready(self) -> None:
         if not self.pending:
             return
         now = time.monotonic()
