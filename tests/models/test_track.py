@@ -85,3 +85,29 @@ def test_wheel_receptance_is_a_mass_line():
     f = np.array([10.0, 100.0])
     r = tr.wheel_receptance(f, 600.0)
     np.testing.assert_allclose(r, -1.0 / (600.0 * (2 * np.pi * f) ** 2))
+
+
+_RECEPTANCE_BYTES = """
+import sys
+import numpy as np
+from rail_monitor.models import track as tr
+f = np.geomspace(20.0, 5000.0, 300)
+sys.stdout.write(tr.discrete_receptance(f, tr.Track(), position=[0.0, 0.25, 0.5]).tobytes().hex())
+"""
+
+
+def test_the_discrete_receptance_does_not_depend_on_the_maths_library_threads():
+    # The receptance is cached on disk and shared by every process of a site, so it must be the
+    # same bits whatever thread count the process that built it allowed OpenBLAS (its threaded
+    # LAPACK solve rounds differently: 5e-10 relative, measured on this 2-core machine).
+    import os
+    import subprocess
+    import sys
+
+    out = {}
+    for threads in ("1", "2"):
+        env = {**os.environ, "OPENBLAS_NUM_THREADS": threads, "OMP_NUM_THREADS": threads}
+        done = subprocess.run([sys.executable, "-c", _RECEPTANCE_BYTES], env=env, capture_output=True, text=True,
+                              timeout=120, check=True)
+        out[threads] = done.stdout
+    assert out["1"] and out["1"] == out["2"]

@@ -193,7 +193,13 @@ def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshe
     g_nn = _green(xn[None, :, None] - xn[None, None, :], per_f)            # (F, N, N)
     g_nf = _green(xn[None, :, None] - xf[None, None, :], per_f)            # (F, N, P)
     k = support_stiffness(f, track)
-    wn = np.linalg.solve(np.eye(supports)[None] + k[:, None, None] * g_nn, g_nf)  # support displacements per unit F
+    # One BLAS thread whatever the process allows: LAPACK's threaded solve rounds differently
+    # (5e-10 relative here), and the receptance, cached on disk and shared by every process of a
+    # site, must not depend on which process built it.
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        wn = np.linalg.solve(np.eye(supports)[None] + k[:, None, None] * g_nn, g_nf)  # support displacements per unit F
     out = _green(0.0, free)[:, None] - k[:, None] * np.einsum("fnp,fnp->fp", g_nf, wn)
     return out.reshape(np.shape(frequency) + np.shape(position))
 

@@ -1,0 +1,221 @@
+"""The live graph as a site runs it: start-up, idle CPU, CPU and latency with passes arriving one at a time.
+
+The graph is the separate-process layout of the launch file (corrugation_estimator,
+rolling_noise_predictor, squeal_risk_model, alert_manager, mcap_recorder, each its own process,
+on wall time), fed by a probe node in this process that publishes sample passes stamped now and
+listens to the outputs. Latency of a pass: from its publication to the arrival of its last output
+(the rolling noise of both models), as the probe sees them. CPU: user + system time of the graph's
+processes over the period, as a share of one core. Start-up: wayside_monitor (the one-process graph)
+on a one-pass history, from its spawn to the probe's receipt of its first output, with its
+resident memory then (its replayer waits for the probe's subscription, as for its own nodes').
+
+Run alone: ros2_ws/run python -m bench.live [--rate 100 --seconds 10]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import tempfile
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+import bench  # noqa: F401  (private DDS domain, one maths thread)
+from bench.timing import rss_mb
+
+MODEL_EXECUTABLES = ("corrugation_estimator", "rolling_noise_predictor", "squeal_risk_model", "alert_manager")
+TICKS = os.sysconf("SC_CLK_TCK")
+
+
+def cpu_s(pid: int) -> float:
+    """User + system CPU time of a process [s]."""
+    with open(f"/proc/{pid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / TICKS
+
+
+class Probe:
+    """A node publishing TrainPass and timing the outputs of each pass (wall clock, monotonic)."""
+
+    def __init__(self, passes: Any) -> None:
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+
+        from rail_monitor.bagio.messages import train_pass_fields
+        from rail_monitor.nodes.convert import TOPICS, to_msg
+
+        self.rclpy = rclpy
+        self.ctx = rclpy.Context()
+        rclpy.init(context=self.ctx, domain_id=int(os.environ["ROS_DOMAIN_ID"]))
+        self.node = rclpy.create_node("bench_probe", context=self.ctx)
+        cls, qos = TOPICS["train_pass"]
+        self.pub = self.node.create_publisher(cls, "train_pass", qos)
+        self._to_msg, self._fields, self._cls = to_msg, train_pass_fields, cls
+        self.passes = passes
+        self.sent: dict[str, float] = {}
+        self.outputs: dict[str, list[float]] = {}
+        self.first_output = 0.0
+        self.lock = threading.Lock()
+        for name in ("noise/rolling", "noise/squeal", "corrugation/state"):
+            c, q = TOPICS[name]
+            self.node.create_subscription(c, name, lambda m, n=name: self._on_output(n, m), q)
+        # Subscribed to train_pass too, so a replayer waiting for its subscribers waits for the probe.
+        self.node.create_subscription(cls, "train_pass", lambda m: None, qos)
+        self.executor = SingleThreadedExecutor(context=self.ctx)
+        self.executor.add_node(self.node)
+        self.thread = threading.Thread(target=self._spin, daemon=True)
+        self.thread.start()
+
+    def _spin(self) -> None:
+        while self.ctx.ok():
+            self.executor.spin_once(timeout_sec=0.05)
+
+    def _on_output(self, topic: str, msg: Any) -> None:
+        now = time.monotonic()
+        with self.lock:
+            self.first_output = self.first_output or now
+            if topic == "noise/rolling":
+                self.outputs.setdefault(msg.train_id, []).append(now)
+
+    def subscribers(self) -> int:
+        return self.pub.get_subscription_count()
+
+    def send(self, i: int) -> str:
+        """Publish sample pass i stamped now, under a fresh train id."""
+        row = self.passes.row(i % len(self.passes))
+        row["stamp_ns"] = time.time_ns()
+        row["train_id"] = f"probe-{i}"
+        msg = self._to_msg(self._cls, self._fields(row, "curve_250"))
+        with self.lock:
+            self.sent[row["train_id"]] = time.monotonic()
+        self.pub.publish(msg)
+        return row["train_id"]
+
+    def latencies_ms(self, ids: list[str], models: int = 2) -> np.ndarray:
+        """Per pass: publication to its last rolling noise output [ms] (NaN: incomplete)."""
+        with self.lock:
+            return np.array([1e3 * (self.outputs[t][models - 1] - self.sent[t])
+                             if len(self.outputs.get(t, [])) >= models else np.nan for t in ids])
+
+    def close(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.rclpy.shutdown(context=self.ctx)
+        self.thread.join(timeout=5)
+
+
+def _spawn(exe: str, site: str, *params: str) -> subprocess.Popen:
+    args = [exe, "--ros-args", "--params-file", site, "--log-level", "warn"]
+    for p in params:
+        args += ["-p", p]
+    return subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def start_up(site: str, probe: Probe, source: str, timeout_s: float = 60.0) -> dict[str, float]:
+    """wayside_monitor on a one-pass history: spawn to the probe's first output [s], its CPU time
+    [s] and resident memory [MB] then."""
+    with tempfile.TemporaryDirectory() as tmp:
+        probe.first_output = 0.0
+        t0 = time.monotonic()
+        proc = _spawn("wayside_monitor", site, f"source:={source}", f"output:={Path(tmp) / 'bag'}",
+                      "progress:=false", f"wait_for_subscribers:={len(MODEL_EXECUTABLES) + 2}")
+        try:
+            while not probe.first_output and time.monotonic() - t0 < timeout_s and proc.poll() is None:
+                time.sleep(0.002)
+            seconds = probe.first_output - t0 if probe.first_output else float("nan")
+            cpu, mem = (cpu_s(proc.pid), rss_mb(proc.pid)) if proc.poll() is None else (float("nan"),) * 2
+        finally:
+            proc.wait(timeout=timeout_s)
+    return {"seconds": seconds, "cpu_s": cpu, "rss_mb": mem}
+
+
+def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle_s: float) -> dict[str, Any]:
+    """The separate-process graph: idle CPU, then per rate CPU share and latency percentiles."""
+    with tempfile.TemporaryDirectory() as tmp:
+        procs = [_spawn(exe, site) for exe in MODEL_EXECUTABLES]
+        procs.append(_spawn("mcap_recorder", site, f"output:={Path(tmp) / 'bag'}"))
+        try:
+            t0 = time.monotonic()
+            while probe.subscribers() < len(MODEL_EXECUTABLES) + 2 and time.monotonic() - t0 < 60:
+                time.sleep(0.05)
+            warm = [probe.send(i) for i in range(3)]  # first outputs: lazy set-up paid before measuring
+            while np.isnan(probe.latencies_ms(warm)).any() and time.monotonic() - t0 < 120:
+                time.sleep(0.05)
+            time.sleep(2.0)
+            out: dict[str, Any] = {"processes": len(procs)}
+            c0 = sum(cpu_s(p.pid) for p in procs)
+            time.sleep(idle_s)
+            out["idle_core"] = (sum(cpu_s(p.pid) for p in procs) - c0) / idle_s
+            n = 3
+            for rate in rates:
+                ids, c0, t_start = [], sum(cpu_s(p.pid) for p in procs), time.monotonic()
+                count = max(int(rate * seconds), 1)
+                for k in range(count):
+                    delay = t_start + k / rate - time.monotonic()
+                    if delay > 0:
+                        time.sleep(delay)
+                    ids.append(probe.send(n))
+                    n += 1
+                t_end = time.monotonic() + 10.0
+                while np.isnan(probe.latencies_ms(ids)).any() and time.monotonic() < t_end:
+                    time.sleep(0.01)
+                wall = time.monotonic() - t_start
+                lat = probe.latencies_ms(ids)
+                out[rate] = {"core": (sum(cpu_s(p.pid) for p in procs) - c0) / wall, "passes": count,
+                             "p50_ms": float(np.nanpercentile(lat, 50)), "p95_ms": float(np.nanpercentile(lat, 95)),
+                             "lost": int(np.isnan(lat).sum())}
+                time.sleep(1.0)
+        finally:
+            for p in procs:
+                p.terminate()
+            for p in procs:
+                p.wait(timeout=60)
+    return out
+
+
+def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: float) -> list[tuple[str, str, str]]:
+    from rail_monitor.bagio.passes_bag import write_passes_bag
+    from rail_monitor.bagio.reader import read_passes
+
+    passes = read_passes(source).sorted()
+    probe = Probe(passes.take(slice(0, 2000)))
+    try:
+        with tempfile.TemporaryDirectory() as tmp:
+            one = write_passes_bag(passes.take(slice(0, 1)), Path(tmp) / "one", "curve_250")
+            cold = start_up(site, probe, str(one))  # the site's tables built, unless cached before
+            s = start_up(site, probe, str(one))
+        g = live_graph(site, probe, rates, seconds, idle_s)
+    finally:
+        probe.close()
+    out = [("wayside_monitor start-up to first output", f"{s['seconds']:.2f} s",
+            f"{s['cpu_s']:.1f} CPU-s, {s['rss_mb']:.0f} MB resident then; a one-pass history, the site's tables "
+            f"from the disk cache (the run before: {cold['seconds']:.2f} s)"),
+           (f"live graph idle ({g['processes']} processes)", f"{100 * g['idle_core']:.1f} % of a core",
+            f"over {idle_s:g} s with no passes")]
+    for rate in rates:
+        r = g[rate]
+        out.append((f"live graph, {rate:g} passes/s arriving one at a time", f"{100 * r['core']:.0f} % of a core",
+                    f"latency pass to last output p50 {r['p50_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms over "
+                    f"{r['passes']} passes" + (f"; {r['lost']} incomplete" if r["lost"] else "")))
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
+    ap.add_argument("--source", default="bags/sample")
+    ap.add_argument("--rates", default="1,100", help="passes per second, comma-separated")
+    ap.add_argument("--seconds", type=float, default=10.0, help="length of each rate's run [s]")
+    ap.add_argument("--idle", type=float, default=10.0, help="length of the idle measurement [s]")
+    ns = ap.parse_args()
+    for row in rows(ns.site, ns.source, [float(r) for r in ns.rates.split(",")], ns.seconds, ns.idle):
+        print(" | ".join(row))
+
+
+if __name__ == "__main__":
+    main()
