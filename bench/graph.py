@@ -30,6 +30,7 @@ def run_one(kind: str, source: str, site: str, output: str, executor: str = "sin
 
     args = ["bench", "--ros-args", "--params-file", site, "-p", f"source:={source}", "-p", f"output:={output}",
             "-p", "progress:=false", "-p", f"executor:={executor}", "-p", f"max_batch:={max_batch}",
+            "-p", "use_sim_time:=true",  # on pass time, as rail-monitor demo runs it (a history may end after today)
             "--log-level", "warn"]
     kw: dict[str, Any] = {}
     if kind == "bare":
