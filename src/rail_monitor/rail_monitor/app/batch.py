@@ -12,6 +12,7 @@ with the same outputs; :mod:`rail_monitor.app.batch_bag` records them as the liv
 from __future__ import annotations
 
 import os
+from collections import Counter
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, replace
@@ -67,17 +68,14 @@ class BatchResult:
         the whole history (equal to run_models on it)."""
         last = parts[-1]
         starts = np.cumsum([0, *(len(p.accepted) for p in parts[:-1])]).tolist()
-        left_out: dict[str, int] = {}
-        for p in parts:
-            for why, n in p.left_out.items():
-                left_out[why] = left_out.get(why, 0) + n
+        left_out = sum((Counter(p.left_out) for p in parts), Counter())
         return cls(last.site, PassTable.concat([p.passes for p in parts]), np.concatenate([p.reasons for p in parts]),
                    PassTable.concat([p.accepted for p in parts]),
                    {k: np.concatenate([p.squeal[k] for p in parts]) for k in last.squeal},
                    Trajectory.concat(list(zip(starts, [p.trajectory for p in parts], strict=True))),
                    {m: NoisePrediction.concat([p.noise[m] for p in parts]) for m in last.noise},
                    [a for p in parts for a in p.alerts] + held, last.standing, advice, last.estimator, last.receiver,
-                   left_out)
+                   dict(left_out))
 
 
 @dataclass
@@ -92,9 +90,7 @@ class _Tail:
     def then(self, traj: Trajectory) -> _Tail:
         stamps = np.concatenate([self.stamp_ns, traj.stamp_ns])
         trains = self.train_id + traj.train_id.tolist()
-        amp = np.concatenate([self.amplitude.reshape(len(self.stamp_ns), -1), traj.amplitude]) if len(
-            self.stamp_ns) else traj.amplitude
-        return _Tail(stamps, trains, amp)
+        return _Tail(stamps, trains, np.concatenate([self.amplitude, traj.amplitude]))
 
     def last_stamp(self) -> _Tail:
         keep = np.flatnonzero(self.stamp_ns == self.stamp_ns[-1]) if len(self.stamp_ns) else np.arange(0)
@@ -128,7 +124,7 @@ class BatchRun:
         self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
         self.newest_taken_ns = self.estimator.newest_ns  # the nodes' reference
         self.newest_ns = np.iinfo(np.int64).min          # newest stamp given so far (time order check)
-        self.left_out: dict[str, int] = {}
+        self.left_out: Counter[str] = Counter()
         self._tail = _Tail(np.zeros(0, np.int64), [], np.zeros((0, len(self.estimator.bands))))
         self._held: list[Alert] = []                     # events a later chunk may still precede
 
@@ -141,8 +137,7 @@ class BatchRun:
                              f"before {format_iso_ns(self.newest_ns)} of an earlier one")
         self.newest_ns = max(self.newest_ns, int(stamps.max(initial=self.newest_ns)))
         table, left_out = publishable(passes, self.margins, self.newest_sent_ns)
-        for why, n in left_out.items():
-            self.left_out[why] = self.left_out.get(why, 0) + n
+        self.left_out.update(left_out)
         self.newest_sent_ns = max(self.newest_sent_ns, int(table.stamp_ns.max(initial=0)))
         reasons = rejection_reasons(table, self.site)
         self.newest_taken_ns = reject_ahead(table.stamp_ns, reasons, self.newest_taken_ns, self.margins)
@@ -179,7 +174,7 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
     run = BatchRun(values, estimator, threads)
     out = run.feed(passes)
     held, advice = run.finish()
-    return replace(out, alerts=out.alerts + held, advice=advice, left_out=run.left_out)
+    return replace(out, alerts=out.alerts + held, advice=advice, left_out=dict(run.left_out))
 
 
 def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:

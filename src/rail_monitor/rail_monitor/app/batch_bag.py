@@ -125,7 +125,7 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
         held, advice = run.finish()
         bag.finish(held, advice, run.estimator.newest_ns)
     out.alert_events += len(held)
-    out.left_out = run.left_out
+    out.left_out = dict(run.left_out)
     return out
 
 

@@ -108,10 +108,10 @@ def params_files(argv: Sequence[str]) -> list[str]:
 # The --params-file arguments of this process's session, in order (the recorder stores the first
 # one, the site file, with its bag), and the shipped site file if the session added it.
 SESSION_PARAMS_FILES: list[str] = []
+SESSION_DEFAULT_SITE: list[str] = []
 # Guard-condition triggers that wake a spinning executor when the session is asked to stop.
 WAKERS: list[Callable[[], None]] = []
 IDLE_SPIN_TIMEOUT_S = 1.0  # the longest an idle spinner sleeps without work or a wake-up
-SESSION_DEFAULT_SITE: list[str] = []
 
 
 @contextlib.contextmanager
@@ -201,6 +201,13 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
             WAKERS.append(wake.trigger)
             spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()),
                                        kwargs={"timeout_sec": IDLE_SPIN_TIMEOUT_S}, daemon=True)
+
+            def stop_spinner() -> None:  # leave no thread inside rcl
+                finished.set()
+                wake.trigger()
+                if spinner.is_alive():
+                    spinner.join(timeout=5.0)
+
             try:
                 def ok() -> bool:
                     return not stop.is_set() and rclpy.ok()
@@ -212,18 +219,13 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
                 else:
                     while ok() and spinner.is_alive():
                         stop.wait(IDLE_SPIN_TIMEOUT_S)
-                    finished.set()
-                    wake.trigger()
-                    spinner.join()
+                    stop_spinner()
                     drain = getattr(node, "drain", None)
                     if drain is not None and rclpy.ok():
                         drain(executor)
             finally:
-                finished.set()
-                wake.trigger()
+                stop_spinner()
                 WAKERS.remove(wake.trigger)
-                if spinner.is_alive():  # leave no thread inside rcl at exit
-                    spinner.join(timeout=5.0)
                 shut_down(executor, 1.0)
                 try:
                     close = getattr(node, "close", None)
