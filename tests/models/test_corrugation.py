@@ -135,6 +135,20 @@ def test_passes_to_band_level_solves_the_energy_sum():
     assert cg.passes_to_band_level(x, g, np.log(1e-6))[0] == 0.0  # already past the level
 
 
+def test_a_bands_passes_to_level_do_not_depend_on_the_bands_solved_with_it(monkeypatch):
+    # Each band stops on its own, so one state alone, a whole history, any block size give the
+    # same bits: the exactness batch = live rests on it.
+    rng = np.random.default_rng(7)
+    x = np.log(rng.uniform(1e-7, 5e-6, (300, 4, 5)))
+    g = rng.normal(0, 1e-6, (300, 4, 5)) * rng.integers(0, 2, (300, 4, 1))
+    level = np.log(np.array([2e-6, 4e-6, 8e-6, 1.6e-5]))
+    whole = cg.passes_to_band_level(x, g, level)
+    assert np.isfinite(whole).any() and np.isinf(whole).any()
+    one_by_one = np.stack([cg.passes_to_band_level(x[i:i + 1], g[i:i + 1], level)[0] for i in range(300)])
+    monkeypatch.setattr(cg, "BAND_BLOCK", 7)
+    assert np.array_equal(one_by_one, whole) and np.array_equal(cg.passes_to_band_level(x, g, level), whole)
+
+
 def test_band_limits_share_each_range_equally():
     # Grassie, Saxon & Smith (1999): a range whose bands all sit at their limit has the range's r.m.s.
     bands = cg.wavelength_bands(0.01, 1.0)

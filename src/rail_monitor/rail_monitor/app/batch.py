@@ -121,6 +121,7 @@ class BatchRun:
         self.model = RollingNoiseModel(self.site, noise_config(values))
         self.alerts = AlertManager(alert_config(values, self.estimator.cfg.lead_time_days))
         self.threads = threads or os.cpu_count() or 1
+        self.estimator.threads = self.threads
         self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
         self.newest_taken_ns = self.estimator.newest_ns  # the nodes' reference
         self.newest_ns = np.iinfo(np.int64).min          # newest stamp given so far (time order check)

@@ -53,6 +53,7 @@ class CorrugationEstimator:
         self.last_survey_ns = 0                                        # last survey or grinding applied
         self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
         self.kept = KeptPasses()
+        self.threads = 1  # threads a history's forecasts may use (batch: its own setting)
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
         # (B, P). A window's growth is a difference of two, so it is the same however the passes
         # were split into calls (live backlogs, batch chunks).
@@ -231,4 +232,4 @@ class CorrugationEstimator:
     def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
                    newest_ns: np.ndarray) -> Forecast:
         return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
-                              self.cfg.lead_time_days, self.site.mean_axles_per_train)
+                              self.cfg.lead_time_days, self.site.mean_axles_per_train, self.threads)

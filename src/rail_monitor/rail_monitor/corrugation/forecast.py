@@ -7,6 +7,8 @@ days = train passes / train passes per day (docs/models.md, "Grinding forecast")
 
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from rail_monitor.core.timeutil import NS_PER_DAY
@@ -17,19 +19,21 @@ from rail_monitor.models import corrugation as cg
 # Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
 # passes nearly balancing the others) can be 1e12 days away, past any 64-bit time stamp.
 MAX_DATED_DAYS = 36_525.0
+PARALLEL_MIN_STATES = 2_000  # fewer states per thread cost more to hand over than they save
 
 
 def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
               newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
-              fallback_axles: float) -> Forecast:
+              fallback_axles: float, threads: int = 1) -> Forecast:
     """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
     day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
     band thresholds (B,) [m]; a Forecast of arrays (grinding_due_ns 0: no date, the forecast
-    being infinite or beyond MAX_DATED_DAYS)."""
+    being infinite or beyond MAX_DATED_DAYS). threads: the states' root finding split over this
+    many threads (each band's root is found on its own, so the split changes no bit)."""
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
     log_threshold = np.log(threshold)
     margin = log_threshold - np.log(cg.band_amplitude(log_components))
-    axle_passes = cg.passes_to_band_level(log_components, growth, log_threshold)
+    axle_passes = _passes_to_level(log_components, growth, log_threshold, threads)
     rows = np.arange(len(rate))
     worst = np.where(np.isfinite(axle_passes).any(axis=1), np.argmin(axle_passes, axis=1),
                      np.argmin(margin, axis=1))
@@ -41,6 +45,18 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     due_ns = np.array([int(t) + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0
                        for t, d in zip(newest_ns.tolist(), days.tolist(), strict=True)], np.int64)
     return Forecast(growth.max(axis=2), worst, passes, days, rate, due, due_ns)
+
+
+def _passes_to_level(log_components: np.ndarray, growth: np.ndarray, log_threshold: np.ndarray,
+                     threads: int) -> np.ndarray:
+    parts = min(threads, len(log_components) // PARALLEL_MIN_STATES)
+    if parts <= 1:
+        return cg.passes_to_band_level(log_components, growth, log_threshold)
+    bounds = np.linspace(0, len(log_components), parts + 1).astype(int)
+    with ThreadPoolExecutor(parts) as pool:  # numpy's ufuncs release the GIL
+        done = pool.map(lambda lo, hi: cg.passes_to_band_level(log_components[lo:hi], growth[lo:hi], log_threshold),
+                        bounds[:-1], bounds[1:])
+        return np.concatenate(list(done))
 
 
 def single(fc: Forecast) -> Forecast:

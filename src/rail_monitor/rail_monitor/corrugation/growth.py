@@ -82,7 +82,7 @@ class GrowthTables:
             patch = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
             self._wheels.append((float(patch.stiffness), float(patch.a), float(v.unsprung_mass_kg)))
         self._kernel: np.ndarray | None = None
-        self.table = np.empty(0)
+        self.table = self._by_speed = np.empty(0)
         self.k_b = np.full(4, np.nan)
         self._inputs = {"track": dataclasses.asdict(self._track), "wheels": self._wheels,
                         "sub_wavelengths_m": self._sub.tolist(), "speeds_mps": [float(self.speeds[0]), SPEED_STEP_MPS,
@@ -119,6 +119,7 @@ class GrowthTables:
 
         self.table = cached_arrays("corrugation_growth_table", {**self._inputs, "k_b": k_b.tolist()},
                                    build)["table"] if cached else build()["table"]
+        self._by_speed = np.ascontiguousarray(np.moveaxis(self.table, 4, 3))  # (C, F, R, V, B, P)
         self.k_b = k_b
 
     def _bay_mean(self, k_b: float) -> np.ndarray:
@@ -140,4 +141,5 @@ class GrowthTables:
         w = (x - j)[:, None, None]
         fi = np.asarray(friction, np.int64) - 1
         ri = np.asarray(regime, np.int64)
-        return (1.0 - w) * self.table[class_idx, fi, ri, :, j, :] + w * self.table[class_idx, fi, ri, :, j + 1, :]
+        t = self._by_speed  # one contiguous (B, P) block per pass and speed
+        return (1.0 - w) * t[class_idx, fi, ri, j] + w * t[class_idx, fi, ri, j + 1]

@@ -153,6 +153,9 @@ def band_amplitude(log_components: ArrayLike) -> FloatArray:
     return np.exp(top[..., 0] + 0.5 * np.log(np.sum(np.exp(2.0 * (x - top)), axis=-1)))
 
 
+BAND_BLOCK = 16384  # bands evaluated together: (P, BAND_BLOCK) arrays stay in cache
+
+
 def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level: ArrayLike) -> FloatArray:
     """Passes n [-] until a band's r.m.s. reaches a level: sum_p Z_p^2 exp(2 g_p n) = Z_level^2.
 
@@ -162,28 +165,37 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
     reaches the level (at or beyond the root) converges to the root monotonically from above.
 
     Evaluated component-major ((P, bands) arrays, so the sums over components are row
-    additions, not reductions over a short last axis) and only on the bands not yet converged
-    (a band that took no step takes none again), with the same arithmetic per band as a plain
-    evaluation of every band.
+    additions, not reductions over a short last axis), in blocks of BAND_BLOCK bands that stay in
+    cache, and only on the bands not yet converged. Each band stops on its own (its step no more
+    than 1e-12 of its n, or none), so a band's result does not depend on which bands it is
+    evaluated with: one state or a whole history, any chunking, give the same bits.
     """
     x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
     shape = x.shape[:-1]
     p = x.shape[-1]
     xs = np.ascontiguousarray(x.reshape(-1, p).T)  # (P, M)
     gs = np.ascontiguousarray(g.reshape(-1, p).T)
-    target = np.broadcast_to(np.asarray(log_level, float), shape).reshape(-1)
+    target = np.ascontiguousarray(np.broadcast_to(np.asarray(log_level, float), shape).reshape(-1))
+    n = np.empty(target.shape)
+    for lo in range(0, len(target), BAND_BLOCK):
+        cols = slice(lo, lo + BAND_BLOCK)
+        n[cols] = _passes_to_level(xs[:, cols], gs[:, cols], target[cols])
+    return n.reshape(shape)
 
-    def excess(idx: np.ndarray | slice, n: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """ln(band r.m.s.) - ln(level) after n passes, and its slope in n, for bands idx."""
-        gi = gs[:, idx]
-        e = 2.0 * (xs[:, idx] + gi * n)
-        top = e.max(axis=0)
-        w = np.exp(e - top)
-        total = w.sum(axis=0)
-        return 0.5 * (top + np.log(total)) - target[idx], (w * gi).sum(axis=0) / total
 
+def _excess(x: FloatArray, g: FloatArray, target: FloatArray, n: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """ln(band r.m.s.) - ln(level) after n passes, and its slope in n, for (P, M) components."""
+    e = 2.0 * (x + g * n)
+    top = e.max(axis=0)
+    w = np.exp(e - top)
+    total = w.sum(axis=0)
+    return 0.5 * (top + np.log(total)) - target, (w * g).sum(axis=0) / total
+
+
+def _passes_to_level(xs: FloatArray, gs: FloatArray, target: FloatArray) -> FloatArray:
+    """passes_to_band_level of (P, M) components (Newton from the fastest component's n)."""
     grows = (gs > 0).any(axis=0)
-    at_level = excess(slice(None), np.zeros(target.shape))[0] >= 0
+    at_level = _excess(xs, gs, target, np.zeros(target.shape))[0] >= 0
     with np.errstate(divide="ignore", invalid="ignore"):
         alone = np.where(gs > 0, (target - xs) / gs, np.inf)
     n = np.where(grows & ~at_level, alone.min(axis=0), 0.0)
@@ -191,13 +203,11 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
     for _ in range(200):
         if not len(active):
             break
-        f, df = excess(active, n[active])
+        f, df = _excess(xs[:, active], gs[:, active], target[active], n[active])
         step = np.where(f > 0, f / np.where(df > 0, df, np.inf), 0.0)
         n[active] -= step
-        if np.all(step <= 1e-12 * np.maximum(n[active], 1.0)):
-            break
-        active = active[step != 0.0]  # a band with no step keeps its n: it needs no more evaluation
-    return np.where(at_level, 0.0, np.where(grows, n, np.inf)).reshape(shape)
+        active = active[step > 1e-12 * np.maximum(n[active], 1.0)]
+    return np.where(at_level, 0.0, np.where(grows, n, np.inf))
 
 
 # Post-grinding acceptance limits of Grassie, Saxon & Smith (1999), r.m.s. roughness per
