@@ -126,33 +126,60 @@ class PassBy:
     pass_by_time_s: FloatArray   # Tp = L / v [s]
 
 
+@dataclass(frozen=True)
+class PassGeometry:
+    """What pass-by levels need of the passes, the bands and the receiver, whatever the spectrum:
+    computed once per set of passes and shared by every component and model radiated on them."""
+
+    length: FloatArray   # train length per pass [m]
+    speed: FloatArray    # speed per pass [m/s]
+    d: float             # horizontal distance [m]
+    r1: float            # direct path distance [m]
+    r2: float            # image path distance [m]
+    k1: FloatArray       # kernel window mean of the direct path per pass (passes, 1) [1/m]
+    k2: FloatArray       # the same for the image path [1/m]
+    total1: float        # kernel total of the direct path [1/m]
+    total2: float        # of the image path [1/m]
+    a_weight: FloatArray  # A-weighting of each band as a power ratio [-]
+    ground_reflection: float
+
+
+def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, receiver: Receiver) -> PassGeometry:
+    """The PassGeometry of passes of these lengths [m] and speeds [m/s] (IEC 61260-1 band numbers)."""
+    length = np.atleast_1d(np.asarray(length_m, float))
+    d = receiver.distance_m
+    (r1, _), (r2, _) = receiver.paths()
+    return PassGeometry(length, np.atleast_1d(np.asarray(speed_mps, float)), d, r1, r2,
+                        kernel_window_mean(length, d, r1)[:, None], kernel_window_mean(length, d, r2)[:, None],
+                        kernel_total(d, r1), kernel_total(d, r2), power(a_weighted(0.0, band)),
+                        receiver.ground_reflection)
+
+
 def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike,
-            receiver: Receiver, direct_correction_db: ArrayLike = 0.0, time_weighted: bool = True) -> PassBy:
+            receiver: Receiver, direct_correction_db: ArrayLike = 0.0, time_weighted: bool = True,
+            geometry: PassGeometry | None = None) -> PassBy:
     """Pass-by levels of trains with band sound power per metre [dB re 1 pW/m] (passes x bands).
 
     length_m, speed_mps: per pass [m], [m/s]. band: IEC 61260-1 band numbers. direct_correction_db:
     per band, added to the direct path only (CNOSSOS-EU's vertical directivity of source A).
-    time_weighted: compute LpAFmax (the costly part; NaN without it).
+    time_weighted: compute LpAFmax (the costly part; NaN without it). geometry: pass_geometry of
+    the same bands, passes and receiver, when it is already at hand.
     """
+    g = geometry or pass_geometry(band, length_m, speed_mps, receiver)
     lw = np.atleast_2d(np.asarray(lw_per_metre_db, float))
-    length = np.atleast_1d(np.asarray(length_m, float))
-    speed = np.atleast_1d(np.asarray(speed_mps, float))
-    d = receiver.distance_m
-    (r1, _), (r2, _) = receiver.paths()
     w_direct = power(lw + np.asarray(direct_correction_db, float))     # per band, direct path
-    w_image = receiver.ground_reflection * power(lw)
-    k1, k2 = kernel_window_mean(length, d, r1)[:, None], kernel_window_mean(length, d, r2)[:, None]
-    lp = level(w_direct * k1 + w_image * k2)
-    tel_band = level(w_direct * kernel_total(d, r1) + w_image * kernel_total(d, r2))
-    a = power(a_weighted(0.0, band))
-    fmax = level(_f_weighted_peak(np.sum(w_direct * a, axis=-1), np.sum(w_image * a, axis=-1), length, speed,
-                                  d, r1, r2)) if time_weighted else np.full(len(length), np.nan)
+    w_image = g.ground_reflection * power(lw)
+    lp = level(w_direct * g.k1 + w_image * g.k2)
+    tel_band = level(w_direct * g.total1 + w_image * g.total2)
+    a = g.a_weight
+    fmax = level(_f_weighted_peak(np.sum(w_direct * a, axis=-1), np.sum(w_image * a, axis=-1), g.length, g.speed,
+                                  g.d, g.r1, g.r2)) if time_weighted else np.full(len(g.length), np.nan)
     return PassBy(
         lp_db=lp,
         lpaeq_tp_dba=level(np.sum(power(lp) * a, axis=-1)),
         tel_dba=level(np.sum(power(tel_band) * a, axis=-1)),
         lpafmax_dba=fmax,
-        pass_by_time_s=length / speed,
+        pass_by_time_s=g.length / g.speed,
     )
 
 

@@ -36,7 +36,7 @@ from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
-from rail_monitor.models.passby import PassBy, pass_by
+from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
 from rail_monitor.noise.config import MODELS, NoiseConfig
 
 # What roughness_growth_increase_db is measured against, for every label that shows it.
@@ -188,17 +188,18 @@ class RollingNoiseModel:
         filter_db = None if model == "cnossos" else level(wrn.contact_filter_power(
             passes.speed_mps, self.band, contact_state(self.site, passes).patch.a, self.cfg.band_points))
         roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filter_db)
-        pb = self._pass_by(components, passes)
+        geometry = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver)
+        pb = self._pass_by(components, geometry)
         names = list(components)
         growth = np.zeros(len(passes))
         if corrugation is not None:
             _, ground = self._sources(self.baseline_db, passes, model, filter_db)
-            growth = pb.lpaeq_tp_dba - self._pass_by(ground, passes, False).lpaeq_tp_dba
+            growth = pb.lpaeq_tp_dba - self._pass_by(ground, geometry, False).lpaeq_tp_dba
         return NoisePrediction(
             model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
             lp_db=pb.lp_db, lw_db=_total(components), roughness_db=roughness, pass_by_time_s=pb.pass_by_time_s,
             lpaeq_tp_dba=pb.lpaeq_tp_dba, lpafmax_dba=pb.lpafmax_dba, tel_dba=pb.tel_dba,
-            component_lpaeq_dba=np.stack([self._pass_by({c: components[c]}, passes, False).lpaeq_tp_dba
+            component_lpaeq_dba=np.stack([self._pass_by({c: components[c]}, geometry, False).lpaeq_tp_dba
                                           for c in names], axis=-1),
             roughness_growth_increase_db=growth)
 
@@ -223,9 +224,10 @@ class RollingNoiseModel:
                 components[comp][rows] = lr + lh + per_metre[rows]
         return roughness, components
 
-    def _pass_by(self, components: dict[str, np.ndarray], passes: PassTable, time_weighted: bool = True) -> PassBy:
-        return pass_by(_total(components), self.band, passes.train_length_m, passes.speed_mps, self.receiver,
-                       self.vertical_db, time_weighted)
+    def _pass_by(self, components: dict[str, np.ndarray], geometry: PassGeometry, time_weighted: bool = True
+                 ) -> PassBy:
+        return pass_by(_total(components), self.band, geometry.length, geometry.speed, self.receiver,
+                       self.vertical_db, time_weighted, geometry)
 
     def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray, model: str,
                    filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
