@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -15,7 +16,7 @@ from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.reader import read_bag_passes, salvage_mcap
 
-from conftest import SAMPLE, TOP, run_cmd
+from conftest import SAMPLE, TOP, run_cmd, wait_until
 
 FIVE_DAYS = str(5 * 86400.0)
 
@@ -217,3 +218,34 @@ def test_a_model_node_started_bare_reads_the_shipped_site():
     assert "curve_250.yaml (shipped; no --params-file given)" in text, text
     assert "classes=emu/dmu/freight" in text, text
     assert p.returncode == 0
+
+
+def test_the_executables_executor_answers_at_once_when_idle_and_takes_a_burst_in_one_go(ros_context):
+    # CoalescingExecutor (every single-node executable): a first message after idling is handled
+    # at once; after a wake-up with work it pauses before waiting again, so messages arriving in
+    # that pause reach one callback together (take_queued) instead of one wake-up each.
+    from rclpy.node import Node
+    from std_msgs.msg import String
+
+    from rail_monitor.nodes.base import subscribe_batched
+    from rail_monitor.nodes.process import CoalescingExecutor
+
+    node = Node("coalescing_probe", context=ros_context)
+    batches: list[list[str]] = []
+    subscribe_batched(node, String, "burst", lambda msgs: batches.append([m.data for m in msgs]), 10, 10)
+    pub = node.create_publisher(String, "burst", 10)
+    ex = CoalescingExecutor(coalesce_s=0.3, context=ros_context)
+    ex.add_node(node)
+    try:
+        assert wait_until(lambda: pub.get_subscription_count() == 1)
+        pub.publish(String(data="a"))
+        t = time.monotonic()
+        ex.spin_once(timeout_sec=2.0)
+        assert batches == [["a"]] and time.monotonic() - t < 0.3
+        threading.Timer(0.05, lambda: [pub.publish(String(data=x)) for x in "bc"]).start()
+        t = time.monotonic()
+        ex.spin_once(timeout_sec=2.0)
+        assert batches == [["a"], ["b", "c"]] and time.monotonic() - t >= 0.3
+    finally:
+        ex.shutdown()
+        node.destroy_node()

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rail_monitor.noise.state_of_pass import state_arrived, state_index
+from rail_monitor.noise.state_of_pass import first_state_needed, state_arrived, state_index
 
 
 def _scan(states, stamp, train):
@@ -37,6 +37,23 @@ def test_the_vectorised_rule_equals_the_scan(seed):
     assert got.tolist() == want
     arrived = state_arrived(stamps, trains, pass_stamp, pass_train)
     assert arrived.tolist() == [_scan_arrived(states, int(s), t) for s, t in zip(pass_stamp, pass_train, strict=True)]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_states_from_the_first_needed_give_the_same_answers_as_all(seed):
+    # The live predictor looks only at the states from first_state_needed of its earliest pending pass.
+    rng = np.random.default_rng(seed)
+    stamps = np.sort(rng.integers(0, 40, 60))
+    trains = [f"T{int(x)}" for x in rng.integers(0, 4, 60)]
+    for earliest in (-3, 0, 7, 20, 39, 50):
+        first = first_state_needed(stamps.tolist(), earliest)
+        pass_stamp = rng.integers(earliest, 55, 50)
+        pass_train = [f"T{int(x)}" for x in rng.integers(0, 5, 50)]
+        full = state_index(stamps, trains, pass_stamp, pass_train)
+        tail = state_index(stamps[first:], trains[first:], pass_stamp, pass_train)
+        assert np.array_equal(np.where(tail >= 0, tail + first, -1), full)
+        assert np.array_equal(state_arrived(stamps[first:], trains[first:], pass_stamp, pass_train),
+                              state_arrived(stamps, trains, pass_stamp, pass_train))
 
 
 def test_cases_by_name():

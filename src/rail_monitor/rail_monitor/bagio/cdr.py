@@ -75,6 +75,10 @@ def _string(buf: bytearray, value: str) -> None:
     buf += b"\x00"
 
 
+def _string_field(name: str, buf: bytearray, fields: Mapping[str, Any]) -> None:
+    _string(buf, fields.get(name, ""))
+
+
 def _array_encoder(name: str, item: tuple[Any, Any], length: int | None) -> Encoder:
     """A fixed array (length) or a sequence (None) of base types, strings or messages."""
     kind, detail = item
@@ -109,6 +113,10 @@ def _array_encoder(name: str, item: tuple[Any, Any], length: int | None) -> Enco
     return items
 
 
+def _nested(name: str, sub: Encoder) -> Encoder:
+    return lambda buf, f: sub(buf, f.get(name, {}))
+
+
 @functools.cache
 def _encoder(typename: str) -> Encoder:
     """The compiled encoder of a type: appends one message's CDR (no header) to a buffer."""
@@ -127,9 +135,9 @@ def _encoder(typename: str) -> Encoder:
             continue
         run = None
         if kind == Nodetype.BASE:
-            steps.append(lambda buf, f, n=name: _string(buf, f.get(n, "")))
+            steps.append(functools.partial(_string_field, name))
         elif kind == Nodetype.NAME:
-            steps.append(lambda buf, f, n=name, sub=_encoder(detail): sub(buf, f.get(n, {})))
+            steps.append(_nested(name, _encoder(detail)))
         else:
             steps.append(_array_encoder(name, detail[0], detail[1] if kind == Nodetype.ARRAY else None))
 

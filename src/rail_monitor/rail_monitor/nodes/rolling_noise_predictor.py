@@ -16,6 +16,7 @@ interleave, and equals batch mode. A pass that waits too long takes the latest s
 
 from __future__ import annotations
 
+import itertools
 import sys
 import time
 from collections import Counter, deque
@@ -35,7 +36,7 @@ from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
-from rail_monitor.noise.state_of_pass import state_arrived, state_index
+from rail_monitor.noise.state_of_pass import first_state_needed, state_arrived, state_index
 from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
 
 STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass queue is as deep)
@@ -60,6 +61,7 @@ class RollingNoisePredictor(PassConsumerNode):
         self.wait_s = declare(self, PREDICTOR_SPECS)["state_wait_s"]
         self.model = RollingNoiseModel(self.site, cfg)
         self.states: deque[tuple[int, str, Corrugation]] = deque(maxlen=STATES_KEPT)  # in arrival order
+        self._state_stamps: deque[int] = deque(maxlen=STATES_KEPT)  # their stamps, to bisect
         self.pending: deque[_Pending] = deque()
         self.sent = Sent()
         self.counts: Counter[str] = Counter()
@@ -84,6 +86,7 @@ class RollingNoisePredictor(PassConsumerNode):
                                           throttle_duration_sec=self.log_throttle_s)
                 continue
             self.states.append((time_ns(msg.header.stamp), msg.last_train_id, corrugation))
+            self._state_stamps.append(self.states[-1][0])
         self._flush()
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
@@ -107,9 +110,10 @@ class RollingNoisePredictor(PassConsumerNode):
         if not self.pending:
             return
         now = time.monotonic()
-        stamps = np.fromiter((st for st, _, _ in self.states), np.int64, len(self.states))
-        trains = [last for _, last, _ in self.states]
         pending = list(self.pending)
+        states = self._states_from(min(p.stamp_ns for p in pending))
+        stamps = np.fromiter((st for st, _, _ in states), np.int64, len(states))
+        trains = [last for _, last, _ in states]
         arrived = state_arrived(stamps, trains, np.array([p.stamp_ns for p in pending], np.int64),
                                 [p.msg.train_id for p in pending])
         n = 0
@@ -125,7 +129,13 @@ class RollingNoisePredictor(PassConsumerNode):
         ready = [self.pending.popleft() for _ in range(n)]
         index = state_index(stamps, trains, np.array([p.stamp_ns for p in ready], np.int64),
                             [p.msg.train_id for p in ready])
-        self._predict(ready, [self.states[k][2] if k >= 0 else None for k in index.tolist()])
+        self._predict(ready, [states[k][2] if k >= 0 else None for k in index.tolist()])
+
+    def _states_from(self, stamp_ns: int) -> list[tuple[int, str, Corrugation]]:
+        """The states a pass at or after stamp_ns can be predicted on (those from that stamp on, and
+        the latest before it), in order: the cost of a pass does not grow with the states kept."""
+        first = first_state_needed(self._state_stamps, stamp_ns)
+        return list(itertools.islice(reversed(self.states), len(self.states) - first))[::-1]
 
     def _predict(self, ready: list[_Pending], states: list[Corrugation | None]) -> None:
         """Both models over the ready passes in one call per run of passes whose states share their

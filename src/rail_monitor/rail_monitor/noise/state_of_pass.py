@@ -10,6 +10,7 @@ one, has arrived.
 
 from __future__ import annotations
 
+import bisect
 from collections.abc import Sequence
 
 import numpy as np
@@ -40,3 +41,10 @@ def state_arrived(state_stamp_ns: np.ndarray, state_train_id: Sequence[str], pas
     own = _last_of_each(s, list(state_train_id))
     later = s.max(initial=np.iinfo(np.int64).min) > t
     return later | np.array([key in own for key in zip(t.tolist(), pass_train_id, strict=True)], bool)
+
+
+def first_state_needed(state_stamp_ns: Sequence[int], earliest_pass_ns: int) -> int:
+    """Index of the first state that a pass at or after earliest_pass_ns [ns] can be predicted on or
+    wait for (states in time order): the latest state before that time, or 0. The states from there
+    on give state_index and state_arrived the same answers as all of them."""
+    return max(bisect.bisect_left(state_stamp_ns, earliest_pass_ns) - 1, 0)
