@@ -16,7 +16,7 @@ from rail_monitor.bagio.reader import bag_info, read_bag_passes, read_passes
 from rail_monitor.cli import main
 from rail_monitor.core.errors import InputError
 
-from conftest import SAMPLE, run_cmd
+from conftest import SAMPLE, SITE_FILE, run_cmd
 
 CHUNK, CHUNK_INDEX, FOOTER, DATA_END = 0x06, 0x08, 0x02, 0x0F
 
@@ -81,11 +81,13 @@ def test_a_damaged_chunk_index_or_channel_is_refused_by_every_front_end(small, t
     _flip(f, index + 9 + 16)  # the chunk's start offset
     with pytest.raises(InputError, match="disagrees with itself"):
         read_bag_passes(bag)
-    for argv in (["info", str(bag)], ["batch", str(bag), "--output", str(tmp_path / "out"), "--no-report"]):
+    for argv in (["info", str(bag)], ["batch", str(bag), "--output", str(tmp_path / "out"), "--no-report"],
+                 ["export", str(bag), "--site", str(SITE_FILE), "--output", str(tmp_path / "exported")]):
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and str(bag) in err
     assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
+    assert not (tmp_path / "exported").exists()
     r = run_cmd("pass_replayer", "--ros-args", "-p", f"source:={bag}", "-p", "progress:=false", timeout=60)
     assert r.returncode == 2 and "disagrees with itself" in r.stderr and "Traceback" not in r.stderr
 

@@ -10,7 +10,7 @@ spectra before and after growth) and the validation of the passes.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,7 +20,7 @@ import numpy as np
 from rail_monitor.alerts.config import KIND_NAMES
 from rail_monitor.alerts.manager import Alert, describe
 from rail_monitor.bagio.messages import alert_from_msg, pass_row, time_ns
-from rail_monitor.bagio.reader import read_messages
+from rail_monitor.bagio.reader import iter_messages, read_messages
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons
 from rail_monitor.core.site import site_from_values
@@ -49,13 +49,64 @@ class RunData:
 def load_run(bag: str | Path) -> RunData:
     """Everything the report needs from a bag (InputError with one line if it cannot be read)."""
     path = Path(bag)
-    got = read_messages(path, [f"rail_msgs/msg/{n}" for n in _TYPES])
+    run = _run_of(path, read_messages(path, [f"rail_msgs/msg/{n}" for n in _TYPES]))
+    if not len(run.passes):
+        raise InputError(f"{path}: no rail_msgs/msg/TrainPass messages: nothing to report")
+    return run
+
+
+class NotStampOrdered(RailMonitorError):
+    """A bag whose log times are not its messages' header stamps (not recorded by rail_monitor)."""
+
+
+def iter_runs(bag: str | Path, chunk: int = 5_000) -> Iterator[RunData]:
+    """A bag's run as consecutive RunData of about ``chunk`` passes each, in time order, for a
+    bag rail_monitor recorded (log time = header stamp, so a pass's outputs share its log time):
+    each part holds its passes, their outputs, the state before its first pass (the one its first
+    passes are reported on) and the alert events of its time; the last part the speed advisory.
+    Memory: one part. NotStampOrdered (before any part of that time is given) for another bag."""
+    path = Path(bag)
+    held: list[tuple[str, int, Any]] = []
+    passes, cut, before, any_pass = 0, None, None, False
+    for part in iter_messages(path, [f"rail_msgs/msg/{n}" for n in _TYPES], chunk):
+        for item in part:
+            typename, t, msg = item
+            if t != max(time_ns(msg.header.stamp), 0):
+                raise NotStampOrdered(f"{path}: a {typename} is logged at {t} ns, not at its stamp: not a bag "
+                                      "rail_monitor recorded")
+            if cut is not None and t > cut:
+                run, before = _part(path, held, before)
+                yield run
+                held, passes, cut = [], 0, None
+            held.append(item)
+            if typename.endswith("/TrainPass"):
+                passes += 1
+                any_pass = True
+                if passes >= chunk:
+                    cut = t
+    if not any_pass:
+        raise InputError(f"{path}: no rail_msgs/msg/TrainPass messages: nothing to report")
+    yield _part(path, held, before)[0]
+
+
+def _part(path: Path, items: list[tuple[str, int, Any]], before: Any) -> tuple[RunData, Any]:
+    """The RunData of a part's messages with the state before it; and the state after it."""
+    got: dict[str, list[Any]] = {f"rail_msgs/msg/{n}": [] for n in _TYPES}
+    for typename, _, msg in items:
+        got[typename].append(msg)
+    states = got["rail_msgs/msg/CorrugationState"]
+    after = states[-1] if states else before
+    if before is not None:
+        states.insert(0, before)
+    return _run_of(path, got), after
+
+
+def _run_of(path: Path, got: dict[str, list[Any]]) -> RunData:
+    """RunData of a bag's messages by type."""
     rows = [pass_row(m) for m in got["rail_msgs/msg/TrainPass"]]
     sq, st, nz, al = (got[f"rail_msgs/msg/{n}"] for n in ("SquealPrediction", "CorrugationState", "RollingNoise",
                                                            "WaysideAlert"))
     advisories = got["rail_msgs/msg/SpeedAdvisory"]
-    if not rows:
-        raise InputError(f"{path}: no rail_msgs/msg/TrainPass messages: nothing to report")
     run = RunData(path, PassTable.from_rows(rows))
     run.squeal = {k: np.array([getattr(m, k) for m in sq]) for k in (
         "crabbing_velocity_mps", "velocity_amplitude_mps", "risk", "level_dba", "friction_state", "speed_mps",

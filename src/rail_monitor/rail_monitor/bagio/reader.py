@@ -142,24 +142,40 @@ def iter_bag_passes(path: str | Path, topic: str | None = None, chunk: int = 5_0
         reader.close()
 
 
-def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, list[Any]]:
-    """Every message of the given types in a bag (any topic), deserialised, by type, in log-time order."""
+def iter_messages(path: str | Path, typenames: Collection[str], chunk: int = 20_000
+                  ) -> Iterator[list[tuple[str, int, Any]]]:
+    """Every message of the given types in a bag (any topic), deserialised, in log-time order, as
+    lists of about ``chunk`` (typename, log time [ns], message); the bag is checked against its
+    own index when opened and its message counts once the last is read."""
     path = Path(path)
     reader = _open_bag(path)
     claims = _checked(path, reader)
-    out: dict[str, list[Any]] = {t: [] for t in typenames}
     read: Counter[str] = Counter()
     try:
-        conns = [c for c in reader.connections if c.msgtype in out]
-        for c, _, raw in reader.messages(connections=conns):
-            out[c.msgtype].append(reader.deserialize(raw, c.msgtype))
+        conns = [c for c in reader.connections if c.msgtype in typenames]
+        out: list[tuple[str, int, Any]] = []
+        for c, t, raw in reader.messages(connections=conns):
+            out.append((c.msgtype, t, reader.deserialize(raw, c.msgtype)))
             read[c.topic] += 1
+            if len(out) >= chunk:
+                yield out
+                out = []
         topics = {c.topic for c in conns}
     except Exception as exc:
         raise InputError(f"{path}: cannot read bag: {_one_line(exc)}") from None
     finally:
         reader.close()
     claims.check_read({t: read[t] for t in topics})
+    if out:
+        yield out
+
+
+def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, list[Any]]:
+    """Every message of the given types in a bag (any topic), deserialised, by type, in log-time order."""
+    out: dict[str, list[Any]] = {t: [] for t in typenames}
+    for part in iter_messages(path, typenames):
+        for typename, _, msg in part:
+            out[typename].append(msg)
     return out
 
 

@@ -17,6 +17,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("bag", help="bag recorded by the graph or by batch")
     s.add_argument("--format", choices=FORMATS, default="csv", help="file format (default: csv)")
     s.add_argument("--output", help="folder to write into (default: <bag>_export next to the bag)")
+    s.add_argument("--chunk", type=int, default=5_000, help="passes read and written at a time for CSV and "
+                   "Parquet (default 5000; 0: read the bag whole)")
     add_site_option(s, default="the site stored in the bag")
     s.add_argument("--overwrite", action="store_true", help="replace an existing export folder that rail_monitor "
                    "created")
@@ -24,24 +26,29 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
+    import shutil
+
     from rail_monitor import __version__
-    from rail_monitor.app.export import alert_table, pass_table, write_tables
-    from rail_monitor.app.report import load_run
+    from rail_monitor.app.export import export_run
     from rail_monitor.bagio.output_folder import new_output_folder
     from rail_monitor.bagio.site_record import read_site_record
     from rail_monitor.core.text import printable
 
     values, _ = bag_site_values(ns.bag, ns.site)
-    data = load_run(ns.bag)
-    tables = [pass_table(data, values), alert_table(data, values)]
     record = read_site_record(ns.bag) or {}
     about = {"rail_monitor.version": __version__, "source bag": str(Path(ns.bag).absolute()),
              "site_id": str(values.get("site_id", "")), **{f"site.{k}": v for k, v in record.items()}}
     out = Path(ns.output) if ns.output else beside(ns.bag, "_export")
     fresh_output(out, ns.overwrite, [ns.bag])
     folder = new_output_folder(out)
-    files = write_tables(tables, ns.format, folder, about)
-    for t in tables:
-        print(f"export: {t.name}: {len(t.columns[0].values)} rows, {len(t.columns)} columns")
-    print("export: " + ", ".join(printable(f) for f in files))
+    try:
+        done = export_run(ns.bag, values, ns.format, folder, about, ns.chunk)
+    except BaseException:
+        shutil.rmtree(folder)  # created above: a failed export leaves nothing behind
+        raise
+    for line in done.notes:
+        print(f"export: {printable(line)}")
+    for name, rows, cols in done.tables:
+        print(f"export: {name}: {rows} rows, {cols} columns")
+    print("export: " + ", ".join(printable(f) for f in done.files))
     return 0
