@@ -7,7 +7,7 @@ times across machines. Sections: the graph against its rclpy ceiling (the no-op 
 bench.bare_graph); the live graph's start-up, idle CPU, CPU and latency (bench.live); batch mode at
 1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
 per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes
-(the graph, the recorder, and the streamed batch);
+(the graph, the recorder, the streamed batch, and export in parts against read whole);
 many sites on a local Dask cluster of 1 and 2 workers.
 """
 
@@ -16,6 +16,8 @@ from __future__ import annotations
 import argparse
 import os
 import platform
+import subprocess
+import sys
 import tempfile
 import time
 from datetime import UTC, datetime
@@ -32,7 +34,7 @@ from bench import recorder as br
 from bench import sites as bsites
 from bench import squeal as bs
 from rail_monitor.app.batch import run_models
-from rail_monitor.app.batch_bag import write_bag
+from rail_monitor.app.batch_bag import run_to_bag, write_bag
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_passes
 from rail_monitor.site_file import load_parameter_file
@@ -113,6 +115,26 @@ def streamed_rows(site: str, sizes: list[int]) -> list[Row]:
     return rows
 
 
+def export_rows(values: dict, site: str, passes: int, tmp: Path) -> list[Row]:
+    """rail-monitor export of a batch bag, in parts and read whole, each in a fresh process: peak memory."""
+    bag = tmp / "export_bag"
+    run_to_bag(bb.busy_chunks(values, passes, 5_000), values, bag, "site")
+    rows: list[Row] = []
+    for chunk in (5_000, 0):
+        out = tmp / f"export_{chunk}"
+        code = ("import sys, time; from rail_monitor.cli import main; from bench.timing import peak_rss_mb; "
+                "t = time.perf_counter(); rc = main(sys.argv[1:]); print(rc, time.perf_counter() - t, peak_rss_mb())")
+        done = subprocess.run([sys.executable, "-c", code, "export", str(bag), "--format", "parquet", "--chunk",
+                               str(chunk), "--site", site, "--output", str(out)],
+                              capture_output=True, text=True, check=True)
+        rc, t, mb = done.stdout.split()[-3:]
+        assert rc == "0", done.stdout
+        how = f"in parts of {chunk:,} passes" if chunk else "read whole"
+        rows.append((f"export to Parquet, {passes:,} passes, {how}", f"{float(mb):,.0f} MB",
+                     f"peak RSS of the process; {float(t):.1f} s"))
+    return rows
+
+
 def model_rows(site: str) -> list[Row]:
     sq = bs.costs(site)
     co = bc.costs(site)
@@ -179,7 +201,8 @@ def main() -> None:
         sections.append(("models, per pass", model_rows(ns.site)))
         sections.append(("recorder", recorder_rows(values, source, tmp)))
         sections.append(("memory against passes", memory + streamed_rows(
-            ns.site, [2_000, 6_000] if ns.quick else [100_000, 1_000_000])))
+            ns.site, [2_000, 6_000] if ns.quick else [100_000, 1_000_000])
+            + export_rows(values, ns.site, 2_000 if ns.quick else 100_000, tmp)))
         sections.append(("many sites on a local Dask cluster", bsites.rows(values, ns.site, 2 if ns.quick else 4,
                                                                            1000 if ns.quick else 20_000)))
     text = f"Machine: {machine()}\n\n{table(sections)}\n"

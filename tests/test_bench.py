@@ -28,6 +28,7 @@ def test_the_benchmark_harness_runs_and_batch_equals_the_live_graph(tmp_path):
                      r"last output p50 [0-9]+ ms, p95 [0-9]+ ms over 40 passes; by process: "
                      r"corrugation_estimator [0-9]+ %", text), text
     assert re.search(r"\| batch streamed to a bag, [0-9,]+ passes \| [0-9,]+ MB \|", text), text
+    assert re.search(r"\| export to Parquet, [0-9,]+ passes, in parts of 5,000 passes \| [0-9,]+ MB \|", text), text
     ratio = re.search(r"\| real / ceiling \| ([0-9.]+) \|", text)
     assert ratio and 0.0 < float(ratio.group(1)) < 10.0
     # The live graph's bag against batch mode on the same passes (test_graph checks the full sample).
