@@ -67,3 +67,14 @@ def test_free_field_point_limit_and_ground():
     hard = passby.pass_by(np.array([[100.0]]), np.array([0]), [1.0], [10.0],
                           passby.Receiver(200.0, 0.0, 0.0, 0.0, 1.0))
     assert hard.lpaeq_tp_dba[0] - out.lpaeq_tp_dba[0] == pytest.approx(10 * np.log10(2), abs=0.01)
+
+
+def test_the_exponential_average_is_lfilter_step_for_step():
+    # The F-weighting recursion against scipy.signal.lfilter (direct form II transposed), bit for bit.
+    from scipy.signal import lfilter
+
+    a = np.exp(-1.0 / 8)
+    for rows in (1, passby.FEW_ROWS, 40):  # plain floats for a few series, numpy rows for many
+        x = np.random.default_rng(rows).lognormal(0.0, 2.0, (rows, 73))
+        want, _ = lfilter([1.0 - a], [1.0, -a], x, axis=1, zi=a * x[:, :1])
+        assert np.array_equal(passby.exponential_average(x, a), want)

@@ -197,8 +197,36 @@ def _f_weighted_peak(c1: FloatArray, c2: FloatArray, length: FloatArray, speed: 
     g = kernel_antiderivative
     x = c1[:, None] * (g(s, d, r1) - g(s - length[:, None], d, r1)) \
         + c2[:, None] * (g(s, d, r2) - g(s - length[:, None], d, r2))
-    a = np.exp(-1.0 / steps_per_tau)
-    from scipy.signal import lfilter  # lazy: scipy.signal costs 0.4 s to import
+    return exponential_average(x, np.exp(-1.0 / steps_per_tau)).max(axis=1)
 
-    y, _ = lfilter([1.0 - a], [1.0, -a], x, axis=1, zi=a * x[:, :1])
-    return y.max(axis=1)
+
+def exponential_average(x: FloatArray, a: float) -> FloatArray:
+    """y_n = (1 - a) x_n + a y_(n-1) along the last axis, started in steady state (y_(-1) = x_0):
+    the sampled exponential time weighting of IEC 61672-1 eq. 7 with a = exp(-dt / tau).
+
+    The arithmetic of scipy.signal.lfilter([1 - a], [1, -a], x, zi=a x_0), step for step (the tests
+    compare the bits), without importing scipy.signal (44 MB and 0.4 s at a node's start-up).
+    """
+    b0 = 1.0 - a
+    rows = np.asarray(x, float).reshape(-1, np.shape(x)[-1])
+    if len(rows) <= FEW_ROWS:  # a live pass: plain floats, the same IEEE operations
+        out = []
+        for row in rows.tolist():
+            state, ys = a * row[0], []
+            for v in row:
+                y = b0 * v + state
+                ys.append(y)
+                state = a * y
+            out.append(ys)
+        return np.array(out, float).reshape(np.shape(x))
+    xt = np.ascontiguousarray(rows.T)  # time-major: each step is one contiguous row
+    yt = np.empty_like(xt)
+    state = a * xt[0]
+    for n in range(len(xt)):
+        np.multiply(b0, xt[n], out=yt[n])
+        yt[n] += state
+        state = a * yt[n]
+    return yt.T.reshape(np.shape(x))
+
+
+FEW_ROWS = 8  # below this many series a Python loop beats numpy's per-call overhead
