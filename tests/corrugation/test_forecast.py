@@ -4,6 +4,7 @@ span, the lead time and the sample history."""
 from __future__ import annotations
 
 import dataclasses
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -102,6 +103,7 @@ def test_forecasts_split_over_threads_are_the_same_bits():
     g = rng.normal(0, 1e-6, (n, 3, 5))
     args = (x, g, rng.uniform(10, 100, n), np.full(n, 8.0), np.full(n, 10**18, np.int64), np.array([3e-6, 6e-6, 9e-6]),
             30.0, 8.0)
-    one, two = fcst.forecasts(*args), fcst.forecasts(*args, threads=2)
+    with ThreadPoolExecutor(2) as pool:
+        one, two = fcst.forecasts(*args), fcst.forecasts(*args, threads=fcst.Threads(pool, 2))
     for a, b in zip(dataclasses.astuple(one), dataclasses.astuple(two), strict=True):
         assert np.array_equal(a, b)

@@ -32,6 +32,7 @@ from rail_monitor.core.site import Site, site_from_values
 from rail_monitor.core.timeutil import fits_time_msg, format_iso_ns
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.forecast import Threads
 from rail_monitor.corrugation.records import StateSnapshot, Trajectory
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
@@ -121,7 +122,6 @@ class BatchRun:
         self.model = RollingNoiseModel(self.site, noise_config(values))
         self.alerts = AlertManager(alert_config(values, self.estimator.cfg.lead_time_days))
         self.threads = threads or os.cpu_count() or 1
-        self.estimator.threads = self.threads
         self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
         self.newest_taken_ns = self.estimator.newest_ns  # the nodes' reference
         self.newest_ns = np.iinfo(np.int64).min          # newest stamp given so far (time order check)
@@ -145,7 +145,11 @@ class BatchRun:
         accepted = with_class_defaults(table.take(reasons == ""), self.site)
         with ThreadPoolExecutor(max_workers=self.threads) as pool:
             squeal_job = pool.submit(predict_squeal, squeal_config(self.values), self.site, accepted)
-            traj = _history(self.estimator, accepted)
+            self.estimator.threads = Threads(pool, self.threads)  # the forecasts' roots on the same threads
+            try:
+                traj = _history(self.estimator, accepted)
+            finally:
+                self.estimator.threads = None
             states = self._tail.then(traj)
             on = state_index(states.stamp_ns, states.train_id, accepted.stamp_ns, accepted.train_id.tolist())
             noise = _noise_on_states(pool, self.model, accepted, states.amplitude, traj.constants, on)

@@ -53,7 +53,7 @@ class CorrugationEstimator:
         self.last_survey_ns = 0                                        # last survey or grinding applied
         self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
         self.kept = KeptPasses()
-        self.threads = 1  # threads a history's forecasts may use (batch: its own setting)
+        self.threads: fcst.Threads | None = None  # threads a history's forecasts may use (batch: its pool)
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
         # (B, P). A window's growth is a difference of two, so it is the same however the passes
         # were split into calls (live backlogs, batch chunks).

@@ -7,7 +7,8 @@ days = train passes / train passes per day (docs/models.md, "Grinding forecast")
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Executor
+from typing import NamedTuple
 
 import numpy as np
 
@@ -22,14 +23,21 @@ MAX_DATED_DAYS = 36_525.0
 PARALLEL_MIN_STATES = 2_000  # fewer states per thread cost more to hand over than they save
 
 
+class Threads(NamedTuple):
+    """Threads a computation may split its work over: a pool and how many of its workers."""
+
+    pool: Executor
+    count: int
+
+
 def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
               newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
-              fallback_axles: float, threads: int = 1) -> Forecast:
+              fallback_axles: float, threads: Threads | None = None) -> Forecast:
     """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
     day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
     band thresholds (B,) [m]; a Forecast of arrays (grinding_due_ns 0: no date, the forecast
-    being infinite or beyond MAX_DATED_DAYS). threads: the states' root finding split over this
-    many threads (each band's root is found on its own, so the split changes no bit)."""
+    being infinite or beyond MAX_DATED_DAYS). threads: to split the states' root finding over
+    (each band's root is found on its own, so the split changes no bit)."""
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
     log_threshold = np.log(threshold)
     margin = log_threshold - np.log(cg.band_amplitude(log_components))
@@ -48,15 +56,14 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
 
 
 def _passes_to_level(log_components: np.ndarray, growth: np.ndarray, log_threshold: np.ndarray,
-                     threads: int) -> np.ndarray:
-    parts = min(threads, len(log_components) // PARALLEL_MIN_STATES)
-    if parts <= 1:
+                     threads: Threads | None) -> np.ndarray:
+    parts = 0 if threads is None else min(threads.count, len(log_components) // PARALLEL_MIN_STATES)
+    if threads is None or parts <= 1:
         return cg.passes_to_band_level(log_components, growth, log_threshold)
     bounds = np.linspace(0, len(log_components), parts + 1).astype(int)
-    with ThreadPoolExecutor(parts) as pool:  # numpy's ufuncs release the GIL
-        done = pool.map(lambda lo, hi: cg.passes_to_band_level(log_components[lo:hi], growth[lo:hi], log_threshold),
-                        bounds[:-1], bounds[1:])
-        return np.concatenate(list(done))
+    done = threads.pool.map(lambda lo, hi: cg.passes_to_band_level(log_components[lo:hi], growth[lo:hi], log_threshold),
+                    bounds[:-1], bounds[1:])  # numpy's ufuncs release the GIL
+    return np.concatenate(list(done))
 
 
 def single(fc: Forecast) -> Forecast:

@@ -82,7 +82,7 @@ class GrowthTables:
             patch = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
             self._wheels.append((float(patch.stiffness), float(patch.a), float(v.unsprung_mass_kg)))
         self._kernel: np.ndarray | None = None
-        self.table = self._by_speed = np.empty(0)
+        self._by_speed = np.empty((0, 0, 0, 0, 0, 0))
         self.k_b = np.full(4, np.nan)
         self._inputs = {"track": dataclasses.asdict(self._track), "wheels": self._wheels,
                         "sub_wavelengths_m": self._sub.tolist(), "speeds_mps": [float(self.speeds[0]), SPEED_STEP_MPS,
@@ -114,12 +114,12 @@ class GrowthTables:
         sliding = cg.sliding_wear_sensitivity(k_b, self.sliding_wear_ratio)
 
         def build() -> dict[str, np.ndarray]:
-            return {"table": np.stack([np.stack([self._bay_mean(kb) for kb in pair], axis=1)
-                                       for pair in zip(k_b, sliding, strict=True)], axis=1)}
+            table = np.stack([np.stack([self._bay_mean(kb) for kb in pair], axis=1)
+                              for pair in zip(k_b, sliding, strict=True)], axis=1)
+            return {"table": np.ascontiguousarray(np.moveaxis(table, 4, 3))}  # (C, F, R, V, B, P)
 
-        self.table = cached_arrays("corrugation_growth_table", {**self._inputs, "k_b": k_b.tolist()},
-                                   build)["table"] if cached else build()["table"]
-        self._by_speed = np.ascontiguousarray(np.moveaxis(self.table, 4, 3))  # (C, F, R, V, B, P)
+        self._by_speed = cached_arrays("corrugation_growth_table_by_speed", {**self._inputs, "k_b": k_b.tolist()},
+                                       build)["table"] if cached else build()["table"]
         self.k_b = k_b
 
     def _bay_mean(self, k_b: float) -> np.ndarray:
@@ -128,6 +128,11 @@ class GrowthTables:
         for x in range(1, len(self.filtered_kernel)):
             out += cg.filtered_log_growth(k_b, self.filtered_kernel[x], 1.0)
         return out / len(self.filtered_kernel)
+
+    @property
+    def table(self) -> np.ndarray:
+        """Per-axle-pass log growth (class, friction state, regime, band, speed, component)."""
+        return np.moveaxis(self._by_speed, 3, 4)
 
     def class_index(self, names: np.ndarray) -> np.ndarray:
         lookup = {n: i for i, n in enumerate(self.classes)}
