@@ -20,6 +20,7 @@ import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 
 from rail_monitor.bagio.messages import train_pass_fields
@@ -148,7 +149,11 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     pubs["/clock"].publish(bad_clock)
     bad_passes, surveys, states = _hostile_passes(site), _hostile_surveys(), _hostile_states()
     squeals, noises = _hostile_outputs()
+    # and two states that are not CDR of a state at all (raw bytes): one cut short, one noise
+    whole = bytes(serialize_message(states[0]))
+    states_raw = [whole[: len(whole) // 2], bytes(np.random.default_rng(3).integers(0, 256, 300, np.uint8))]
     for topic, msgs in (("train_pass", bad_passes), ("roughness_survey", surveys), ("corrugation/state", states),
+                        ("corrugation/state", states_raw),
                         ("noise/squeal", squeals), ("noise/rolling", noises),
                         ("/diagnostics", [_diagnostic("fake", 2000)])):
         for m in msgs:
@@ -166,15 +171,16 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     n_bad = len(bad_passes)
     assert wait_until(lambda: all(n.taken == 3 + n_bad for n in (est, noise, squeal, alerts)), 20)
     assert wait_until(lambda: sum(est.surveys_rejected.values()) == len(surveys)
-                      and sum(noise.states_rejected.values()) == 4  # the arrays it reads: 4 of the 8
-                      and alerts.inputs["corrugation/state"] >= 3 + len(states)
+                      and sum(noise.states_rejected.values()) == 4 + 2  # the arrays it reads: 4 of the 8
+                      and alerts.inputs["corrugation/state"] >= 3 + len(states) + 2
                       and alerts.inputs["noise/rolling"] >= 6 + len(noises), 20), \
         (est.surveys_rejected, noise.states_rejected, alerts.inputs)
     for node in (est, noise, squeal, alerts):
         assert sum(node.rejected.values()) == n_bad, (node.get_name(), node.rejected)
         assert not node.model_errors
     refused = {k: n for k, n in alerts.inputs.items() if " refused: " in k}
-    assert sum(n for k, n in refused.items() if k.startswith("corrugation/state")) == len(states), refused
+    assert sum(n for k, n in refused.items() if k.startswith("corrugation/state")) == len(states) + 2, refused
+    assert sum(n for k, n in refused.items() if "not a readable CDR message" in k) == 2, refused
     assert sum(n for k, n in refused.items() if k.startswith("noise/squeal")) == len(squeals), refused
     assert sum(n for k, n in refused.items() if k.startswith("noise/rolling")) == len(noises), refused
     assert est.surveys_rejected["stamp more than 366 d ahead of the stream (stamps.max_ahead_of_stream_s)"] == 2, \

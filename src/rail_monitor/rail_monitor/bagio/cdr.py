@@ -1,4 +1,5 @@
-"""CDR bytes of a message given as plain fields (:mod:`rail_monitor.bagio.messages`), without rclpy.
+"""CDR bytes of a message given as plain fields (:mod:`rail_monitor.bagio.messages`), and the fields
+of CDR bytes, without rclpy.
 
 The encoder of a type is compiled once from its definition in the typestore: the fields are
 flattened (nested messages inline), and each run of consecutive fixed-size fields is packed by
@@ -8,7 +9,9 @@ and rosbags write it: a 4-byte encapsulation header (CDR_LE), every primitive al
 size relative to the end of that header, zero padding, strings as uint32 length (with the
 terminating NUL) then UTF-8 bytes and NUL, sequences as a uint32 count then the elements; the
 test suite checks the bytes against rosbags' serialiser and rclpy for every graph topic.
-Missing fields take their zero value; unknown fields raise KeyError.
+Missing fields take their zero value; unknown fields raise KeyError. The decoder is compiled the
+same way and reads numeric sequences as numpy views of the bytes (no copy); bytes that do not hold
+one whole message raise CdrError, a ValueError.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from __future__ import annotations
 import functools
 import struct
 from collections.abc import Callable, Mapping
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -65,6 +69,11 @@ class _Run:
     def encode(self, buf: bytearray, fields: Mapping[str, Any]) -> None:
         s = self._struct((len(buf) - 4) % 8)
         buf += s.pack(*[fields.get(n, z) for n, z in zip(self.names, self.zeros, strict=True)])
+
+    def decode(self, data: memoryview, pos: int, out: dict[str, Any]) -> int:
+        s = self._struct((pos - 4) % 8)
+        out.update(zip(self.names, s.unpack_from(data, pos), strict=True))
+        return pos + s.size
 
 
 def _string(buf: bytearray, value: str) -> None:
@@ -154,3 +163,133 @@ def serialize(typename: str, fields: Mapping[str, Any]) -> bytes:
     buf = bytearray(ENCAPSULATION)
     _encoder(typename)(buf, fields)
     return bytes(buf)
+
+
+# -- reading --------------------------------------------------------------------------------------
+Decoder = Callable[[memoryview, int, dict[str, Any]], int]
+
+
+class CdrError(ValueError):
+    """Bytes that are not a whole CDR message of the type."""
+
+
+def _align(pos: int, size: int) -> int:
+    return pos + (-(pos - 4) % size)
+
+
+def _read_string(data: memoryview, pos: int) -> tuple[str, int]:
+    pos = _align(pos, 4)
+    (n,) = _COUNT.unpack_from(data, pos)
+    pos += 4
+    if n < 1 or pos + n > len(data) or data[pos + n - 1] != 0:
+        raise CdrError(f"a string of {n} bytes at offset {pos} does not fit or is not terminated")
+    return bytes(data[pos:pos + n - 1]).decode(), pos + n
+
+
+def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Decoder:
+    kind, detail = item
+    if kind == Nodetype.BASE and detail[0] != "string":
+        dtype = np.dtype(_BASE[detail[0]]).newbyteorder("<")
+
+        def numeric(data: memoryview, pos: int, out: dict[str, Any]) -> int:
+            n = length
+            if n is None:
+                pos = _align(pos, 4)
+                (n,) = _COUNT.unpack_from(data, pos)
+                pos += 4
+            if n:
+                pos = _align(pos, dtype.itemsize)
+            end = pos + n * dtype.itemsize
+            if end > len(data):
+                raise CdrError(f"field {name}: {n} values at offset {pos} run past the {len(data)} bytes")
+            out[name] = np.frombuffer(data, dtype, n, pos)
+            return end
+        return numeric
+    sub = None if kind == Nodetype.BASE else _decoder(detail)
+
+    def items(data: memoryview, pos: int, out: dict[str, Any]) -> int:
+        n = length
+        if n is None:
+            pos = _align(pos, 4)
+            (n,) = _COUNT.unpack_from(data, pos)
+            pos += 4
+            if n > len(data) - pos:  # every element takes at least a byte
+                raise CdrError(f"field {name}: {n} elements cannot fit in {len(data)} bytes")
+        values = []
+        for _ in range(n):
+            if sub is None:
+                value, pos = _read_string(data, pos)
+            else:
+                value = {}
+                pos = sub(data, pos, value)
+            values.append(value)
+        out[name] = values
+        return pos
+    return items
+
+
+@functools.cache
+def _decoder(typename: str) -> Decoder:
+    """The compiled decoder of a type: reads one message's fields from an offset, returns the next."""
+    steps: list[Decoder] = []
+    run: _Run | None = None
+    for name, (kind, detail) in typestore().fielddefs[typename][1]:
+        if kind == Nodetype.BASE and detail[0] != "string":
+            if run is None:
+                run = _Run()
+                steps.append(run.decode)
+            run.names.append(name)
+            run.codes.append(_BASE[detail[0]])
+            run.zeros.append(_zero_of(detail[0]))
+            continue
+        run = None
+        if kind == Nodetype.BASE:
+            steps.append(functools.partial(_string_step, name))
+        elif kind == Nodetype.NAME:
+            steps.append(functools.partial(_nested_step, name, _decoder(detail)))
+        else:
+            steps.append(_array_decoder(name, detail[0], detail[1] if kind == Nodetype.ARRAY else None))
+
+    def decode(data: memoryview, pos: int, out: dict[str, Any]) -> int:
+        for step in steps:
+            pos = step(data, pos, out)
+        return pos
+    return decode
+
+
+def _string_step(name: str, data: memoryview, pos: int, out: dict[str, Any]) -> int:
+    out[name], pos = _read_string(data, pos)
+    return pos
+
+
+def _nested_step(name: str, sub: Decoder, data: memoryview, pos: int, out: dict[str, Any]) -> int:
+    out[name] = {}
+    return sub(data, pos, out[name])
+
+
+def deserialize(typename: str, data: bytes) -> dict[str, Any]:
+    """The fields of a message of the type from its CDR bytes (sub-messages as dicts, numeric
+    sequences as read-only numpy arrays over the bytes, strings as str); CdrError for bytes too
+    short for the message they begin (bytes after it are ignored, as rclpy ignores them)."""
+    view = memoryview(data)
+    if len(view) < 4 or bytes(view[:2]) != ENCAPSULATION[:2]:
+        raise CdrError(f"not little-endian CDR (header {bytes(view[:4])!r})")
+    out: dict[str, Any] = {}
+    try:
+        _decoder(typename)(view, 4, out)
+    except (struct.error, UnicodeDecodeError) as exc:
+        raise CdrError(f"{typename}: {exc}") from None
+    return out
+
+
+def message_view(typename: str, data: bytes) -> SimpleNamespace:
+    """A message of the type read from CDR bytes with its fields as attributes (sub-messages too):
+    what a node reads of a message, without rclpy's conversion to Python objects; CdrError as
+    :func:`deserialize`."""
+    return _namespace(deserialize(typename, data))
+
+
+def _namespace(fields: dict[str, Any]) -> SimpleNamespace:
+    return SimpleNamespace(**{k: _namespace(v) if isinstance(v, dict) else
+                              [_namespace(x) if isinstance(x, dict) else x for x in v] if isinstance(v, list) else v
+                              for k, v in fields.items()})

@@ -23,6 +23,7 @@ from rclpy.parameter import Parameter
 
 from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, SEVERITY_CRITICAL, alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager, describe
+from rail_monitor.bagio.cdr import CdrError, message_view
 from rail_monitor.bagio.messages import (
     corrugation_series,
     noise_refusal,
@@ -59,9 +60,11 @@ class AlertManagerNode(PassConsumerNode):
         # Each stream in its own order (streams do not interact): what is queued is taken at once and
         # fed as one series; alerts/standing (latched, latest only) is published once per series.
         for msg_type, topic, handle, qos in ((SquealPrediction, "noise/squeal", self._on_squeal, STREAM_SUB_QOS),
-                                             (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS),
-                                             (CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS)):
+                                             (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS)):
             subscribe_batched(self, msg_type, topic, handle, qos, self.max_batch)
+        # Raw: a state is read straight from its CDR (numpy views of its arrays), not converted by rclpy.
+        subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch,
+                          raw=True)
         # The initial (empty) standing set for late subscribers, once the clock runs: a message
         # stamped 0 before the first /clock would stretch a bag's timeline back to 1970.
         self._initial = wall_timer(self, 0.1, self._publish_initial_standing)
@@ -101,8 +104,8 @@ class AlertManagerNode(PassConsumerNode):
                 k: np.array([getattr(m, k) for m in mine]) for k in NOISE_METRICS})
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
 
-    def _on_states(self, msgs: list[CorrugationState]) -> None:
-        ok = self._usable("corrugation/state", msgs, state_refusal)
+    def _on_states(self, raws: list[bytes]) -> None:
+        ok = self._usable("corrugation/state", [_state_view(r) for r in raws], _view_refusal(state_refusal))
         for run in runs(ok, _same_bands):  # states on the same bands and thresholds, as one series
             self._emit(self.alerts.on_states(**corrugation_series(ok[run])))
 
@@ -156,8 +159,20 @@ class AlertManagerNode(PassConsumerNode):
         return super()._level()
 
 
-def _same_bands(a: CorrugationState, b: CorrugationState) -> bool:
-    return a.wavelength_m == b.wavelength_m and a.threshold_m == b.threshold_m
+def _same_bands(a: Any, b: Any) -> bool:
+    return np.array_equal(a.wavelength_m, b.wavelength_m) and np.array_equal(a.threshold_m, b.threshold_m)
+
+
+def _state_view(raw: bytes) -> Any:
+    """A CorrugationState read from its CDR, or the CdrError that says why it cannot be read."""
+    try:
+        return message_view("rail_msgs/msg/CorrugationState", raw)
+    except CdrError as exc:
+        return exc
+
+
+def _view_refusal(refusal: Callable[[Any], str]) -> Callable[[Any], str]:
+    return lambda view: f"not a readable CDR message ({view})" if isinstance(view, CdrError) else refusal(view)
 
 
 def main(args: list[str] | None = None) -> int:

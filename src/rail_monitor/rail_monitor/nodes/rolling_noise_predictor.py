@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from rail_monitor.bagio.cdr import message_view
 from rail_monitor.bagio.messages import corrugation_from_msg, header_of, rolling_noise_fields, time_ns
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
@@ -39,6 +40,7 @@ from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 from rail_monitor.noise.state_of_pass import first_state_needed, state_arrived, state_index
 from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
 
+STATE_TYPE = "rail_msgs/msg/CorrugationState"
 STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass queue is as deep)
 
 
@@ -67,7 +69,9 @@ class RollingNoisePredictor(PassConsumerNode):
         self.counts: Counter[str] = Counter()
         self.states_rejected: Counter[str] = Counter()
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
-        subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch)
+        # Raw: a state is read straight from its CDR (numpy views of its amplitudes), not converted by rclpy.
+        subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch,
+                          raw=True)
         # Only while passes wait for their state: an idle predictor has no timer to wake it.
         self._waiting = wall_timer(self, 0.05, self._flush)
         self._waiting.cancel()
@@ -76,11 +80,12 @@ class RollingNoisePredictor(PassConsumerNode):
     def key_parameters(self) -> dict[str, Any]:
         return {"models": "+".join(self.model.models), "state_wait_s": f"{self.wait_s:g}"}
 
-    def _on_states(self, msgs: list[CorrugationState]) -> None:
-        for msg in msgs:
+    def _on_states(self, raws: list[bytes]) -> None:
+        for raw in raws:
             try:
+                msg = message_view(STATE_TYPE, raw)
                 corrugation = corrugation_from_msg(msg)
-            except ValueError as exc:
+            except ValueError as exc:  # unusable, or not a CorrugationState's CDR (CdrError)
                 self.states_rejected[str(exc)] += 1
                 self.get_logger().warning(f"corrugation state refused: {exc}",
                                           throttle_duration_sec=self.log_throttle_s)
