@@ -152,7 +152,10 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     # and two states that are not CDR of a state at all (raw bytes): one cut short, one noise
     whole = bytes(serialize_message(states[0]))
     states_raw = [whole[: len(whole) // 2], bytes(np.random.default_rng(3).integers(0, 256, 300, np.uint8))]
-    for topic, msgs in (("train_pass", bad_passes), ("roughness_survey", surveys), ("corrugation/state", states),
+    whole = bytes(serialize_message(bad_passes[0]))
+    passes_raw = [whole[:20], b"\x00\x01\x00\x00" + bytes(np.random.default_rng(4).integers(0, 256, 90, np.uint8))]
+    for topic, msgs in (("train_pass", bad_passes), ("train_pass", passes_raw), ("roughness_survey", surveys),
+                        ("corrugation/state", states),
                         ("corrugation/state", states_raw),
                         ("noise/squeal", squeals), ("noise/rolling", noises),
                         ("/diagnostics", [_diagnostic("fake", 2000)])):
@@ -168,7 +171,7 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     assert wait_until(lambda: all(f.done() for f in futures), 20)
     assert not any(f.result().success for f in futures), [f.result().message for f in futures]
 
-    n_bad = len(bad_passes)
+    n_bad = len(bad_passes) + len(passes_raw)
     assert wait_until(lambda: all(n.taken == 3 + n_bad for n in (est, noise, squeal, alerts)), 20)
     assert wait_until(lambda: sum(est.surveys_rejected.values()) == len(surveys)
                       and sum(noise.states_rejected.values()) == 4 + 2  # the arrays it reads: 4 of the 8
@@ -177,6 +180,7 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
         (est.surveys_rejected, noise.states_rejected, alerts.inputs)
     for node in (est, noise, squeal, alerts):
         assert sum(node.rejected.values()) == n_bad, (node.get_name(), node.rejected)
+        assert node.rejected["not a readable TrainPass (CDR)"] == len(passes_raw), node.rejected
         assert not node.model_errors
     refused = {k: n for k, n in alerts.inputs.items() if " refused: " in k}
     assert sum(n for k, n in refused.items() if k.startswith("corrugation/state")) == len(states) + 2, refused

@@ -21,7 +21,9 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.parameter import Parameter
 
+from rail_monitor.bagio.cdr import CdrError, message_view
 from rail_monitor.bagio.messages import pass_row, time_ns
+from rail_monitor.bagio.typestore import TRAIN_PASS
 from rail_monitor.core.node_params import BATCH_SPECS, STAMP_SPECS, StampParams
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, reject_ahead, rejection_reasons, with_class_defaults
@@ -67,7 +69,9 @@ class PassConsumerNode(RailNode):
 
     def listen(self) -> None:
         """Subscribe train_pass (the last step of a subclass's __init__), and say so."""
-        subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, self.max_batch)
+        # Raw: each TrainPass is read straight from its CDR, not converted by rclpy.
+        subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, self.max_batch,
+                          raw=True)
         announce(self, site=self.site.site_id, radius_m=f"{self.site.curve_radius_m:g}",
                  classes="/".join(self.site.vehicles), **self.key_parameters())
 
@@ -82,11 +86,20 @@ class PassConsumerNode(RailNode):
     def on_validated(self, table: PassTable, reasons: list[str]) -> None:
         """See every taken pass with its reason ('' accepted), once, before on_passes. Nothing by default."""
 
-    def _on_train_passes(self, msgs: list[TrainPass]) -> None:
+    def _on_train_passes(self, raws: list[bytes]) -> None:
         try:
-            self._handle(msgs)
+            msgs = []
+            for raw in raws:
+                try:
+                    msgs.append(message_view(TRAIN_PASS, raw))
+                except CdrError as exc:
+                    self.rejected["not a readable TrainPass (CDR)"] += 1
+                    self.get_logger().warning(f"train_pass message refused: {exc}",
+                                              throttle_duration_sec=self.log_throttle_s)
+            if msgs:
+                self._handle(msgs)
         finally:
-            self.taken += len(msgs)  # after handling: a reader of ``taken`` sees the passes' effects
+            self.taken += len(raws)  # after handling: a reader of ``taken`` sees the passes' effects
 
     def _handle(self, msgs: list[TrainPass]) -> None:
         """Rejections and runs of accepted passes, in message order."""
