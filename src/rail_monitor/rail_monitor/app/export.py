@@ -300,7 +300,7 @@ class TableSink:
         elif names != self.names:
             raise ColumnsChanged(f"{self.path.name}: columns change along the run "
                                  f"({sorted(set(names) ^ set(self.names))[:3]})")
-        first = self.rows == 0 and not self._held and self._writer is None
+        first = self.rows == 0
         self.rows += len(t.columns[0].values)
         try:
             if self.fmt == "csv":

@@ -127,28 +127,44 @@ def _nested(name: str, sub: Encoder) -> Encoder:
 
 
 @functools.cache
-def _encoder(typename: str) -> Encoder:
-    """The compiled encoder of a type: appends one message's CDR (no header) to a buffer."""
-    defs = typestore().fielddefs[typename][1]
-    known = frozenset(name for name, _ in defs)
-    steps: list[Encoder] = []
-    run: _Run | None = None
-    for name, (kind, detail) in defs:
+def _layout(typename: str) -> tuple[_Run | tuple[str, int, Any], ...]:
+    """A type's fields in order: consecutive fixed-size ones as one _Run, the others as
+    (name, node kind, node detail); shared by its encoder and its decoder."""
+    out: list[_Run | tuple[str, int, Any]] = []
+    for name, (kind, detail) in typestore().fielddefs[typename][1]:
         if kind == Nodetype.BASE and detail[0] != "string":
-            if run is None:
-                run = _Run()
-                steps.append(run.encode)
+            if not out or not isinstance(out[-1], _Run):
+                out.append(_Run())
+            run = out[-1]
             run.names.append(name)
             run.codes.append(_BASE[detail[0]])
             run.zeros.append(_zero_of(detail[0]))
-            continue
-        run = None
-        if kind == Nodetype.BASE:
-            steps.append(functools.partial(_string_field, name))
-        elif kind == Nodetype.NAME:
-            steps.append(_nested(name, _encoder(detail)))
         else:
-            steps.append(_array_encoder(name, detail[0], detail[1] if kind == Nodetype.ARRAY else None))
+            out.append((name, kind, detail))
+    return tuple(out)
+
+
+def _steps(typename: str, run: Callable[[_Run], Any], string: Callable[[str], Any], nested: Callable[[str, str], Any],
+           array: Callable[[str, Any, int | None], Any]) -> list[Any]:
+    """One step per item of the type's layout, made by the function for its kind (a run of
+    fixed-size fields, a string, a sub-message, an array or sequence of length or None)."""
+    out = []
+    for item in _layout(typename):
+        if isinstance(item, _Run):
+            out.append(run(item))
+            continue
+        name, kind, detail = item
+        out.append(string(name) if kind == Nodetype.BASE else nested(name, detail) if kind == Nodetype.NAME
+                   else array(name, detail[0], detail[1] if kind == Nodetype.ARRAY else None))
+    return out
+
+
+@functools.cache
+def _encoder(typename: str) -> Encoder:
+    """The compiled encoder of a type: appends one message's CDR (no header) to a buffer."""
+    known = frozenset(name for name, _ in typestore().fielddefs[typename][1])
+    steps = _steps(typename, lambda run: run.encode, lambda name: functools.partial(_string_field, name),
+                   lambda name, sub: _nested(name, _encoder(sub)), _array_encoder)
 
     def encode(buf: bytearray, fields: Mapping[str, Any]) -> None:
         if not fields.keys() <= known:
@@ -177,10 +193,17 @@ def _align(pos: int, size: int) -> int:
     return pos + (-(pos - 4) % size)
 
 
-def _read_string(data: memoryview, pos: int) -> tuple[str, int]:
+def _read_count(data: memoryview, pos: int, length: int | None = None) -> tuple[int, int]:
+    """A fixed array's length, or a sequence's (or string's) uint32 count read at pos; and the
+    offset after it."""
+    if length is not None:
+        return length, pos
     pos = _align(pos, 4)
-    (n,) = _COUNT.unpack_from(data, pos)
-    pos += 4
+    return _COUNT.unpack_from(data, pos)[0], pos + 4
+
+
+def _read_string(data: memoryview, pos: int) -> tuple[str, int]:
+    n, pos = _read_count(data, pos)
     if n < 1 or pos + n > len(data) or data[pos + n - 1] != 0:
         raise CdrError(f"a string of {n} bytes at offset {pos} does not fit or is not terminated")
     return bytes(data[pos:pos + n - 1]).decode(), pos + n
@@ -192,11 +215,7 @@ def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Deco
         dtype = np.dtype(_BASE[detail[0]]).newbyteorder("<")
 
         def numeric(data: memoryview, pos: int, out: dict[str, Any]) -> int:
-            n = length
-            if n is None:
-                pos = _align(pos, 4)
-                (n,) = _COUNT.unpack_from(data, pos)
-                pos += 4
+            n, pos = _read_count(data, pos, length)
             if n:
                 pos = _align(pos, dtype.itemsize)
             end = pos + n * dtype.itemsize
@@ -208,13 +227,9 @@ def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Deco
     sub = None if kind == Nodetype.BASE else _decoder(detail)
 
     def items(data: memoryview, pos: int, out: dict[str, Any]) -> int:
-        n = length
-        if n is None:
-            pos = _align(pos, 4)
-            (n,) = _COUNT.unpack_from(data, pos)
-            pos += 4
-            if n > len(data) - pos:  # every element takes at least a byte
-                raise CdrError(f"field {name}: {n} elements cannot fit in {len(data)} bytes")
+        n, pos = _read_count(data, pos, length)
+        if n > len(data) - pos:  # every element takes at least a byte
+            raise CdrError(f"field {name}: {n} elements cannot fit in {len(data)} bytes")
         values = []
         for _ in range(n):
             if sub is None:
@@ -231,24 +246,8 @@ def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Deco
 @functools.cache
 def _decoder(typename: str) -> Decoder:
     """The compiled decoder of a type: reads one message's fields from an offset, returns the next."""
-    steps: list[Decoder] = []
-    run: _Run | None = None
-    for name, (kind, detail) in typestore().fielddefs[typename][1]:
-        if kind == Nodetype.BASE and detail[0] != "string":
-            if run is None:
-                run = _Run()
-                steps.append(run.decode)
-            run.names.append(name)
-            run.codes.append(_BASE[detail[0]])
-            run.zeros.append(_zero_of(detail[0]))
-            continue
-        run = None
-        if kind == Nodetype.BASE:
-            steps.append(functools.partial(_string_step, name))
-        elif kind == Nodetype.NAME:
-            steps.append(functools.partial(_nested_step, name, _decoder(detail)))
-        else:
-            steps.append(_array_decoder(name, detail[0], detail[1] if kind == Nodetype.ARRAY else None))
+    steps = _steps(typename, lambda run: run.decode, lambda name: functools.partial(_string_step, name),
+                   lambda name, sub: functools.partial(_nested_step, name, _decoder(sub)), _array_decoder)
 
     def decode(data: memoryview, pos: int, out: dict[str, Any]) -> int:
         for step in steps:

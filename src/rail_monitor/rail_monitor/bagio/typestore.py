@@ -20,6 +20,7 @@ from rail_monitor.core.timeutil import from_sec_nanosec
 
 SEPARATOR = "=" * 80
 TRAIN_PASS = "rail_msgs/msg/TrainPass"
+CORRUGATION_STATE = "rail_msgs/msg/CorrugationState"
 
 
 def _share_dir(package: str) -> Path:

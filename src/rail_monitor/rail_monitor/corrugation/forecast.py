@@ -41,7 +41,7 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
     log_threshold = np.log(threshold)
     margin = log_threshold - np.log(cg.band_amplitude(log_components))
-    axle_passes = _passes_to_level(log_components, growth, log_threshold, threads)
+    axle_passes = _passes_to_level_split(log_components, growth, log_threshold, threads)
     rows = np.arange(len(rate))
     worst = np.where(np.isfinite(axle_passes).any(axis=1), np.argmin(axle_passes, axis=1),
                      np.argmin(margin, axis=1))
@@ -55,7 +55,7 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     return Forecast(growth.max(axis=2), worst, passes, days, rate, due, due_ns)
 
 
-def _passes_to_level(log_components: np.ndarray, growth: np.ndarray, log_threshold: np.ndarray,
+def _passes_to_level_split(log_components: np.ndarray, growth: np.ndarray, log_threshold: np.ndarray,
                      threads: Threads | None) -> np.ndarray:
     parts = 0 if threads is None else min(threads.count, len(log_components) // PARALLEL_MIN_STATES)
     if threads is None or parts <= 1:

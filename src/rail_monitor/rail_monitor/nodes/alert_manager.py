@@ -23,7 +23,6 @@ from rclpy.parameter import Parameter
 
 from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, SEVERITY_CRITICAL, alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager, describe
-from rail_monitor.bagio.cdr import CdrError, message_view
 from rail_monitor.bagio.messages import (
     corrugation_series,
     noise_refusal,
@@ -33,10 +32,11 @@ from rail_monitor.bagio.messages import (
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
+from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import LEAD_TIME
-from rail_monitor.nodes.base import Sent, declare, runs, subscribe_batched, wall_timer
+from rail_monitor.nodes.base import Sent, declare, read_views, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
@@ -83,12 +83,19 @@ class AlertManagerNode(PassConsumerNode):
         ok = []
         for m in msgs:
             why = refusal(m)
-            if not why:
+            if why:
+                self._refuse(topic, why)
+            else:
                 ok.append(m)
-                continue
-            self.inputs[f"{topic} refused: {why}"] += 1
-            self.get_logger().warning(f"{topic} message refused: {why}", throttle_duration_sec=self.log_throttle_s)
         return ok
+
+    def _refuse(self, topic: str, why: str) -> None:
+        self.inputs[f"{topic} refused: {why}"] += 1
+        self.get_logger().warning(f"{topic} message refused: {why}", throttle_duration_sec=self.log_throttle_s)
+
+    def _unreadable_on(self, topic: str, exc: Exception) -> None:
+        self.inputs[topic] += 1
+        self._refuse(topic, f"not a readable CDR message ({exc})")
 
     def _on_squeal(self, msgs: list[SquealPrediction]) -> None:
         msgs = self._usable("noise/squeal", msgs, squeal_refusal)
@@ -105,7 +112,8 @@ class AlertManagerNode(PassConsumerNode):
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
 
     def _on_states(self, raws: list[bytes]) -> None:
-        ok = self._usable("corrugation/state", [_state_view(r) for r in raws], _view_refusal(state_refusal))
+        views = read_views(CORRUGATION_STATE, raws, lambda exc: self._unreadable_on("corrugation/state", exc))
+        ok = self._usable("corrugation/state", views, state_refusal)
         for run in runs(ok, _same_bands):  # states on the same bands and thresholds, as one series
             self._emit(self.alerts.on_states(**corrugation_series(ok[run])))
 
@@ -162,17 +170,6 @@ class AlertManagerNode(PassConsumerNode):
 def _same_bands(a: Any, b: Any) -> bool:
     return np.array_equal(a.wavelength_m, b.wavelength_m) and np.array_equal(a.threshold_m, b.threshold_m)
 
-
-def _state_view(raw: bytes) -> Any:
-    """A CorrugationState read from its CDR, or the CdrError that says why it cannot be read."""
-    try:
-        return message_view("rail_msgs/msg/CorrugationState", raw)
-    except CdrError as exc:
-        return exc
-
-
-def _view_refusal(refusal: Callable[[Any], str]) -> Callable[[Any], str]:
-    return lambda view: f"not a readable CDR message ({view})" if isinstance(view, CdrError) else refusal(view)
 
 
 def main(args: list[str] | None = None) -> int:

@@ -21,7 +21,6 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.parameter import Parameter
 
-from rail_monitor.bagio.cdr import CdrError, message_view
 from rail_monitor.bagio.messages import pass_row, time_ns
 from rail_monitor.bagio.typestore import TRAIN_PASS
 from rail_monitor.core.node_params import BATCH_SPECS, STAMP_SPECS, StampParams
@@ -37,6 +36,7 @@ from rail_monitor.nodes.base import (
     declare,
     declare_site,
     isolate_failures,
+    read_views,
     runs,
     subscribe_batched,
 )
@@ -88,14 +88,7 @@ class PassConsumerNode(RailNode):
 
     def _on_train_passes(self, raws: list[bytes]) -> None:
         try:
-            msgs = []
-            for raw in raws:
-                try:
-                    msgs.append(message_view(TRAIN_PASS, raw))
-                except CdrError as exc:
-                    self.rejected["not a readable TrainPass (CDR)"] += 1
-                    self.get_logger().warning(f"train_pass message refused: {exc}",
-                                              throttle_duration_sec=self.log_throttle_s)
+            msgs = read_views(TRAIN_PASS, raws, self._unreadable_pass)
             if msgs:
                 self._handle(msgs)
         finally:
@@ -116,6 +109,10 @@ class PassConsumerNode(RailNode):
             self.rejected[why] += 1
             self.get_logger().warning(f"pass {msgs[run.start].train_id!r} rejected: {why}",
                                       throttle_duration_sec=self.log_throttle_s)
+
+    def _unreadable_pass(self, exc: Exception) -> None:
+        self.rejected["not a readable TrainPass (CDR)"] += 1
+        self.get_logger().warning(f"train_pass message refused: {exc}", throttle_duration_sec=self.log_throttle_s)
 
     def _on_set_throttle(self, params: list[Parameter]) -> SetParametersResult:
         """ros2 param set log_throttle_s: rclpy has checked its type and range already."""

@@ -53,7 +53,8 @@ COALESCE_S = 0.005
 
 class CoalescingExecutor(SingleThreadedExecutor):
     """rclpy's single-threaded executor that pauses COALESCE_S before a wait when the last wait
-    found work (the executor of every single-node executable and of wayside_monitor)."""
+    found work (the executor of every single-node executable). It wraps rclpy's wait generator
+    (``_wait_for_ready_callbacks``, rclpy 7.1 as pinned), the one place a new wait begins."""
 
     def __init__(self, coalesce_s: float = COALESCE_S, **kwargs: Any) -> None:
         super().__init__(**kwargs)

@@ -27,6 +27,7 @@ import numpy as np
 
 from rail_monitor.bagio.cdr import message_view
 from rail_monitor.bagio.messages import corrugation_from_msg, header_of, rolling_noise_fields, time_ns
+from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
@@ -40,7 +41,6 @@ from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 from rail_monitor.noise.state_of_pass import first_state_needed, state_arrived, state_index
 from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
 
-STATE_TYPE = "rail_msgs/msg/CorrugationState"
 STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass queue is as deep)
 
 
@@ -83,7 +83,7 @@ class RollingNoisePredictor(PassConsumerNode):
     def _on_states(self, raws: list[bytes]) -> None:
         for raw in raws:
             try:
-                msg = message_view(STATE_TYPE, raw)
+                msg = message_view(CORRUGATION_STATE, raw)
                 corrugation = corrugation_from_msg(msg)
             except ValueError as exc:  # unusable, or not a CorrugationState's CDR (CdrError)
                 self.states_rejected[str(exc)] += 1
