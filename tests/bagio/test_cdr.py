@@ -76,9 +76,17 @@ def test_bytes_equal_rosbags_and_decode_with_rclpy(topic):
 def test_missing_fields_are_zero_and_wrong_lengths_are_refused():
     typename = "rail_msgs/msg/CorrugationState"
     full = _random_fields(np.random.default_rng(1), typename)
-    zero = {k: (v if k == "k_b_by_friction" else type(v)() if not isinstance(v, dict) else
-                {"sec": 0, "nanosec": 0} if k.endswith("time") else {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""})
-            for k, v in full.items()}
+    # Fixed-length arrays left out are zeros, as rclpy and rosbags construct them.
+    def zero_of(k, v):
+        if k == "k_b_by_friction":
+            return v
+        if k.startswith("k_b_"):
+            return [0.0] * 4
+        if not isinstance(v, dict):
+            return type(v)()
+        return {"sec": 0, "nanosec": 0} if k.endswith("time") else {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": ""}
+
+    zero = {k: zero_of(k, v) for k, v in full.items()}
     assert serialize(typename, {"k_b_by_friction": full["k_b_by_friction"]}) == serialize(typename, zero)
     with pytest.raises(ValueError, match="k_b_by_friction"):
         serialize(typename, {"k_b_by_friction": [1.0, 2.0]})

@@ -107,3 +107,24 @@ def test_forecasts_split_over_threads_are_the_same_bits():
         one, two = fcst.forecasts(*args), fcst.forecasts(*args, threads=fcst.Threads(pool, 2))
     for a, b in zip(dataclasses.astuple(one), dataclasses.astuple(two), strict=True):
         assert np.array_equal(a, b)
+
+
+def test_interval_collapses_to_the_forecast_without_uncertainty(site_, tables):
+    # Independent method: with a posterior of (almost) no spread and levels known exactly, every
+    # quantile is the deterministic forecast's days to threshold (within 1e-6 relative); with the
+    # prior's spread, P10 < P50 < P90 around it.
+    from rail_monitor.models import calibration
+
+    est = _estimator(site_, tables)
+    rng = np.random.default_rng(2)
+    est.advance(_passes(site_, rng.normal(19.0, 1.0, 400), friction=rng.integers(1, 5, 400)))
+    point = est.forecast().days_to_threshold
+    wide = est.forecast_interval()
+    assert wide.days[0] < point < wide.days[2]
+    est.calibration = dataclasses.replace(est.calibration, cov=1e-18 * np.eye(4))
+    est.level_var = np.zeros(len(est.bands))
+    narrow = est.forecast_interval()
+    np.testing.assert_allclose(narrow.days, point, rtol=1e-6)
+    from scipy.stats import norm
+
+    assert norm.ppf(0.1) == pytest.approx(calibration.Z_P10, abs=1e-15)

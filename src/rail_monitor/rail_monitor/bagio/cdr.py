@@ -96,7 +96,7 @@ def _array_encoder(name: str, item: tuple[Any, Any], length: int | None) -> Enco
         size = dtype.itemsize
 
         def numeric(buf: bytearray, fields: Mapping[str, Any]) -> None:
-            data = np.asarray(fields.get(name, ()), dtype=dtype)
+            data = np.asarray(fields.get(name, () if length is None else np.zeros(length)), dtype=dtype)
             if data.ndim != 1 or (length is not None and len(data) != length):
                 raise ValueError(f"field {name}: expected {length or 'a sequence of'} values, got shape {data.shape}")
             if length is None:

@@ -95,7 +95,8 @@ def corrugation_state_fields(snap: StateSnapshot, fc: Forecast, frame_id: str) -
         "worst_wavelength_m": float(snap.bands[fc.worst_band]), "passes_to_threshold": float(fc.passes_to_threshold),
         "days_to_threshold": float(fc.days_to_threshold), "passes_per_day": float(fc.passes_per_day),
         "grinding_due": bool(fc.grinding_due), "grinding_due_time": future_time_fields(fc.grinding_due_ns),
-        "k_b_by_friction": [float(k) for k in snap.k_b]}
+        "k_b_by_friction": [float(k) for k in snap.k_b], "k_b_p10_by_friction": [float(k) for k in snap.k_b_p10],
+        "k_b_p90_by_friction": [float(k) for k in snap.k_b_p90], "calibration_surveys": int(snap.calibration_surveys)}
 
 
 def speed_advisory_fields(advice: SpeedAdvice, stamp_ns: int, frame_id: str) -> Fields:

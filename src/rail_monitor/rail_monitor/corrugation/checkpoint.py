@@ -3,7 +3,8 @@ previous good file.
 
 The file is a numpy .npz (zip members with CRCs): a JSON ``meta`` record (version, site, counts,
 times), the band centres, ln Z of every component, K_b, the last survey and the post-grinding
-amplitudes, and the kept passes' columns.
+amplitudes, the calibration (growth since the last survey per friction state, the covariance of
+ln K_b, each band's level variance) and the kept passes' columns.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import io
 import json
 import os
 import zipfile
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -19,11 +21,15 @@ import numpy as np
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.history import COLUMNS, KeptPasses
+from rail_monitor.models import calibration
 
-VERSION = 3
+VERSION = 4
 # 1: before grinding_amplitude (read as the post-grinding default); 1-2: before the contact regime
-# (their kept passes read as in partial slip, at their class's nominal load, as they were counted).
-READABLE_VERSIONS = (1, 2, 3)
+# (their kept passes read as in partial slip, at their class's nominal load, as they were counted);
+# 1-3: before the calibration (read as the prior about their K_b, no growth since the last survey,
+# each band's level known to the post-grinding uncertainty).
+READABLE_VERSIONS = (1, 2, 3, 4)
+CALIBRATION_ARRAYS = ("growth_by_state", "calibration_cov", "level_var")
 CONTACT_COLUMNS = ("regime", "load", "creepage")
 _COUNTS = ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns", "last_survey_ns")
 
@@ -46,10 +52,11 @@ def save(est: CorrugationEstimator, path: str | Path) -> None:
     """
     path = Path(path)
     meta = {"version": VERSION, "site_id": est.site.site_id, **{k: getattr(est, k) for k in _COUNTS},
-            "newest_train_id": est.newest_train_id}
+            "newest_train_id": est.newest_train_id, "calibration_fits": est.calibration.fits}
     buf = io.BytesIO()
     np.savez(buf, meta=np.array(json.dumps(meta)), bands=est.bands, log_components=est.log_components,
              k_b=est.k_b, survey_log_amplitude=est.survey_log_amplitude, grinding_amplitude=est.grinding_amplitude,
+             growth_by_state=est.growth_by_state, calibration_cov=est.calibration.cov, level_var=est.level_var,
              **{f"recent_{n}": est.kept.train_id.astype(str) if n == "train_id" else getattr(est.kept, n)
                 for n in COLUMNS})
     tmp = path.with_name(f".{path.name}.tmp")
@@ -74,10 +81,10 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
         with np.load(path, allow_pickle=False) as z:
             data = {k: z[k] for k in z.files}  # zip member CRCs are checked as each is read
         meta = json.loads(str(data["meta"]))
-        wanted = COLUMNS if isinstance(meta, dict) and meta.get("version") == VERSION else \
-            tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
-        missing = {"bands", "log_components", "k_b", "survey_log_amplitude", *(f"recent_{n}" for n in wanted)} \
-            - set(data)
+        version = meta.get("version") if isinstance(meta, dict) else None
+        wanted = COLUMNS if version in (3, VERSION) else tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
+        missing = {"bands", "log_components", "k_b", "survey_log_amplitude", *(f"recent_{n}" for n in wanted),
+                   *(CALIBRATION_ARRAYS if version == VERSION else ())} - set(data)
         if missing:
             raise KeyError(f"arrays missing: {', '.join(sorted(missing))}")
     except FileNotFoundError:
@@ -145,12 +152,35 @@ def _state(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarray]) -
               or not np.all(np.isin(cols["regime"], (0, 1))) or not np.all(np.isfinite(cols["load"]))
               or not np.all(np.isfinite(cols["creepage"]))):
         raise ValueError("kept passes hold an unknown class, friction state, regime, speed, load or creepage")
+    calibrated = _calibration(est, meta, data, k_b)
     counts = {key: int(meta[key]) for key in _COUNTS}
     if any(v < 0 for v in counts.values()):
         raise ValueError("negative counts")
     return {"log_components": log_components, "survey_log_amplitude": survey, "grinding_amplitude": grinding,
             **counts, "newest_train_id": str(meta.get("newest_train_id", "")), "kept": KeptPasses(**cols),
-            "_k_b": k_b}
+            **calibrated, "_k_b": k_b}
+
+
+def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarray], k_b: np.ndarray) -> dict:
+    """The calibration's attributes: from the file (version 4), else the prior about its K_b. The
+    posterior mean is ln(K_b / the configured default), so a changed default keeps the fitted K_b."""
+    default = est.cfg.k_b
+    mean = np.log(np.divide(k_b, default, out=np.ones(4), where=(default > 0) & (k_b > 0)))
+    if "calibration_cov" not in data:
+        return {"growth_by_state": np.zeros_like(est.growth_by_state), "level_var": est.post_grinding_var.copy(),
+                "calibration": replace(est.calibration, mean=mean)}
+    growth = np.asarray(data["growth_by_state"], float)
+    cov = np.asarray(data["calibration_cov"], float)
+    level_var = np.asarray(data["level_var"], float)
+    fits = int(meta.get("calibration_fits", 0))
+    if growth.shape != est.growth_by_state.shape or cov.shape != (4, 4) or level_var.shape != est.bands.shape:
+        raise ValueError("calibration arrays have the wrong shape")
+    if not (np.all(np.isfinite(growth)) and np.all(np.isfinite(level_var)) and np.all(level_var >= 0)
+            and np.allclose(cov, cov.T) and fits >= 0):
+        raise ValueError("calibration arrays not finite, variances negative or covariance not symmetric")
+    np.linalg.cholesky(cov)  # LinAlgError (a ValueError) unless positive definite
+    return {"growth_by_state": growth, "level_var": level_var,
+            "calibration": calibration.KbPosterior(mean, cov, fits)}
 
 
 def resume(est: CorrugationEstimator, path: str | Path) -> tuple[Path | None, list[str]]:

@@ -35,6 +35,14 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("points_per_band", 5, "Wavelengths across each band over which its growth is averaged [-].", 1, 50),
     *(ParamSpec(f"k_b.{state}", value, f"Wear sensitivity K_b with {state} rail, per axle pass [-] (re-fitted "
                 "from roughness surveys).", 0.0, 1.0e-2) for state, value in K_B_DEFAULTS.items()),
+    ParamSpec("kb_prior_scale_sd", 1.0, "Prior standard deviation of ln K_b common to every friction state [-] "
+              "(1: the defaults are known to a factor of e).", 0.01, 10.0),
+    ParamSpec("kb_prior_ratio_sd", 0.3, "Prior standard deviation of ln K_b of one friction state about the "
+              "common scale [-].", 0.01, 10.0),
+    ParamSpec("survey_uncertainty_db", 1.0, "Standard uncertainty of a surveyed band roughness level [dB].",
+              0.01, 20.0),
+    ParamSpec("post_grinding_uncertainty_db", 3.0, "Standard uncertainty of the post-grinding roughness where a "
+              "grinding event gives no spectrum [dB].", 0.01, 20.0),
     ParamSpec("sliding_wear_ratio", 1.0, "Mean wear per pass in full sliding over that in partial slip at the same "
               "friction state [-]; K_b in full sliding is -2/3 of this times K_b (docs/models.md, Sliding).",
               0.0, 100.0),

@@ -26,7 +26,8 @@ from rail_monitor.corrugation import forecast as fcst
 from rail_monitor.corrugation.config import CorrugationConfig
 from rail_monitor.corrugation.growth import GrowthTables
 from rail_monitor.corrugation.history import KeptPasses
-from rail_monitor.corrugation.records import Forecast, StateSnapshot, Trajectory
+from rail_monitor.corrugation.records import Forecast, ForecastInterval, StateSnapshot, Trajectory
+from rail_monitor.models import calibration
 from rail_monitor.models import corrugation as cg
 
 
@@ -52,6 +53,14 @@ class CorrugationEstimator:
         self.newest_train_id = ""                                      # train_id of the newest pass counted
         self.last_survey_ns = 0                                        # last survey or grinding applied
         self.survey_log_amplitude = np.full(len(self.bands), np.nan)   # last survey, NaN: band not measured
+        # Log growth since the last survey or grinding per friction state (4, B, P), at the K_b in
+        # use: what the next survey re-fits K_b against (rail_monitor.models.calibration).
+        self.growth_by_state = np.zeros((4, *self.log_components.shape))
+        self.calibration = calibration.prior(cfg.kb_prior_scale_sd, cfg.kb_prior_ratio_sd)
+        # Variance of each band's ln Z at the last survey or grinding [-].
+        self.post_grinding_var = np.full(len(self.bands),
+                                         (cfg.post_grinding_uncertainty_db * calibration.LN_PER_DB) ** 2)
+        self.level_var = self.post_grinding_var.copy()
         self.kept = KeptPasses()
         self.threads: fcst.Threads | None = None  # threads a history's forecasts may use (batch: its pool)
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
@@ -97,6 +106,10 @@ class CorrugationEstimator:
         # Sequential sums (cumsum), so a batch adds as the same passes one by one would.
         steps = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[1:]
         self.log_components = steps[-1].copy()
+        friction = np.asarray(new.friction_state)
+        for f in np.unique(friction).tolist():  # cumsum: sequential, as the passes one by one
+            self.growth_by_state[f - 1] = np.cumsum(
+                np.concatenate([self.growth_by_state[f - 1][None], growth[friction == f]]), axis=0)[-1]
         summed = np.cumsum(np.concatenate([self._growth_total[None], growth]), axis=0)
         self._growth_before = np.concatenate([self._growth_before, summed[:-1]])
         self._growth_total = summed[-1].copy()
@@ -161,7 +174,8 @@ class CorrugationEstimator:
         """The state as a CorrugationState carries it (without the forecast)."""
         return StateSnapshot(self.newest_ns, self.newest_train_id, self.pass_count, self.axle_pass_count,
                              self.total_pass_count, self.last_grinding_ns, self.bands, self.amplitude,
-                             self.threshold, self.grinding_amplitude.copy(), self.k_b.copy())
+                             self.threshold, self.grinding_amplitude.copy(), self.k_b.copy(), self.k_b_p10,
+                             self.k_b_p90, self.calibration_surveys)
 
     def _prune(self) -> None:
         k = self.kept
@@ -202,11 +216,43 @@ class CorrugationEstimator:
     def k_b(self) -> np.ndarray:
         return self.tables.k_b
 
+    @property
+    def k_b_p10(self) -> np.ndarray:
+        return self.calibration.quantiles(self.cfg.k_b)[0]
+
+    @property
+    def k_b_p90(self) -> np.ndarray:
+        return self.calibration.quantiles(self.cfg.k_b)[2]
+
+    @property
+    def calibration_surveys(self) -> int:
+        return self.calibration.fits
+
     def recent_growth(self) -> np.ndarray:
         """g per component (B, P) [1/axle pass]: the kept passes' growth, averaged per axle pass."""
         if self._axle_sum == 0:
             return np.zeros((len(self.bands), self.points))
         return (self._growth_total - self._growth_before[0]) / self._axle_sum
+
+    def recent_growth_by_state(self) -> np.ndarray:
+        """recent_growth() split by friction state (4, B, P) [1/axle pass of all kept passes]."""
+        k, out = self.kept, np.zeros((4, *self.log_components.shape))
+        if self._axle_sum == 0:
+            return out
+        growth = self._growth(k.class_idx, k.friction, k.regime, k.speed, k.axles)
+        for f in range(4):
+            out[f] = growth[k.friction == f + 1].sum(axis=0)
+        return out / self._axle_sum
+
+    def forecast_interval(self) -> ForecastInterval:
+        """P10, P50 and P90 of the days to threshold over the K_b posterior and the level variance
+        of each band, at the recent traffic (:func:`.forecast.interval`)."""
+        rate, axles = self.traffic()
+        axles = axles if np.isfinite(axles) else self.site.mean_axles_per_train
+        days_per_axle_pass = 1.0 / (rate * axles) if np.isfinite(rate) and rate > 0 else np.inf
+        return fcst.interval(self.log_components, self.growth_by_state, self.recent_growth_by_state(),
+                             self.calibration, np.sqrt(self.level_var), self.threshold, days_per_axle_pass,
+                             self.newest_ns)
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic (see :func:`.forecast.traffic`)."""

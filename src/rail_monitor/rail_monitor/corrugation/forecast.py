@@ -14,13 +14,17 @@ import numpy as np
 
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation.history import KeptPasses
-from rail_monitor.corrugation.records import Forecast
+from rail_monitor.corrugation.records import Forecast, ForecastInterval
+from rail_monitor.models import calibration
 from rail_monitor.models import corrugation as cg
 
 # Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
 # passes nearly balancing the others) can be 1e12 days away, past any 64-bit time stamp.
 MAX_DATED_DAYS = 36_525.0
-PARALLEL_MIN_STATES = 2_000  # fewer states per thread cost more to hand over than they save
+PARALLEL_MIN_STATES = 2_000
+INTERVAL_DRAWS = 500  # draws of the forecast interval: its quantiles to about +-2 % of the spread
+INTERVAL_SEED = 20_260_901
+  # fewer states per thread cost more to hand over than they save
 
 
 class Threads(NamedTuple):
@@ -81,3 +85,32 @@ def traffic(kept: KeptPasses, min_traffic_days: float) -> tuple[float, float]:
     span = (int(kept.stamp_ns.max()) - int(kept.stamp_ns.min())) / NS_PER_DAY
     rate = (len(kept) - 1) / span if span > 0 and span >= min_traffic_days else float("nan")
     return rate, float(kept.axles.mean())
+
+
+def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth_by_state: np.ndarray,
+             posterior: calibration.KbPosterior, level_sd: np.ndarray, threshold: np.ndarray,
+             days_per_axle_pass: float, newest_ns: int) -> ForecastInterval:
+    """P10, P50 and P90 of the days to threshold, per band and of the first band, over the
+    uncertainty of K_b and of the present roughness.
+
+    ln Z (B, P) [ln m]; the log growth since the last survey per friction state (4, B, P), computed
+    at the posterior median; the recent growth per friction state (4, B, P) [1/axle pass]; the
+    standard deviation of each band's ln Z at the last survey (level_sd (B,) [-]); thresholds (B,) [m]; days per axle
+    pass at the recent traffic. Each of INTERVAL_DRAWS fixed draws takes ln K_b from the posterior
+    (both growths scale with exp(delta_f), first order in K_b) and an independent error of each
+    band's level, and is forecast as the state is; the quantiles are those of the draws (so the
+    same state gives the same interval in every process). The traffic and its friction mix are
+    the recent window's.
+    """
+    rng = np.random.Generator(np.random.PCG64(INTERVAL_SEED))
+    delta = rng.standard_normal((INTERVAL_DRAWS, len(posterior.mean))) @ np.linalg.cholesky(posterior.cov).T
+    level = level_sd * rng.standard_normal((INTERVAL_DRAWS, len(threshold)))
+    state = log_components + np.einsum("df,fbp->dbp", np.expm1(delta), growth_since_survey) + level[:, :, None]
+    growth = np.einsum("df,fbp->dbp", np.exp(delta), growth_by_state)
+    axle_passes = cg.passes_to_band_level(state, growth, np.log(threshold))
+    with np.errstate(invalid="ignore"):
+        days = np.where(axle_passes == 0.0, 0.0, axle_passes * days_per_axle_pass)
+    q = (0.1, 0.5, 0.9)
+    first = np.quantile(days.min(axis=1), q, method="inverted_cdf")
+    due = np.array([newest_ns + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0 for d in first.tolist()], np.int64)
+    return ForecastInterval(np.quantile(days, q, axis=0, method="inverted_cdf"), first, due)

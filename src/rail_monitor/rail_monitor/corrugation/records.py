@@ -23,6 +23,16 @@ class Forecast:
 
 
 @dataclass(frozen=True)
+class ForecastInterval:
+    """The grinding forecast's P10, P50 and P90: days to threshold per band (3, B), of the first
+    band to reach it (3,), and that date (3,) [ns] (0: never, or past the dated horizon)."""
+
+    band_days: np.ndarray
+    days: np.ndarray
+    due_ns: np.ndarray
+
+
+@dataclass(frozen=True)
 class StateSnapshot:
     """What a CorrugationState carries besides the forecast (units as in the message)."""
 
@@ -37,6 +47,9 @@ class StateSnapshot:
     threshold: np.ndarray
     grinding_amplitude: np.ndarray
     k_b: np.ndarray
+    k_b_p10: np.ndarray
+    k_b_p90: np.ndarray
+    calibration_surveys: int
 
 
 @dataclass
@@ -65,7 +78,8 @@ class Trajectory:
         c, f = self.constants, self.forecast
         snap = StateSnapshot(int(self.stamp_ns[k]), str(self.train_id[k]), int(self.pass_count[k]),
                              int(self.axle_pass_count[k]), int(self.total_pass_count[k]), c.last_grinding_ns,
-                             c.bands, self.amplitude[k], c.threshold, c.grinding_amplitude, c.k_b)
+                             c.bands, self.amplitude[k], c.threshold, c.grinding_amplitude, c.k_b,
+                             c.k_b_p10, c.k_b_p90, c.calibration_surveys)
         return snap, Forecast(f.growth_per_axle_pass[k], int(f.worst_band[k]), float(f.passes_to_threshold[k]),
                               float(f.days_to_threshold[k]), float(f.passes_per_day[k]), bool(f.grinding_due[k]),
                               int(f.grinding_due_ns[k]))

@@ -1,11 +1,11 @@
 """Measured roughness surveys and grinding events applied to a corrugation state.
 
-A survey re-fits K_b from the growth between two surveys: the measured growth rate of a band is
-g_hat = ln(Z2 / Z1) / (n2 - n1) (the UQ seminar paper, see :mod:`rail_monitor.corrugation`;
-docs/models.md, "Surveys"). Since ln|1 + K_b x| is K_b x to first order, the scale s minimising
-sum (ln(Z2/Z1) - s Delta_model)^2 over the bands measured twice (Delta_model: the state's ln Z
-growth since the first survey) scales K_b of every friction state (one survey pair cannot
-separate them). A measured band keeps its components' shape, scaled to the measured r.m.s.
+A survey re-fits K_b per friction state from the growth since the last survey: a Bayesian update
+of ln K_b (:mod:`rail_monitor.models.calibration`; docs/models.md, "Calibration") against the
+state's growth since then, split by friction state. The state then follows the fitted K_b (its
+growth since the last survey re-scaled), and each measured band's level is the Kalman update of
+the model's prediction by the survey (each weighed by its variance; a band keeps its components'
+shape). Each band's level variance is kept: it weighs the next fit and the forecast interval.
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.models import calibration
 
 
 def match_bands(bands: np.ndarray, wavelength: np.ndarray, amplitude: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -35,24 +36,36 @@ def match_bands(bands: np.ndarray, wavelength: np.ndarray, amplitude: np.ndarray
 
 
 def apply_survey(est: CorrugationEstimator, wavelength: np.ndarray, amplitude: np.ndarray,
-                 stamp_ns: int = 0) -> float | None:
-    """Take a measured roughness survey (wavelengths [m], r.m.s. amplitudes [m]): re-fit K_b against
-    the previous survey, then set the measured bands to the measurement. Returns the K_b scale
-    applied, or None without a fit."""
+                 stamp_ns: int = 0) -> calibration.KbPosterior | None:
+    """Take a measured roughness survey (wavelengths [m], r.m.s. amplitudes [m]): re-fit K_b from
+    the growth since the last survey, then update the state's level of the measured bands. Returns
+    the posterior of K_b after the fit, or None without one (no growth since the last survey)."""
     z, matched = match_bands(est.bands, wavelength, amplitude)
-    scale = None
-    both = matched & np.isfinite(est.survey_log_amplitude)
-    dm = est.log_amplitude[both] - est.survey_log_amplitude[both]
-    if both.any() and np.dot(dm, dm) > 0:  # no passes since the last survey: nothing to fit
-        measured = np.log(z[both]) - est.survey_log_amplitude[both]
-        s = float(np.dot(measured, dm) / np.dot(dm, dm))
-        if s > 0:
-            scale = s
-            est.set_k_b(est.k_b * s)
-    est.log_components[matched] += (np.log(z[matched]) - est.log_amplitude[matched])[:, None]
+    measured = np.log(z[matched])
+    noise_var = (est.cfg.survey_uncertainty_db * calibration.LN_PER_DB) ** 2
+    fit = None
+    growth = est.growth_by_state
+    if np.any(growth[:, matched] != 0.0):
+        start = est.log_components[matched] - growth[:, matched].sum(axis=0)
+        sigma = np.sqrt(noise_var + est.level_var[matched])
+        fit, delta = calibration.update(est.calibration, start, growth[:, matched], measured, sigma)
+        growth = growth * np.exp(delta)[:, None, None]
+        est.log_components += np.einsum("f,fbp->bp", np.expm1(delta), est.growth_by_state)
+        est.calibration = fit
+        est.set_k_b(fit.k_b(est.cfg.k_b))
+    # Kalman update of each band's ln Z: the model's prediction (its level's variance and the
+    # growth's, from K_b) weighed against the survey's.
+    level = calibration.band_log_amplitude(est.log_components)
+    jac = np.einsum("bp,fbp->bf", np.exp(2.0 * (est.log_components - level[:, None])), growth)
+    predicted_var = est.level_var + np.einsum("bf,fg,bg->b", jac, est.calibration.cov, jac)
+    gain = predicted_var[matched] / (predicted_var[matched] + noise_var)
+    est.log_components[matched] += (gain * (measured - level[matched]))[:, None]
+    est.level_var = predicted_var
+    est.level_var[matched] = gain * noise_var
     est.survey_log_amplitude = np.where(matched, np.log(np.where(matched, z, 1.0)), np.nan)
+    est.growth_by_state[:] = 0.0
     est.last_survey_ns = max(est.last_survey_ns, int(stamp_ns))
-    return scale
+    return fit
 
 
 def apply_grinding(est: CorrugationEstimator, stamp_ns: int, wavelength: np.ndarray | None = None,
@@ -66,6 +79,10 @@ def apply_grinding(est: CorrugationEstimator, stamp_ns: int, wavelength: np.ndar
         rms[matched] = z[matched]
         est.survey_log_amplitude[matched] = np.log(z[matched])
     est.log_components = est.flat(rms)
+    est.growth_by_state[:] = 0.0
+    est.level_var = est.post_grinding_var.copy()
+    if wavelength is not None and len(wavelength):
+        est.level_var[matched] = (est.cfg.survey_uncertainty_db * calibration.LN_PER_DB) ** 2
     est.grinding_amplitude = rms
     est.pass_count = est.axle_pass_count = 0
     est.last_grinding_ns = int(stamp_ns)

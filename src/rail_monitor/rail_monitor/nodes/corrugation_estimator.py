@@ -132,10 +132,11 @@ class CorrugationEstimatorNode(PassConsumerNode):
             if self.stamp_ahead(stamp):  # one far-future survey would refuse every later one
                 raise ValueError(self.stamp_ahead(stamp))
             if msg.kind == RoughnessSurvey.KIND_SURVEY:
-                scale = surveys.apply_survey(self.est, msg.wavelength_m, msg.amplitude_m, stamp)
+                fit = surveys.apply_survey(self.est, msg.wavelength_m, msg.amplitude_m, stamp)
                 self.counts["surveys"] += 1
-                if scale is not None:
-                    self.get_logger().info(f"survey re-fitted K_b by x{scale:.3g}: {self.est.k_b.tolist()}")
+                if fit is not None:
+                    self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
+                                           f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
             elif msg.kind == RoughnessSurvey.KIND_GRINDING:
                 surveys.apply_grinding(self.est, stamp, msg.wavelength_m, msg.amplitude_m)
                 self.counts["grindings"] += 1

@@ -1,0 +1,121 @@
+"""Calibration of the wear coefficient K_b from roughness surveys: a Bayesian update in ln K_b.
+
+The unknowns are u_f = ln(K_b,f / K_b,f default) for the four friction states. The prior is
+Gaussian with covariance s^2 (1 1^T) + r^2 I: a common scale that is known to an order of
+magnitude (s) and ratios between friction states that the wear model fixes more closely (r), so a
+survey that constrains mostly the sum of the growth still moves every state's K_b.
+
+A survey at t2 measures y_b = ln Z_b(t2) per band b. Since the last survey or grinding (t1) the
+state's components grew by G_f (friction state f, computed at the K_b in use); since
+ln|1 + K_b F^2 H| = K_b F^2 H to first order (K_b F^2 H is about 1e-6 per axle pass), changing u
+by delta scales G_f by exp(delta_f), so the model's band level is
+
+    yhat_b(delta) = ln sqrt(sum_p exp(2 (C_bp + sum_f exp(delta_f) G_f,bp)))
+
+with C the components at t1 (UQ seminar paper eqs. 1-2; the band r.m.s. is the energy sum of its
+components). The posterior mode maximises the Gaussian likelihood (variance sigma_b^2 per band:
+the survey's plus the state's at t1) times the prior, found by Gauss-Newton; its Laplace
+covariance is the inverse Hessian of the negative log posterior at the mode (J^T W J + P^-1 less
+the residuals' curvature; W = diag 1/sigma_b^2; e.g. Gelman et al., Bayesian Data Analysis, 3rd
+ed., CRC 2013, sec. 4.1 and 13.3). Each survey's posterior is the next one's prior.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+LN_PER_DB = np.log(10.0) / 20.0  # ln Z per dB of a roughness level (20 lg Z)
+Z_P10 = -1.2815515655446004      # standard normal 10 % quantile
+_MAX_ITERATIONS = 50
+_STEP_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True)
+class KbPosterior:
+    """Normal distribution of u = ln(K_b / K_b default) per friction state: mean (4,), covariance
+    (4, 4), and the surveys it has taken."""
+
+    mean: np.ndarray
+    cov: np.ndarray
+    fits: int = 0
+
+    def k_b(self, default: np.ndarray, z: float = 0.0) -> np.ndarray:
+        """K_b per friction state [-/axle pass] at the standard normal quantile z of each state's
+        marginal (z = 0: the posterior median, the K_b in use)."""
+        return np.asarray(default, float) * np.exp(self.mean + z * np.sqrt(np.diag(self.cov)))
+
+    def quantiles(self, default: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """K_b per friction state at P10, P50 and P90 [-/axle pass]."""
+        return self.k_b(default, Z_P10), self.k_b(default), self.k_b(default, -Z_P10)
+
+
+def prior(scale_sd: float, ratio_sd: float, states: int = 4) -> KbPosterior:
+    """The prior: u ~ N(0, scale_sd^2 1 1^T + ratio_sd^2 I) (standard deviations of ln K_b)."""
+    cov = scale_sd**2 * np.ones((states, states)) + ratio_sd**2 * np.eye(states)
+    return KbPosterior(np.zeros(states), cov, 0)
+
+
+def band_log_amplitude(log_components: np.ndarray) -> np.ndarray:
+    """ln of a band's r.m.s. from ln Z of its components (..., P): ln sqrt(sum_p Z_p^2)."""
+    return 0.5 * np.logaddexp.reduce(2.0 * log_components, axis=-1)
+
+
+def _predicted(start: np.ndarray, growth: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Band ln Z after the growth scaled per state (B,) and its Jacobian in delta (B, 4)."""
+    scaled = growth * scale[:, None, None]                       # (4, B, P)
+    comp = start + scaled.sum(axis=0)                            # (B, P)
+    level = band_log_amplitude(comp)
+    weight = np.exp(2.0 * (comp - level[:, None]))              # energy share of each component
+    return level, np.einsum("bp,fbp->bf", weight, scaled)
+
+
+def _curvature(start: np.ndarray, growth: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """Second derivatives of the band ln Z in delta (B, 4, 4): with a_fp = exp(delta_f) G_fp and
+    the energy shares w_p, d2 yhat / d delta_f d delta_g = [f = g] abar_f + 2 (sum_p w_p a_fp a_gp
+    - abar_f abar_g), abar_f = sum_p w_p a_fp."""
+    scaled = growth * scale[:, None, None]
+    comp = start + scaled.sum(axis=0)
+    weight = np.exp(2.0 * (comp - band_log_amplitude(comp)[:, None]))
+    mean = np.einsum("bp,fbp->bf", weight, scaled)
+    second = 2.0 * (np.einsum("bp,fbp,gbp->bfg", weight, scaled, scaled) - mean[:, :, None] * mean[:, None, :])
+    return second + mean[:, :, None] * np.eye(len(scale))
+
+
+def update(post: KbPosterior, start: np.ndarray, growth: np.ndarray, measured: np.ndarray,
+           sigma: np.ndarray | float) -> tuple[KbPosterior, np.ndarray]:
+    """The posterior after one survey, and delta = its change of u (4,).
+
+    post: the posterior so far, whose median K_b the growth was computed with; start: ln Z of the
+    components of the surveyed bands at t1 (B, P) [ln m]; growth: their log growth since then per
+    friction state (4, B, P); measured: their surveyed ln Z (B,) [ln m]; sigma: standard deviation
+    of each band's measured minus predicted ln Z (B,) or scalar [-].
+    """
+    p_inv = np.linalg.inv(post.cov)
+    w = np.broadcast_to(1.0 / np.asarray(sigma, float) ** 2, np.shape(measured))
+    delta = np.zeros(len(post.mean))
+    for _ in range(_MAX_ITERATIONS):
+        level, jac = _predicted(start, growth, np.exp(delta))
+        info = (jac.T * w) @ jac + p_inv
+        gradient = (jac.T * w) @ (measured - level) - p_inv @ delta
+        step = np.linalg.solve(info, gradient)
+        delta = delta + step
+        if np.max(np.abs(step)) < _STEP_TOLERANCE:
+            break
+    level, jac = _predicted(start, growth, np.exp(delta))
+    hessian = (jac.T * w) @ jac + p_inv - np.einsum("b,bfg->fg", w * (measured - level),
+                                                     _curvature(start, growth, np.exp(delta)))
+    try:
+        np.linalg.cholesky(hessian)
+        cov = np.linalg.inv(hessian)
+    except np.linalg.LinAlgError:  # not positive definite (far from a mode): Gauss-Newton's
+        cov = np.linalg.inv((jac.T * w) @ jac + p_inv)
+    return KbPosterior(post.mean + delta, 0.5 * (cov + cov.T), post.fits + 1), delta
+
+
+def log_rate_sd(post: KbPosterior, share: np.ndarray) -> np.ndarray:
+    """Standard deviation of ln g per band from the posterior, g being a sum over friction states
+    of growth proportional to K_b: d ln g / d u_f = share_f, the state's share of the band's growth
+    (B, 4) [-]; (B,)."""
+    return np.sqrt(np.maximum(np.einsum("bf,fg,bg->b", share, post.cov, share), 0.0))
