@@ -58,8 +58,8 @@ class CorrugationEstimator:
         self.growth_by_state = np.zeros((4, *self.log_components.shape))
         self.calibration = calibration.prior(cfg.kb_prior_scale_sd, cfg.kb_prior_ratio_sd)
         # Variance of each band's ln Z at the last survey or grinding [-].
-        self.post_grinding_var = np.full(len(self.bands),
-                                         (cfg.post_grinding_uncertainty_db * calibration.LN_PER_DB) ** 2)
+        self.survey_var = calibration.log_variance(cfg.survey_uncertainty_db)
+        self.post_grinding_var = np.full(len(self.bands), calibration.log_variance(cfg.post_grinding_uncertainty_db))
         self.level_var = self.post_grinding_var.copy()
         self.kept = KeptPasses()
         self.threads: fcst.Threads | None = None  # threads a history's forecasts may use (batch: its pool)

@@ -21,10 +21,9 @@ from rail_monitor.models import corrugation as cg
 # Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
 # passes nearly balancing the others) can be 1e12 days away, past any 64-bit time stamp.
 MAX_DATED_DAYS = 36_525.0
-PARALLEL_MIN_STATES = 2_000
+PARALLEL_MIN_STATES = 2_000  # fewer states per thread cost more to hand over than they save
 INTERVAL_DRAWS = 500  # draws of the forecast interval: its quantiles to about +-2 % of the spread
 INTERVAL_SEED = 20_260_901
-  # fewer states per thread cost more to hand over than they save
 
 
 class Threads(NamedTuple):
@@ -95,8 +94,8 @@ def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth
 
     ln Z (B, P) [ln m]; the log growth since the last survey per friction state (4, B, P), computed
     at the posterior median; the recent growth per friction state (4, B, P) [1/axle pass]; the
-    standard deviation of each band's ln Z at the last survey (level_sd (B,) [-]); thresholds (B,) [m]; days per axle
-    pass at the recent traffic. Each of INTERVAL_DRAWS fixed draws takes ln K_b from the posterior
+    standard deviation of each band's ln Z at the last survey (level_sd (B,) [-]); thresholds (B,)
+    [m]; days per axle pass at the recent traffic. Each of INTERVAL_DRAWS fixed draws takes ln K_b from the posterior
     (both growths scale with exp(delta_f), first order in K_b) and an independent error of each
     band's level, and is forecast as the state is; the quantiles are those of the draws (so the
     same state gives the same interval in every process). The traffic and its friction mix are

@@ -42,7 +42,7 @@ def apply_survey(est: CorrugationEstimator, wavelength: np.ndarray, amplitude: n
     the posterior of K_b after the fit, or None without one (no growth since the last survey)."""
     z, matched = match_bands(est.bands, wavelength, amplitude)
     measured = np.log(z[matched])
-    noise_var = (est.cfg.survey_uncertainty_db * calibration.LN_PER_DB) ** 2
+    noise_var = est.survey_var
     fit = None
     growth = est.growth_by_state
     if np.any(growth[:, matched] != 0.0):
@@ -55,8 +55,7 @@ def apply_survey(est: CorrugationEstimator, wavelength: np.ndarray, amplitude: n
         est.set_k_b(fit.k_b(est.cfg.k_b))
     # Kalman update of each band's ln Z: the model's prediction (its level's variance and the
     # growth's, from K_b) weighed against the survey's.
-    level = calibration.band_log_amplitude(est.log_components)
-    jac = np.einsum("bp,fbp->bf", np.exp(2.0 * (est.log_components - level[:, None])), growth)
+    level, jac, _ = calibration.band_level_jacobian(est.log_components, growth)
     predicted_var = est.level_var + np.einsum("bf,fg,bg->b", jac, est.calibration.cov, jac)
     gain = predicted_var[matched] / (predicted_var[matched] + noise_var)
     est.log_components[matched] += (gain * (measured - level[matched]))[:, None]
@@ -82,7 +81,7 @@ def apply_grinding(est: CorrugationEstimator, stamp_ns: int, wavelength: np.ndar
     est.growth_by_state[:] = 0.0
     est.level_var = est.post_grinding_var.copy()
     if wavelength is not None and len(wavelength):
-        est.level_var[matched] = (est.cfg.survey_uncertainty_db * calibration.LN_PER_DB) ** 2
+        est.level_var[matched] = est.survey_var
     est.grinding_amplitude = rms
     est.pass_count = est.axle_pass_count = 0
     est.last_grinding_ns = int(stamp_ns)

@@ -26,6 +26,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rail_monitor.models import corrugation as cg
+
 LN_PER_DB = np.log(10.0) / 20.0  # ln Z per dB of a roughness level (20 lg Z)
 Z_P10 = -1.2815515655446004      # standard normal 10 % quantile
 _MAX_ITERATIONS = 50
@@ -57,30 +59,32 @@ def prior(scale_sd: float, ratio_sd: float, states: int = 4) -> KbPosterior:
     return KbPosterior(np.zeros(states), cov, 0)
 
 
-def band_log_amplitude(log_components: np.ndarray) -> np.ndarray:
-    """ln of a band's r.m.s. from ln Z of its components (..., P): ln sqrt(sum_p Z_p^2)."""
-    return 0.5 * np.logaddexp.reduce(2.0 * log_components, axis=-1)
+def log_variance(sd_db: float) -> float:
+    """Variance of ln Z [-] of a level known to sd_db [dB] (one standard deviation)."""
+    return (sd_db * LN_PER_DB) ** 2
 
 
-def _predicted(start: np.ndarray, growth: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Band ln Z after the growth scaled per state (B,) and its Jacobian in delta (B, 4)."""
-    scaled = growth * scale[:, None, None]                       # (4, B, P)
-    comp = start + scaled.sum(axis=0)                            # (B, P)
-    level = band_log_amplitude(comp)
-    weight = np.exp(2.0 * (comp - level[:, None]))              # energy share of each component
-    return level, np.einsum("bp,fbp->bf", weight, scaled)
+def band_level_jacobian(log_components: np.ndarray, growth: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A band's ln r.m.s. (B,) from ln Z of its components (B, P), its derivative with respect to
+    scaling the growth of each friction state, d ln Z_b / d delta_f = sum_p w_bp G_f,bp (B, 4), for
+    growth G (4, B, P) already in the components, and the components' energy shares w (B, P)."""
+    level = cg.band_log_amplitude(log_components)
+    weight = np.exp(2.0 * (log_components - level[:, None]))
+    return level, np.einsum("bp,fbp->bf", weight, growth), weight
 
 
-def _curvature(start: np.ndarray, growth: np.ndarray, scale: np.ndarray) -> np.ndarray:
-    """Second derivatives of the band ln Z in delta (B, 4, 4): with a_fp = exp(delta_f) G_fp and
-    the energy shares w_p, d2 yhat / d delta_f d delta_g = [f = g] abar_f + 2 (sum_p w_p a_fp a_gp
-    - abar_f abar_g), abar_f = sum_p w_p a_fp."""
+def _scaled(start: np.ndarray, growth: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The growth scaled per friction state (4, B, P) and the components after it (B, P)."""
     scaled = growth * scale[:, None, None]
-    comp = start + scaled.sum(axis=0)
-    weight = np.exp(2.0 * (comp - band_log_amplitude(comp)[:, None]))
-    mean = np.einsum("bp,fbp->bf", weight, scaled)
-    second = 2.0 * (np.einsum("bp,fbp,gbp->bfg", weight, scaled, scaled) - mean[:, :, None] * mean[:, None, :])
-    return second + mean[:, :, None] * np.eye(len(scale))
+    return scaled, start + scaled.sum(axis=0)
+
+
+def _curvature(scaled: np.ndarray, weight: np.ndarray, jac: np.ndarray) -> np.ndarray:
+    """Second derivatives of the band ln Z in delta (B, 4, 4): with a_fp = exp(delta_f) G_fp, the
+    energy shares w_p and abar_f = sum_p w_p a_fp (the Jacobian),
+    d2 yhat / d delta_f d delta_g = [f = g] abar_f + 2 (sum_p w_p a_fp a_gp - abar_f abar_g)."""
+    second = 2.0 * (np.einsum("bp,fbp,gbp->bfg", weight, scaled, scaled) - jac[:, :, None] * jac[:, None, :])
+    return second + jac[:, :, None] * np.eye(jac.shape[1])
 
 
 def update(post: KbPosterior, start: np.ndarray, growth: np.ndarray, measured: np.ndarray,
@@ -96,16 +100,18 @@ def update(post: KbPosterior, start: np.ndarray, growth: np.ndarray, measured: n
     w = np.broadcast_to(1.0 / np.asarray(sigma, float) ** 2, np.shape(measured))
     delta = np.zeros(len(post.mean))
     for _ in range(_MAX_ITERATIONS):
-        level, jac = _predicted(start, growth, np.exp(delta))
+        scaled, comp = _scaled(start, growth, np.exp(delta))
+        level, jac, _ = band_level_jacobian(comp, scaled)
         info = (jac.T * w) @ jac + p_inv
         gradient = (jac.T * w) @ (measured - level) - p_inv @ delta
         step = np.linalg.solve(info, gradient)
         delta = delta + step
         if np.max(np.abs(step)) < _STEP_TOLERANCE:
             break
-    level, jac = _predicted(start, growth, np.exp(delta))
+    scaled, comp = _scaled(start, growth, np.exp(delta))
+    level, jac, weight = band_level_jacobian(comp, scaled)
     hessian = (jac.T * w) @ jac + p_inv - np.einsum("b,bfg->fg", w * (measured - level),
-                                                     _curvature(start, growth, np.exp(delta)))
+                                                     _curvature(scaled, weight, jac))
     try:
         np.linalg.cholesky(hessian)
         cov = np.linalg.inv(hessian)
@@ -113,9 +119,3 @@ def update(post: KbPosterior, start: np.ndarray, growth: np.ndarray, measured: n
         cov = np.linalg.inv((jac.T * w) @ jac + p_inv)
     return KbPosterior(post.mean + delta, 0.5 * (cov + cov.T), post.fits + 1), delta
 
-
-def log_rate_sd(post: KbPosterior, share: np.ndarray) -> np.ndarray:
-    """Standard deviation of ln g per band from the posterior, g being a sum over friction states
-    of growth proportional to K_b: d ln g / d u_f = share_f, the state's share of the band's growth
-    (B, 4) [-]; (B,)."""
-    return np.sqrt(np.maximum(np.einsum("bf,fg,bg->b", share, post.cov, share), 0.0))

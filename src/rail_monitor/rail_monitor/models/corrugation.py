@@ -145,12 +145,17 @@ def filtered_log_growth(wear_sensitivity: ArrayLike, kernel: ArrayLike, contact_
     return log_growth_per_pass(wear_sensitivity, f * f * np.asarray(kernel))
 
 
-def band_amplitude(log_components: ArrayLike) -> FloatArray:
-    """r.m.s. of each band [m] from the ln amplitudes [ln m] of its components (last axis):
-    sqrt(sum_p Z_p^2), computed without overflow."""
+def band_log_amplitude(log_components: ArrayLike) -> FloatArray:
+    """ln of each band's r.m.s. [ln m] from the ln amplitudes [ln m] of its components (last axis):
+    ln sqrt(sum_p Z_p^2), computed without overflow."""
     x = np.asarray(log_components, float)
     top = x.max(axis=-1, keepdims=True)
-    return np.exp(top[..., 0] + 0.5 * np.log(np.sum(np.exp(2.0 * (x - top)), axis=-1)))
+    return top[..., 0] + 0.5 * np.log(np.sum(np.exp(2.0 * (x - top)), axis=-1))
+
+
+def band_amplitude(log_components: ArrayLike) -> FloatArray:
+    """r.m.s. of each band [m] from the ln amplitudes [ln m] of its components (last axis)."""
+    return np.exp(band_log_amplitude(log_components))
 
 
 BAND_BLOCK = 16384  # bands evaluated together: (P, BAND_BLOCK) arrays stay in cache
