@@ -83,10 +83,10 @@ def _hostile_history(passes):
     return PassTable.concat([base, dup, same, bad, odd]).sorted()
 
 
-def _chunked(passes, values, cuts):
+def _chunked(passes, values, cuts, events=()):
     from rail_monitor.app.batch import BatchRun
 
-    run = BatchRun(values)
+    run = BatchRun(values, events=events)
     parts = [run.feed(passes.take(slice(a, b))) for a, b in zip([0, *cuts], [*cuts, len(passes)], strict=True)]
     held, advice = run.finish()
     return run, parts, held, advice
@@ -111,23 +111,93 @@ def test_any_chunking_of_a_history_gives_the_one_call_outputs_alerts_included(si
                  [tie, 1500, 1500, 3000], [1]):
         run, parts, held, advice = _chunked(history, site_values, cuts)
         got = BatchResult.merged(parts, held, advice)
-        assert got.passes.equals(whole.passes) and got.accepted.equals(whole.accepted)
-        np.testing.assert_array_equal(got.reasons, whole.reasons)
-        for k, col in whole.squeal.items():
-            np.testing.assert_array_equal(got.squeal[k], col, err_msg=k)
-        a, b = whole.trajectory, got.trajectory
-        for name in ("index", "stamp_ns", "train_id", "amplitude", "pass_count", "axle_pass_count",
-                     "total_pass_count"):
-            np.testing.assert_array_equal(getattr(b, name), getattr(a, name), err_msg=name)
-        for name in ("growth_per_axle_pass", "worst_band", "passes_to_threshold", "days_to_threshold",
-                     "passes_per_day", "grinding_due", "grinding_due_ns"):
-            np.testing.assert_array_equal(getattr(b.forecast, name), getattr(a.forecast, name), err_msg=name)
-        for model, out in whole.noise.items():
-            for k, col in out.per_pass().items():
-                np.testing.assert_array_equal(got.noise[model].per_pass()[k], col, err_msg=f"{model} {k}")
-        assert got.alerts == whole.alerts and got.standing == whole.standing
+        _assert_same_result(got, whole)
         assert got.left_out == whole.left_out == run.left_out
         assert advice.lines() == whole.advice.lines()
+
+
+def _assert_same_result(got, whole) -> None:
+    """Every output of two batch results is bit for bit the same."""
+    import numpy as np
+
+    assert got.passes.equals(whole.passes) and got.accepted.equals(whole.accepted)
+    np.testing.assert_array_equal(got.reasons, whole.reasons)
+    for k, col in whole.squeal.items():
+        np.testing.assert_array_equal(got.squeal[k], col, err_msg=k)
+    a, b = whole.trajectory, got.trajectory
+    for name in ("index", "stamp_ns", "train_id", "amplitude", "pass_count", "axle_pass_count",
+                 "total_pass_count"):
+        np.testing.assert_array_equal(getattr(b, name), getattr(a, name), err_msg=name)
+    for name in ("growth_per_axle_pass", "worst_band", "passes_to_threshold", "days_to_threshold",
+                 "passes_per_day", "grinding_due", "grinding_due_ns"):
+        np.testing.assert_array_equal(getattr(b.forecast, name), getattr(a.forecast, name), err_msg=name)
+    for k in range(len(a)):  # the constants in force at each pass (K_b, last grinding, ...)
+        sa, sb = a.constants_at(k), b.constants_at(k)
+        assert (sa.last_grinding_ns, sa.calibration_surveys) == (sb.last_grinding_ns, sb.calibration_surveys), k
+        np.testing.assert_array_equal(sa.k_b, sb.k_b)
+        np.testing.assert_array_equal(sa.grinding_amplitude, sb.grinding_amplitude)
+    for model, out in whole.noise.items():
+        for k, col in out.per_pass().items():
+            np.testing.assert_array_equal(got.noise[model].per_pass()[k], col, err_msg=f"{model} {k}")
+    assert got.alerts == whole.alerts and got.standing == whole.standing
+
+
+def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(site_values, sample_passes):
+    """A history's surveys and grinding events (one at a stamp two passes share, one refused as not
+    newer, one matching no band, one after the last accepted pass): applied before the first pass stamped
+    later, they give the state of an estimator advanced and surveyed by hand in that order, and
+    random chunk boundaries give the one call's outputs bit for bit."""
+    import numpy as np
+
+    from rail_monitor.app.batch import BatchResult, run_models
+    from rail_monitor.core.passes import rejection_reasons, with_class_defaults
+    from rail_monitor.core.site import site_from_values
+    from rail_monitor.corrugation.config import corrugation_config
+    from rail_monitor.corrugation.estimator import CorrugationEstimator
+    from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent, apply_event
+
+    history = _hostile_history(sample_passes)
+    est = CorrugationEstimator(site_from_values(site_values), corrugation_config(site_values))
+    bands, post = est.bands, est.post_grinding
+    stamps = history.stamp_ns[history.stamp_ns > 0]
+    tie = int(stamps[np.flatnonzero(stamps[1:] == stamps[:-1])[3]])
+    at = [int(stamps[len(stamps) * k // 6]) + 1 for k in range(1, 5)]
+    events = [MaintenanceEvent(at[0], KIND_SURVEY, bands, 1.5 * post),
+              MaintenanceEvent(at[0], KIND_SURVEY, bands, 1.6 * post),            # not newer: refused
+              MaintenanceEvent(at[1], KIND_GRINDING, bands[:4], 0.7 * post[:4]),
+              MaintenanceEvent(at[2], KIND_SURVEY, np.array([7.0]), np.array([1e-5])),  # no band: refused
+              MaintenanceEvent(max(tie, at[2] + 1), KIND_SURVEY, bands[2:9], 1.3 * post[2:9]),
+              MaintenanceEvent(at[3], KIND_SURVEY, bands, 1.2 * post),
+              # after the last accepted pass (the two far-future ones are rejected)
+              MaintenanceEvent(int(np.sort(stamps)[-3]) + 10**9, KIND_SURVEY, bands, 1.1 * post)]
+    whole = run_models(history, site_values, events=events)
+    assert len(whole.events) == len(events)
+    assert whole.estimator.calibration_surveys == 4 and whole.estimator.last_grinding_ns == at[1]
+
+    # by hand: the accepted passes up to each event's stamp, then the event
+    sent = history.take(np.isin(history.stamp_ns, whole.passes.stamp_ns))
+    accepted = with_class_defaults(whole.passes.take(rejection_reasons(whole.passes, est.site) == ""), est.site)
+    refused = 0
+    for e in sorted(events, key=lambda e: e.stamp_ns):
+        n = int(np.argmax(accepted.stamp_ns > e.stamp_ns)) if (accepted.stamp_ns > e.stamp_ns).any() else len(accepted)
+        est.advance(accepted.take(slice(0, n)))
+        accepted = accepted.take(slice(n, None))
+        try:
+            apply_event(est, e)
+        except ValueError:
+            refused += 1
+    assert len(sent) and refused == 2
+    np.testing.assert_array_equal(est.log_components, whole.estimator.log_components)
+    np.testing.assert_array_equal(est.k_b, whole.estimator.k_b)
+
+    rng = np.random.default_rng(12)
+    for cuts in (sorted(rng.choice(len(history), 11, replace=False).tolist()), [1, 2, 3]):
+        run, parts, held, advice = _chunked(history, site_values, cuts, events)
+        got = BatchResult.merged(parts, held, advice)
+        _assert_same_result(got, whole)
+        assert sum(run.events_refused.values()) == 2
+        assert [e.stamp_ns for e in got.events + run.trailing_events] == [e.stamp_ns for e in whole.events]
+        np.testing.assert_array_equal(run.estimator.log_components, whole.estimator.log_components)
 
 
 def test_a_chunk_older_than_an_earlier_one_is_refused_and_leaves_the_run_as_it_was(site_values, sample_passes):

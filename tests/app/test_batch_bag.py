@@ -76,3 +76,37 @@ def test_a_bag_found_bad_while_streaming_leaves_no_output(tmp_path, history, cap
     out = tmp_path / "out"
     assert main(["batch", str(broken), "--output", str(out), "--no-report", "--chunk", "500"]) == 2
     assert "3001" in capsys.readouterr().err and not out.exists()
+
+
+def test_batch_applies_and_records_the_history_s_surveys_streamed_as_in_one_call(tmp_path, history, site_values,
+                                                                                 capsys):
+    """A history bag with surveys and a grinding (rail-monitor batch reads them from it): the
+    streamed run's bag holds the one call's messages, the surveys on roughness_survey among them."""
+    import numpy as np
+
+    from rail_monitor.bagio.reader import read_bag_events
+    from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent
+
+    passes, _ = history
+    from rail_monitor.core.site import site_from_values
+    from rail_monitor.corrugation.config import corrugation_config
+    from rail_monitor.corrugation.estimator import CorrugationEstimator
+
+    est = CorrugationEstimator(site_from_values(site_values), corrugation_config(site_values))
+    t = passes.stamp_ns
+    events = [MaintenanceEvent(int(t[800]) + 1, KIND_SURVEY, est.bands, 1.5 * est.post_grinding),
+              MaintenanceEvent(int(t[1700]) + 1, KIND_GRINDING, np.zeros(0), np.zeros(0)),
+              MaintenanceEvent(int(t[-1]) + 1, KIND_SURVEY, est.bands[:5], 1.1 * est.post_grinding[:5])]
+    bag = write_passes_bag(passes, tmp_path / "with_surveys", "curve_250", events=events)
+    assert [(e.stamp_ns, e.kind) for e in read_bag_events(bag)] == [(e.stamp_ns, e.kind) for e in events]
+    assert main(["batch", str(bag), "--output", str(tmp_path / "streamed"), "--no-report", "--chunk", "333"]) == 0
+    assert "3 roughness survey(s) and grinding event(s) applied in stamp order, 0 refused" in capsys.readouterr().out
+    one = write_bag(run_models(read_bag_passes(bag), site_values, events=events), tmp_path / "one", "curve_250")
+    a, b = _messages(one), _messages(tmp_path / "streamed")
+    assert len(a["/curve_250/roughness_survey"]) == 3
+    assert set(a) == set(b)
+    for topic, msgs in a.items():
+        assert b[topic] == msgs, topic
+    plain = _messages(write_bag(run_models(read_bag_passes(bag), site_values), tmp_path / "plain", "curve_250"))
+    assert plain["/curve_250/corrugation/state"][:800] == a["/curve_250/corrugation/state"][:800]
+    assert plain["/curve_250/corrugation/state"][801] != a["/curve_250/corrugation/state"][801]

@@ -74,3 +74,37 @@ def test_a_table_without_json(capsys):
     assert main(["predict", "corrugation", "--speeds", "15", "17", "19", "--weights", "1", "2", "1"]) == 0
     out = capsys.readouterr().out.splitlines()
     assert out[0].startswith("# site curve_250, post-grinding rail, dry") and out[-1].startswith("peak g ")
+
+
+def test_a_history_s_surveys_refit_k_b_and_give_the_forecast_interval(tmp_path, site, site_values, capsys):
+    """The surveys in a history bag are applied in stamp order (as an estimator advanced and surveyed
+    by hand), and the forecast comes with its P10/P50/P90 interval and K_b's."""
+    from rail_monitor.bagio.passes_bag import write_passes_bag
+    from rail_monitor.bagio.reader import read_bag_passes
+    from rail_monitor.core.passes import rejection_reasons, with_class_defaults
+    from rail_monitor.corrugation import surveys
+
+    from conftest import SAMPLE
+
+    passes = read_bag_passes(SAMPLE).sorted().take(slice(0, 4000))
+    est = CorrugationEstimator(site, corrugation_config(site_values))
+    at = int(passes.stamp_ns[2500]) + 1
+    event = surveys.MaintenanceEvent(at, surveys.KIND_SURVEY, est.bands, 1.3 * est.post_grinding)
+    bag = write_passes_bag(passes, tmp_path / "h", "curve_250", events=[event])
+    assert main(["predict", "corrugation", "--history", str(bag), "--json"]) == 0
+    got = json.loads(capsys.readouterr().out)
+    ok = with_class_defaults(passes.take(rejection_reasons(passes, site) == ""), site)
+    n = int(np.argmax(ok.stamp_ns > at))
+    est.advance(ok.take(slice(0, n)))
+    surveys.apply_survey(est, event.wavelength_m, event.amplitude_m, at)
+    est.advance(ok.take(slice(n, None)))
+    assert got["calibration_surveys"] == 1 and got["surveys_and_grinding"] == 1
+    np.testing.assert_allclose(got["k_b_by_friction"], est.k_b, rtol=1e-12)
+    assert np.all(np.array(got["k_b_p10_by_friction"]) < est.k_b) and np.all(est.k_b < got["k_b_p90_by_friction"])
+    iv = est.forecast_interval()
+    np.testing.assert_allclose(got["forecast_interval"]["days_to_threshold_p10_p50_p90"], iv.days, rtol=1e-12)
+    p10, p50, p90 = iv.days
+    assert p10 < p50 < p90
+    assert all(len(b["days_to_threshold_p10_p50_p90"]) == 3 for b in got["bands"])
+    assert main(["predict", "corrugation", "--history", str(bag)]) == 0
+    assert "(P10 / P50 / P90:" in capsys.readouterr().out

@@ -73,3 +73,25 @@ def test_grinding_resets_the_state(site_, tables):
     np.testing.assert_allclose(est.amplitude[:3], [1e-7, 2e-7, 3e-7], rtol=1e-12)
     np.testing.assert_allclose(est.level_var[:3], (np.log(10) / 20) ** 2, rtol=1e-12)
     np.testing.assert_allclose(est.level_var[3:], (3 * np.log(10) / 20) ** 2, rtol=1e-12)
+
+
+def test_events_apply_in_stamp_order_and_a_refused_one_changes_nothing(site_, tables):
+    est = _estimator(site_, tables)
+    est.advance(_passes(site_, np.full(50, 19.0)))
+    before = (est.log_components.copy(), est.level_var.copy(), est.survey_log_amplitude.copy(), est.last_survey_ns)
+    bad_grinding = surveys.MaintenanceEvent(10**18, surveys.KIND_GRINDING, np.array([9.0]), np.array([1e-6]))
+    for event, why in ((bad_grinding, "no survey wavelength"),
+                       (surveys.MaintenanceEvent(10**18, 7, est.bands, est.post_grinding), "unknown kind")):
+        with pytest.raises(ValueError, match=why):
+            surveys.apply_event(est, event)
+        after = (est.log_components, est.level_var, est.survey_log_amplitude, est.last_survey_ns)
+        for a, b in zip(before, after, strict=True):
+            np.testing.assert_array_equal(a, b)
+    surveys.apply_event(est, surveys.MaintenanceEvent(10**18, surveys.KIND_GRINDING, np.zeros(0), np.zeros(0)))
+    with pytest.raises(ValueError, match="not newer"):
+        surveys.apply_event(est, surveys.MaintenanceEvent(10**18, surveys.KIND_SURVEY, est.bands, est.post_grinding))
+    # before the first pass stamped later: equal stamps come before the event, order as sent
+    assert surveys.split_before(np.array([1, 5, 5, 9, 3]), 5) == 3
+    assert surveys.split_before(np.array([1, 5]), 5) == 2 and surveys.split_before(np.array([], np.int64), 0) == 0
+    assert [e.stamp_ns for e in surveys.in_time_order([bad_grinding, surveys.MaintenanceEvent(
+        3, 1, est.bands, est.post_grinding)])] == [3, 10**18]

@@ -13,7 +13,7 @@ from rail_monitor.advice import plan
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.bagio.messages import train_pass_fields
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
-from rail_monitor.corrugation import advice
+from rail_monitor.corrugation import advice, surveys
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.nodes.convert import time_msg, to_msg
@@ -118,15 +118,35 @@ def test_node_state_rejections_identity_surveys_service_and_advisory(ros_context
         assert list(adv.noise_model) == want_adv.noise_model
         assert adv.squeal_share_recommended <= adv.squeal_share_current + 1e-9
 
+        # A grinding stamped after every pass waits for the first pass later than it (as batch mode
+        # applies it), then resets the state before that pass counts.
         grind = RoughnessSurvey(kind=RoughnessSurvey.KIND_GRINDING)
         grind.header.stamp = time_msg(int(good.stamp_ns[-1]) + 10**9)
         probe.surveys.publish(grind)
-        assert wait_until(lambda: probe.states[-1].pass_count == 0)
-        np.testing.assert_allclose(probe.states[-1].amplitude_m, pure.post_grinding, rtol=1e-12)
+        assert wait_until(lambda: probe.diag().get("surveys pending") == "1")
+        assert probe.states[-1].total_pass_count == 30
+        after = _passes(site, 1, start=30)
+        probe.send(after)
+        assert wait_until(lambda: probe.states[-1].total_pass_count == 31)
+        surveys.apply_grinding(pure, int(good.stamp_ns[-1]) + 10**9)
+        pure.advance(after)
+        assert probe.states[-1].pass_count == 1
+        assert wait_until(lambda: probe.diag().get("grindings") == "1")
+        np.testing.assert_allclose(probe.states[-1].amplitude_m, pure.amplitude, rtol=1e-12)
         stale = RoughnessSurvey(kind=RoughnessSurvey.KIND_SURVEY, wavelength_m=[0.1], amplitude_m=[1e-6])
         stale.header.stamp = time_msg(int(good.stamp_ns[0]))
         probe.surveys.publish(stale)
         assert wait_until(lambda: any(k.startswith("survey rejected: not newer") for k in probe.diag()))
+        # A survey stamped between counted passes can only be applied on arrival: counted as late,
+        # and the state it gives is published at once.
+        late = RoughnessSurvey(kind=RoughnessSurvey.KIND_SURVEY, wavelength_m=pure.bands.tolist(),
+                               amplitude_m=(2 * pure.post_grinding).tolist())
+        late.header.stamp = time_msg(int(after.stamp_ns[0]) - 10**9)
+        probe.surveys.publish(late)
+        assert wait_until(lambda: probe.diag().get("surveys") == "1"
+                          and probe.diag().get("applied late (passes after its stamp already counted)") == "1")
+        surveys.apply_survey(pure, pure.bands, 2 * pure.post_grinding, int(after.stamp_ns[0]) - 10**9)
+        assert wait_until(lambda: np.allclose(probe.states[-1].amplitude_m, pure.amplitude, rtol=1e-12, atol=0))
 
 
 def test_restart_resumes_from_the_checkpoint(ros_context, site, site_values, tmp_path):

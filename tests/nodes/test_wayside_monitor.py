@@ -24,11 +24,15 @@ from rail_monitor.alerts.config import KIND_SQUEAL
 from rail_monitor.app.batch import run_models
 from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.app.report import build_report, load_run
+from rail_monitor.bagio.messages import time_ns
+from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_bag_passes, read_messages
 from rail_monitor.bagio.site_record import read_site_record
+from rail_monitor.core.site import site_from_values
 from rail_monitor.corrugation.checkpoint import load, resume
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.layout import PROCESSES, SOURCE
 from rail_monitor.nodes.qos import LATEST_QOS, STREAM_QOS
@@ -65,6 +69,20 @@ def _values() -> dict:
 def _slice():
     t = read_bag_passes(SAMPLE).sorted()
     return t.take(t.stamp_ns <= t.stamp_ns[0] + int(DAYS * 86400e9))
+
+
+def _events() -> list[MaintenanceEvent]:
+    """Surveys and a grinding within the slice, and a survey after its last pass: every layout must
+    apply each before the first pass stamped later than it, as batch mode does."""
+    est = CorrugationEstimator(site_from_values(_values()), corrugation_config(_values()))
+    bands, post = est.bands, est.post_grinding
+    t = _slice().stamp_ns
+    at = [int(t[0] + f * (t[-1] - t[0])) + 1 for f in (0.3, 0.55, 0.8)]
+    half = np.arange(0, len(bands), 2)
+    return [MaintenanceEvent(at[0], KIND_SURVEY, bands, 1.4 * post),
+            MaintenanceEvent(at[1], KIND_GRINDING, bands[half], 0.8 * post[half]),
+            MaintenanceEvent(at[2], KIND_SURVEY, bands[3:8], 1.2 * post[3:8]),
+            MaintenanceEvent(int(t[-1]) + 60 * 10**9, KIND_SURVEY, bands, 1.1 * post)]
 
 
 def _ros_params(site: Path, extra: dict | None = None) -> list[str]:
@@ -148,12 +166,14 @@ def runs(tmp_path_factory) -> dict:
     os.environ["ROS_DOMAIN_ID"] = str(GRAPH_DOMAIN)
     live = tmp / "live"
     site = _site_file(tmp)
-    r = run_cmd("rail-monitor", "monitor", str(SAMPLE), "--site", str(site), "--output", str(live),
+    history = write_passes_bag(_slice(), tmp / "history", "curve_250", events=_events())
+    r = run_cmd("rail-monitor", "monitor", str(history), "--site", str(site), "--output", str(live),
                 "--end-offset-s", str(DAYS * 86400), "--report", str(tmp / "live_report"), "--no-progress", timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
-    result = run_models(_slice(), _values())
+    result = run_models(_slice(), _values(), events=_events())
     write_bag(result, tmp / "batch", "curve_250")
-    return {"tmp": tmp, "site": site, "stdout": r.stdout, "live": load_run(live), "batch": load_run(tmp / "batch"),
+    return {"tmp": tmp, "site": site, "history": history, "stdout": r.stdout, "live": load_run(live),
+            "batch": load_run(tmp / "batch"),
             "result": result, "report": tmp / "live_report"}
 
 
@@ -170,6 +190,12 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
     assert "alerts:" in runs["stdout"] and "squeal" in runs["stdout"] and "loudest passes" in runs["stdout"]
     # the site travels with the data: the recorder stored the site file the process was given
     assert read_site_record(runs["tmp"] / "live")["site_file"] == runs["site"].read_text()
+    # the history's surveys and grinding reached the state: recorded, K_b re-fitted, the grinding reset
+    surveys = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/RoughnessSurvey"])["rail_msgs/msg/RoughnessSurvey"]
+    assert [time_ns(m.header.stamp) for m in surveys] == [e.stamp_ns for e in _events()]
+    states = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/CorrugationState"])["rail_msgs/msg/CorrugationState"]
+    assert [m.calibration_surveys for m in states][-1] == 2 and min(m.pass_count for m in states) == 1
+    assert runs["result"].estimator.calibration_surveys == 3  # the survey after the last pass, at the end
 
 
 def test_report_folder_has_images_and_a_page(runs):
@@ -203,7 +229,7 @@ def _graph_in_processes(runs, folder: Path, graph_host: tuple[str, ...] = (), re
     exits, the rest get SIGINT, as the launch's shutdown on its exit sends. Returns the passes
     replayed; the recording is in folder/bag."""
     env = {**os.environ, **(env or {})}
-    args = {"output": str(folder / "bag"), "source": str(SAMPLE), "rate": 0.0, "checkpoint": ""}
+    args = {"output": str(folder / "bag"), "source": str(runs["history"]), "rate": 0.0, "checkpoint": ""}
     procs, source = [], None
     try:
         for p in PROCESSES:
@@ -308,11 +334,9 @@ def test_restart_mid_replay_ends_in_the_uninterrupted_state(runs, tmp_path, tall
     ckpt = tmp_path / "state.npz"
     args = ["wayside_monitor", "--ros-args", "-r", "__ns:=/curve_250",
             *_ros_params(_site_file(tmp_path, ckpt)),
-            "-p", f"source:={SAMPLE}", "-p", f"end_offset_s:={DAYS * 86400}", "-p", "progress:=false",
+            "-p", f"source:={runs['history']}", "-p", f"end_offset_s:={DAYS * 86400}", "-p", "progress:=false",
             "-p", "record:=false"]
     site_values = _values()
-    from rail_monitor.core.site import site_from_values
-
     site = site_from_values(site_values)
 
     def counted() -> int:

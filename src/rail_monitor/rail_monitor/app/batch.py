@@ -15,7 +15,7 @@ import os
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,7 @@ from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.forecast import Threads
 from rail_monitor.corrugation.records import StateSnapshot, Trajectory
+from rail_monitor.corrugation.surveys import MaintenanceEvent, apply_event, in_time_order, split_before
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
 from rail_monitor.noise.state_of_pass import state_index
@@ -62,6 +63,7 @@ class BatchResult:
     estimator: CorrugationEstimator   # the state after these passes
     receiver: Any
     left_out: dict[str, int]          # passes the replayer would not send, by reason
+    events: list[MaintenanceEvent] = field(default_factory=list)  # surveys and grinding taken, applied or not
 
     @classmethod
     def merged(cls, parts: Sequence[BatchResult], held: list[Alert], advice: SpeedAdvice | None) -> BatchResult:
@@ -76,7 +78,7 @@ class BatchResult:
                    Trajectory.concat(list(zip(starts, [p.trajectory for p in parts], strict=True))),
                    {m: NoisePrediction.concat([p.noise[m] for p in parts]) for m in last.noise},
                    [a for p in parts for a in p.alerts] + held, last.standing, advice, last.estimator, last.receiver,
-                   dict(left_out))
+                   dict(left_out), [e for p in parts for e in p.events])
 
 
 @dataclass
@@ -111,10 +113,15 @@ class BatchRun:
 
     Chunks must follow each other in time: a chunk's passes may not be older than any of an earlier
     chunk's (stamps that builtin_interfaces/Time cannot hold aside, which are left out).
+
+    events: the history's surveys and grinding events (MaintenanceEvent), each applied before the
+    first pass stamped later than it, as the estimator node applies them when a replay sends them
+    so; those after the last pass at finish(). One the node would refuse is counted in
+    ``events_refused`` by reason and changes nothing.
     """
 
     def __init__(self, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
-                 threads: int = 0) -> None:
+                 threads: int = 0, events: Sequence[MaintenanceEvent] = ()) -> None:
         self.values = values
         self.site = site_from_values(values)
         self.margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
@@ -128,15 +135,43 @@ class BatchRun:
         self.left_out: Counter[str] = Counter()
         self._tail = _Tail(np.zeros(0, np.int64), [], np.zeros((0, len(self.estimator.bands))))
         self._held: list[Alert] = []                     # events a later chunk may still precede
+        self._pending = in_time_order(events)            # surveys and grinding not yet applied
+        self.events_refused: Counter[str] = Counter()
+        self.trailing_events: list[MaintenanceEvent] = []
 
     def feed(self, passes: PassTable) -> BatchResult:
-        """The outputs of the next chunk of the history (the input error of a chunk out of time
-        order leaves the run as it was)."""
+        """The outputs of the next chunk of the history, with the events due within it applied (the
+        input error of a chunk out of time order leaves the run as it was)."""
         stamps = passes.stamp_ns[fits_time_msg(passes.stamp_ns)]
         if len(stamps) and int(stamps.min()) < self.newest_ns:
             raise PassOrderError(f"passes out of time order: a chunk has a pass at {format_iso_ns(int(stamps.min()))}, "
                              f"before {format_iso_ns(self.newest_ns)} of an earlier one")
         self.newest_ns = max(self.newest_ns, int(stamps.max(initial=self.newest_ns)))
+        parts, applied = [], []
+        while self._pending and (n := split_before(passes.stamp_ns, self._pending[0].stamp_ns)) < len(passes):
+            parts.append(self._segment(passes.take(slice(0, n))))
+            applied.append(self._apply(self._pending.pop(0)))
+            passes = passes.take(slice(n, None))
+        parts.append(self._segment(passes))
+        if len(parts) == 1:
+            return parts[0]
+        for part, event in zip(parts, applied, strict=False):
+            part.events.append(event)
+        return BatchResult.merged(parts, [], None)
+
+    def _apply(self, event: MaintenanceEvent) -> MaintenanceEvent:
+        """Apply a survey or grinding as the estimator node does (refusals counted)."""
+        why = np.array([""], dtype=object)
+        reject_ahead(np.array([event.stamp_ns]), why, self.newest_taken_ns, self.margins)
+        try:
+            if why[0]:
+                raise ValueError(why[0])
+            apply_event(self.estimator, event)
+        except ValueError as exc:
+            self.events_refused[str(exc)] += 1
+        return event
+
+    def _segment(self, passes: PassTable) -> BatchResult:
         table, left_out = publishable(passes, self.margins, self.newest_sent_ns)
         self.left_out.update(left_out)
         self.newest_sent_ns = max(self.newest_sent_ns, int(table.stamp_ns.max(initial=0)))
@@ -167,19 +202,23 @@ class BatchRun:
         return sorted(self.alerts.standing.values(), key=_alert_key)
 
     def finish(self) -> tuple[list[Alert], SpeedAdvice | None]:
-        """The events held back for a later chunk, and the speed advice on the final state."""
+        """The events held back for a later chunk, and the speed advice on the final state (after
+        the surveys and grinding later than every pass, kept in ``trailing_events``)."""
+        self.trailing_events = [self._apply(e) for e in self._pending]
+        self._pending = []
         held, self._held = self._held, []
         return held, advise_or_none(self.estimator, Consequences(self.site, self.model, squeal_config(self.values)))
 
 
 def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
-               threads: int = 0) -> BatchResult:
+               threads: int = 0, events: Sequence[MaintenanceEvent] = ()) -> BatchResult:
     """Every model over the history ``passes`` for the site of the flat parameter ``values`` in one
-    call (estimator, threads: as for BatchRun)."""
-    run = BatchRun(values, estimator, threads)
+    call (estimator, threads, events: as for BatchRun)."""
+    run = BatchRun(values, estimator, threads, events)
     out = run.feed(passes)
     held, advice = run.finish()
-    return replace(out, alerts=out.alerts + held, advice=advice, left_out=dict(run.left_out))
+    return replace(out, alerts=out.alerts + held, advice=advice, left_out=dict(run.left_out),
+                   events=out.events + run.trailing_events)
 
 
 def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:

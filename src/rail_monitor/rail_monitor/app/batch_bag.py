@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import math
 import shutil
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -17,10 +17,11 @@ from rail_monitor.bagio import messages as fields
 from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
-from rail_monitor.bagio.topics import GRAPH_TOPICS
+from rail_monitor.bagio.topics import EVENT_TOPICS, GRAPH_TOPICS
 from rail_monitor.core.errors import PassOrderError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.text import printable
+from rail_monitor.corrugation.surveys import MaintenanceEvent
 
 
 class BatchBag:
@@ -45,7 +46,16 @@ class BatchBag:
         self.bag.close()
 
     def _put(self, name: str, msg: dict[str, Any], stamp_ns: int) -> None:
-        self.bag.write(f"{self.ns}/{name}", serialize(GRAPH_TOPICS[name][0], msg), stamp_ns)
+        typename = GRAPH_TOPICS[name][0] if name in GRAPH_TOPICS else EVENT_TOPICS[name][0]
+        self.bag.write(f"{self.ns}/{name}", serialize(typename, msg), stamp_ns)
+
+    def events(self, events: list[MaintenanceEvent]) -> None:
+        """Surveys and grinding events given to the run, on the topic the replayer sends them on
+        (declared with the first, as the recorder records it once it is published)."""
+        for event in events:
+            typename, qos = EVENT_TOPICS["roughness_survey"]
+            self.bag.add_topic(f"{self.ns}/roughness_survey", typename, [qos.as_metadata()])
+            self._put("roughness_survey", fields.roughness_survey_fields(event, self.frame), max(event.stamp_ns, 0))
 
     def add(self, result: BatchResult) -> None:
         """One chunk's passes and outputs, and its settled alert events."""
@@ -66,6 +76,7 @@ class BatchBag:
                                                                        result.receiver),
                           int(result.accepted.stamp_ns[i]))
         self._alerts(result.alerts)
+        self.events(result.events)
 
     def _alerts(self, events: list[Alert]) -> None:
         for a in events:
@@ -89,7 +100,7 @@ def write_bag(result: BatchResult, folder: str | Path, namespace: str, compressi
               site: dict[str, str] | None = None) -> Path:
     """Record a whole history's outputs (run_models) in a new bag folder."""
     with BatchBag(folder, namespace, result.site.site_id, compression, site) as bag:
-        bag.add(result)
+        bag.add(result)  # its events include those after the last pass (run_models)
         bag.finish([], result.advice, result.estimator.newest_ns)
     return Path(folder)
 
@@ -105,13 +116,15 @@ class Recorded:
     days_to_threshold: float = math.inf
     left_out: dict[str, int] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    events: int = 0                                               # surveys and grinding events read
+    events_refused: dict[str, int] = field(default_factory=dict)  # of those, refused by reason
 
 
 def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: str | Path, namespace: str,
-               site: dict[str, str] | None = None) -> Recorded:
-    """BatchRun over an iterable of PassTable chunks in time order, each recorded as it is done
-    (memory: one chunk's outputs)."""
-    run = BatchRun(values)
+               site: dict[str, str] | None = None, events: Sequence[MaintenanceEvent] = ()) -> Recorded:
+    """BatchRun over an iterable of PassTable chunks in time order (and the history's surveys and
+    grinding events), each recorded as it is done (memory: one chunk's outputs)."""
+    run = BatchRun(values, events=events)
     out = Recorded()
     with BatchBag(folder, namespace, run.site.site_id, site=site) as bag:
         for chunk in chunks:
@@ -123,9 +136,11 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
             if len(result.trajectory):
                 out.days_to_threshold = float(result.trajectory.forecast.days_to_threshold[-1])
         held, advice = run.finish()
+        bag.events(run.trailing_events)
         bag.finish(held, advice, run.estimator.newest_ns)
     out.alert_events += len(held)
     out.left_out = dict(run.left_out)
+    out.events, out.events_refused = len(events), dict(run.events_refused)
     return out
 
 
@@ -135,13 +150,14 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
     """The batch run of a history file recorded to a new bag folder. A bag is read and recorded chunk
     by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
     time order is read whole and sorted. A run that fails leaves no output behind."""
-    from rail_monitor.bagio.reader import is_csv, iter_bag_passes
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_events
 
     existed = folder.exists()
     try:
         if not (salvage or is_csv(Path(source))):
             try:
-                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site)
+                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site,
+                                  read_bag_events(source))
             except PassOrderError as exc:
                 note = f"{printable(str(source))}: {exc}; read whole to sort it"
                 _discard(folder, existed)
@@ -156,15 +172,16 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
 
 def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
            site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool) -> Recorded:
-    from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.bagio.reader import read_bag_events, read_passes
 
     passes = read_passes(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
-    notes = [printable(passes.salvage.line(source))] if salvage else []
+    events = [] if salvage else read_bag_events(source)  # a salvage recovers passes only
+    notes = [printable(passes.salvage.line(source)), "surveys and grinding events are not salvaged"] if salvage else []
     skipped = getattr(passes, "skipped_rows", [])
     if skipped:
         notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "
                      + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
-    rec = run_to_bag([passes], values, folder, namespace, site)
+    rec = run_to_bag([passes], values, folder, namespace, site, events)
     rec.notes = notes
     return rec
 

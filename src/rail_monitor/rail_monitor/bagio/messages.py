@@ -19,6 +19,7 @@ from rail_monitor.alerts.config import NOISE_METRICS
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.core.timeutil import TIME_MSG_END_NS, fits_time_msg, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot
+from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.predict import Corrugation, NoisePrediction
 from rail_monitor.squeal.config import RISK_HIGH
@@ -137,7 +138,19 @@ def wayside_alert_array_fields(alerts: list[Alert], stamp_ns: int, frame_id: str
     return {"header": header_fields(stamp_ns, frame_id), "alerts": [wayside_alert_fields(a, frame_id) for a in alerts]}
 
 
+def roughness_survey_fields(event: MaintenanceEvent, frame_id: str) -> Fields:
+    return {"header": header_fields(event.stamp_ns, frame_id), "kind": event.kind,
+            "wavelength_m": np.asarray(event.wavelength_m, float).tolist(),
+            "amplitude_m": np.asarray(event.amplitude_m, float).tolist()}
+
+
 # -- back to records ------------------------------------------------------------------------------
+def event_from_msg(msg: Any) -> MaintenanceEvent:
+    """A RoughnessSurvey as a MaintenanceEvent (its checks are apply_event's)."""
+    return MaintenanceEvent(time_ns(msg.header.stamp), int(msg.kind), np.array(msg.wavelength_m, float),
+                            np.array(msg.amplitude_m, float))
+
+
 def alert_from_msg(msg: Any) -> Alert:
     """A WaysideAlert as an Alert."""
     return Alert(msg.kind, msg.key, msg.severity, msg.active, msg.summary, msg.value, msg.threshold, msg.unit,

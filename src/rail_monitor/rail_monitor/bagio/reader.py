@@ -15,10 +15,11 @@ from typing import Any
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.integrity import Claims, ScannedMessage, check_bag, scan_mcap
-from rail_monitor.bagio.messages import pass_row
-from rail_monitor.bagio.typestore import TRAIN_PASS, typestore
+from rail_monitor.bagio.messages import event_from_msg, pass_row
+from rail_monitor.bagio.typestore import ROUGHNESS_SURVEY, TRAIN_PASS, typestore
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import PassTable
+from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
 
 
 def _one_line(exc: BaseException) -> str:
@@ -154,7 +155,7 @@ def iter_messages(path: str | Path, typenames: Collection[str], chunk: int = 20_
     try:
         conns = [c for c in reader.connections if c.msgtype in typenames]
         out: list[tuple[str, int, Any]] = []
-        for c, t, raw in reader.messages(connections=conns):
+        for c, t, raw in reader.messages(connections=conns) if conns else ():  # none given: rosbags reads all
             out.append((c.msgtype, t, reader.deserialize(raw, c.msgtype)))
             read[c.topic] += 1
             if len(out) >= chunk:
@@ -177,6 +178,15 @@ def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, lis
         for typename, _, msg in part:
             out[typename].append(msg)
     return out
+
+
+def read_bag_events(path: str | Path) -> list[MaintenanceEvent]:
+    """The roughness surveys and grinding events (rail_msgs/RoughnessSurvey, any topic) of a bag,
+    in stamp order; none for a CSV history."""
+    if is_csv(Path(path)):
+        return []
+    msgs = read_messages(path, [ROUGHNESS_SURVEY])[ROUGHNESS_SURVEY]
+    return in_time_order([event_from_msg(m) for m in msgs])
 
 
 def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,

@@ -21,6 +21,7 @@ from rail_monitor.core.timeutil import from_sec_nanosec
 SEPARATOR = "=" * 80
 TRAIN_PASS = "rail_msgs/msg/TrainPass"
 CORRUGATION_STATE = "rail_msgs/msg/CorrugationState"
+ROUGHNESS_SURVEY = "rail_msgs/msg/RoughnessSurvey"
 
 
 def _share_dir(package: str) -> Path:

@@ -67,6 +67,11 @@ def run(ns: argparse.Namespace) -> int:
         print(f"batch: {line}")
     for why, count in rec.left_out.items():
         print(f"batch: {count} pass(es) left out: {why}")
+    if rec.events:
+        print(f"batch: {rec.events} roughness survey(s) and grinding event(s) applied in stamp order, "
+              f"{sum(rec.events_refused.values())} refused")
+    for why, count in rec.events_refused.items():
+        print(f"batch: {count} survey or grinding event(s) refused: {why}")
     t = time.monotonic() - t0
     print(f"batch: {rec.passes} passes through the models and recorded to {out} in {t:.2f} s "
           f"({rec.passes / max(t, 1e-9):.0f} passes/s)")

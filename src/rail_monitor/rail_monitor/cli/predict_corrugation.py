@@ -40,13 +40,13 @@ def run(ns: argparse.Namespace) -> int:
     from rail_monitor.corrugation.whatif import predict_corrugation, summary
 
     values = site_values(ns.site)
-    history = None
+    history, events = None, []
     if ns.history:
-        from rail_monitor.bagio.reader import read_passes
+        from rail_monitor.bagio.reader import read_bag_events, read_passes
 
-        history = read_passes(Path(ns.history))
+        history, events = read_passes(Path(ns.history)), read_bag_events(Path(ns.history))
     r = predict_corrugation(values, history, ns.history or "", ns.speeds, ns.weights, ns.vehicle_class,
-                            ns.speed_mean, ns.speed_cv, ns.friction, ns.passes_per_day, ns.advise)
+                            ns.speed_mean, ns.speed_cv, ns.friction, ns.passes_per_day, ns.advise, events)
     data = summary(r)
     if ns.json:
         print_json(data)
@@ -69,6 +69,14 @@ def _print_table(r, data: dict) -> None:
     print(f"peak g {ev.peak_growth:.3e} per axle pass at {1e3 * ev.peak_wavelength_m:.1f} mm; worst band "
           f"{1e3 * est.bands[fc.worst_band]:.1f} mm reaches its limit in {fc.passes_to_threshold:.4g} train passes"
           f" = {fc.days_to_threshold:.4g} days at {fc.passes_per_day:.4g} passes/day of {r.axles_per_train:.3g} axles")
+    if r.interval is not None:
+        iv = data["forecast_interval"]
+        p10, p50, p90 = iv["days_to_threshold_p10_p50_p90"]
+        print(f"first band at its limit in {p10:.4g} / {p50:.4g} / {p90:.4g} days (P10 / P50 / P90: "
+              f"{' / '.join(d[:10] for d in iv['grinding_due_p10_p50_p90'])}) from {iv['basis']}")
+        print(f"K_b P10-P90 {', '.join(f'{a:.3g}-{b:.3g}' for a, b in zip(est.k_b_p10, est.k_b_p90, strict=True))}"
+              f" after {est.calibration_surveys} survey fit(s); {r.events} survey(s)/grinding(s) in the history, "
+              f"{sum(r.events_refused.values())} refused")
     if advice is not None:
         print("advice:")
         for line in advice.lines():

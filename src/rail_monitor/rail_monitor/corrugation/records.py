@@ -57,7 +57,8 @@ class Trajectory:
     """The state after each counted pass of a history (batch mode): arrays over counted passes.
 
     index: row of each counted pass in the history given; constants: the snapshot before the
-    history (bands, thresholds, post-grinding amplitudes, K_b, last grinding).
+    history (bands, thresholds, post-grinding amplitudes, K_b, last grinding); constants_from:
+    (first counted pass, snapshot) where a survey or grinding changed them within the history.
     """
 
     index: np.ndarray
@@ -69,13 +70,14 @@ class Trajectory:
     total_pass_count: np.ndarray
     forecast: Forecast             # of arrays (M,) and (M, B)
     constants: StateSnapshot
+    constants_from: tuple[tuple[int, StateSnapshot], ...] = ()
 
     def __len__(self) -> int:
         return len(self.index)
 
     def state(self, k: int) -> tuple[StateSnapshot, Forecast]:
         """The snapshot and forecast after counted pass k (for message conversion)."""
-        c, f = self.constants, self.forecast
+        c, f = self.constants_at(k), self.forecast
         snap = StateSnapshot(int(self.stamp_ns[k]), str(self.train_id[k]), int(self.pass_count[k]),
                              int(self.axle_pass_count[k]), int(self.total_pass_count[k]), c.last_grinding_ns,
                              c.bands, self.amplitude[k], c.threshold, c.grinding_amplitude, c.k_b,
@@ -83,6 +85,15 @@ class Trajectory:
         return snap, Forecast(f.growth_per_axle_pass[k], int(f.worst_band[k]), float(f.passes_to_threshold[k]),
                               float(f.days_to_threshold[k]), float(f.passes_per_day[k]), bool(f.grinding_due[k]),
                               int(f.grinding_due_ns[k]))
+
+    def constants_at(self, k: int) -> StateSnapshot:
+        """The constants in force at counted pass k."""
+        c = self.constants
+        for first, later in self.constants_from:
+            if first > k:
+                break
+            c = later
+        return c
 
     @classmethod
     def from_rows(cls, rows: list[tuple[int, StateSnapshot, Forecast]], last: StateSnapshot) -> Trajectory:
@@ -103,17 +114,23 @@ class Trajectory:
     @classmethod
     def concat(cls, parts: Sequence[tuple[int, Trajectory]]) -> Trajectory:
         """Trajectories of consecutive chunks of one history, each with the history row its chunk
-        starts at, as one (constants: the first chunk's, the state before the history)."""
+        starts at, as one (constants: the first chunk's, the state before the history; each later
+        chunk's from its first counted pass)."""
         first = parts[0][1]
+        offsets = np.cumsum([0, *(len(t) for _, t in parts)]).tolist()
+        changes: list[tuple[int, StateSnapshot]] = []
+        for i, (_, t) in enumerate(parts):
+            changes += [(offsets[i], t.constants)] if i else []
+            changes += [(offsets[i] + k, c) for k, c in t.constants_from]
 
         def join(get) -> np.ndarray:
             return np.concatenate([get(t) for _, t in parts])
 
         fc = Forecast(**{f.name: join(lambda t, k=f.name: getattr(t.forecast, k)) for f in fields(Forecast)})
         per_pass = {f.name: join(lambda t, k=f.name: getattr(t, k)) for f in fields(cls)
-                    if f.name not in ("index", "forecast", "constants")}
+                    if f.name not in ("index", "forecast", "constants", "constants_from")}
         return cls(index=np.concatenate([t.index + start for start, t in parts]), forecast=fc,
-                   constants=first.constants, **per_pass)
+                   constants=first.constants, constants_from=tuple(changes), **per_pass)
 
 
 @dataclass

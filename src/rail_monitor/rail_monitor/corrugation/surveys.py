@@ -6,14 +6,77 @@ state's growth since then, split by friction state. The state then follows the f
 growth since the last survey re-scaled), and each measured band's level is the Kalman update of
 the model's prediction by the survey (each weighed by its variance; a band keeps its components'
 shape). Each band's level variance is kept: it weighs the next fit and the forecast interval.
+
+Order: an event (survey or grinding) applies to the state after every pass stamped at or before
+it, and before the first pass stamped later (:func:`split_before`), in batch, in a replay and live
+(where an event stamped before a pass already counted can only be applied on arrival).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
+
 import numpy as np
 
+from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.models import calibration
+
+KIND_SURVEY, KIND_GRINDING = 1, 2  # as rail_msgs/RoughnessSurvey's KIND_*
+
+
+@dataclass(frozen=True)
+class MaintenanceEvent:
+    """A roughness survey or a grinding event (units as in rail_msgs/RoughnessSurvey)."""
+
+    stamp_ns: int
+    kind: int                  # KIND_SURVEY or KIND_GRINDING
+    wavelength_m: np.ndarray   # band centre wavelengths [m] (a grinding may give none)
+    amplitude_m: np.ndarray    # r.m.s. roughness per band [m]
+
+
+def apply_event(est: CorrugationEstimator, event: MaintenanceEvent) -> calibration.KbPosterior | None:
+    """Apply a survey (apply_survey's result) or a grinding (None); ValueError, with the state
+    untouched, for an event not newer than the last one applied or an unusable one."""
+    if event.stamp_ns <= est.last_survey_ns:
+        raise ValueError("not newer than the last survey or grinding applied")
+    if event.kind == KIND_SURVEY:
+        return apply_survey(est, event.wavelength_m, event.amplitude_m, event.stamp_ns)
+    if event.kind == KIND_GRINDING:
+        apply_grinding(est, event.stamp_ns, event.wavelength_m, event.amplitude_m)
+        return None
+    raise ValueError(f"unknown kind {event.kind}")
+
+
+def split_before(stamps_ns: np.ndarray, event_ns: int) -> int:
+    """How many of the passes (stamps [ns], in stream order) come before an event at event_ns:
+    those before the first pass stamped later than it."""
+    later = np.asarray(stamps_ns) > event_ns
+    return int(np.argmax(later)) if later.any() else len(later)
+
+
+def in_time_order(events: Sequence[MaintenanceEvent]) -> list[MaintenanceEvent]:
+    """The events sorted by stamp (a stable sort: equal stamps keep their order)."""
+    return sorted(events, key=lambda e: e.stamp_ns)
+
+
+def advance_with_events(est: CorrugationEstimator, passes: PassTable, events: Sequence[MaintenanceEvent]
+                        ) -> dict[str, int]:
+    """Advance est over passes (valid, class defaults filled, in stream order) with each event
+    applied before the first pass stamped later than it (those after every pass at the end);
+    returns the events refused, by reason (a refused event changes nothing)."""
+    refused: dict[str, int] = {}
+    for event in in_time_order(events):
+        n = split_before(passes.stamp_ns, event.stamp_ns)
+        est.advance(passes.take(slice(0, n)))
+        passes = passes.take(slice(n, None))
+        try:
+            apply_event(est, event)
+        except ValueError as exc:
+            refused[str(exc)] = refused.get(str(exc), 0) + 1
+    est.advance(passes)
+    return refused
 
 
 def match_bands(bands: np.ndarray, wavelength: np.ndarray, amplitude: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -72,16 +135,15 @@ def apply_grinding(est: CorrugationEstimator, stamp_ns: int, wavelength: np.ndar
     """Reset after grinding at stamp_ns [ns]: the measured spectrum where given, else the
     post-grinding default."""
     rms = est.post_grinding.copy()
-    est.survey_log_amplitude = np.full(len(est.bands), np.nan)
+    matched = np.zeros(len(est.bands), bool)
     if wavelength is not None and len(wavelength):
-        z, matched = match_bands(est.bands, wavelength, amplitude)
+        z, matched = match_bands(est.bands, wavelength, amplitude)  # before any change: a refusal leaves the state
         rms[matched] = z[matched]
-        est.survey_log_amplitude[matched] = np.log(z[matched])
+    est.survey_log_amplitude = np.where(matched, np.log(rms), np.nan)
     est.log_components = est.flat(rms)
     est.growth_by_state[:] = 0.0
     est.level_var = est.post_grinding_var.copy()
-    if wavelength is not None and len(wavelength):
-        est.level_var[matched] = est.survey_var
+    est.level_var[matched] = est.survey_var
     est.grinding_amplitude = rms
     est.pass_count = est.axle_pass_count = 0
     est.last_grinding_ns = int(stamp_ns)

@@ -3,8 +3,8 @@ as ``rail-monitor predict corrugation`` reports them (callable from Python too).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -12,10 +12,12 @@ import numpy as np
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.passes import FRICTION_BY_NAME, PassTable, rejection_reasons, with_class_defaults
 from rail_monitor.core.site import site_from_values
+from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.corrugation import advice as adv
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.corrugation.records import Evaluation, Forecast
+from rail_monitor.corrugation.records import Evaluation, Forecast, ForecastInterval
+from rail_monitor.corrugation.surveys import MaintenanceEvent, advance_with_events
 
 
 @dataclass
@@ -32,6 +34,9 @@ class CorrugationWhatIf:
     evaluation: Evaluation
     forecast: Forecast
     advice: Any                     # rail_monitor.advice.plan.SpeedAdvice, or None
+    interval: ForecastInterval | None = None  # P10/P50/P90 of the history's forecast (None without one)
+    events: int = 0                           # surveys and grinding events given with the history
+    events_refused: dict[str, int] = field(default_factory=dict)
 
 
 def speed_distribution(mean_mps: float, cv: float) -> tuple[np.ndarray, np.ndarray]:
@@ -47,10 +52,13 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
                         speeds: np.ndarray | None = None, weights: np.ndarray | None = None,
                         vehicle_class: str | None = None, speed_mean_mps: float | None = None,
                         speed_cv: float | None = None, friction: str | None = None,
-                        passes_per_day: float | None = None, advise: bool = False) -> CorrugationWhatIf:
+                        passes_per_day: float | None = None, advise: bool = False,
+                        events: Sequence[MaintenanceEvent] = ()) -> CorrugationWhatIf:
     """Evaluate a speed distribution for the site of the flat parameter values.
 
-    With a history, the state, speeds (axle-weighted) and traffic come from it; otherwise the
+    With a history, the state, speeds (axle-weighted) and traffic come from it, with its surveys
+    and grinding events (events) applied in stamp order, and the forecast has its P10/P50/P90
+    interval; otherwise the
     post-grinding rail with the given speeds and weights, or a normal distribution of the
     class's mean and sd (overridden by speed_mean_mps [m/s] and speed_cv [-]), on dry rail
     unless friction names a state; the kernel and axles per train are then vehicle_class's when
@@ -63,7 +71,7 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
     kernel_class = None
     if history is not None:
         ok = rejection_reasons(history, site) == ""
-        est.advance(with_class_defaults(history.take(ok), site))
+        refused = advance_with_events(est, with_class_defaults(history.take(ok), site), events)
         where = f"site {site.site_id}, history {history_name} ({int(ok.sum())} passes, {int((~ok).sum())} rejected)"
         if not len(est.kept):
             raise RailMonitorError(f"{history_name}: no valid pass for site {site.site_id}")
@@ -94,7 +102,10 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
     axles = adv.axles_per_train(est, kernel_class)
     fc = est.forecast(adv.growth_at_speeds(est, v, state, kernel_class) @ (w / w.sum()), passes_per_day, axles)
     axles = axles or (est.traffic()[1] if len(est.kept) else site.mean_axles_per_train)
-    return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice)
+    if history is None:
+        return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice)
+    return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice, est.forecast_interval(),
+                             len(events), refused)
 
 
 def _advise(values: Mapping[str, Any], est: CorrugationEstimator) -> Any:
@@ -113,12 +124,22 @@ def summary(r: CorrugationWhatIf) -> dict[str, Any]:
         "worst_wavelength_m": float(est.bands[fc.worst_band]), "passes_to_threshold": fc.passes_to_threshold,
         "days_to_threshold": fc.days_to_threshold, "passes_per_day": fc.passes_per_day,
         "kernel_vehicle_class": r.vehicle_class, "axles_per_train": r.axles_per_train,
-        "k_b_by_friction": est.k_b.tolist()}
+        "k_b_by_friction": est.k_b.tolist(), "k_b_p10_by_friction": est.k_b_p10.tolist(),
+        "k_b_p90_by_friction": est.k_b_p90.tolist(), "calibration_surveys": est.calibration_surveys,
+        "surveys_and_grinding": r.events, "surveys_and_grinding_refused": r.events_refused}
+    iv = r.interval
+    if iv is not None:
+        out["forecast_interval"] = {
+            "basis": "K_b posterior and each band's level uncertainty; traffic and friction mix of the recent "
+                     f"{est.cfg.history_days:g} days",
+            "days_to_threshold_p10_p50_p90": iv.days.tolist(),
+            "grinding_due_p10_p50_p90": [format_iso_ns(int(ns)) if ns else "never" for ns in iv.due_ns.tolist()]}
     if r.advice is not None:
         out["advice"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in vars(r.advice).items()}
         out["advice"]["summary"] = r.advice.lines()
     out["bands"] = [{"wavelength_m": float(est.bands[i]), "growth_per_axle_pass": float(ev.growth_per_axle_pass[i]),
-                     "amplitude_m": float(est.amplitude[i]), "threshold_m": float(est.threshold[i])}
+                     "amplitude_m": float(est.amplitude[i]), "threshold_m": float(est.threshold[i]),
+                     **({} if iv is None else {"days_to_threshold_p10_p50_p90": iv.band_days[:, i].tolist()})}
                     for i in range(len(est.bands))]
     return out
 

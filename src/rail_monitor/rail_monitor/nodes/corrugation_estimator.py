@@ -2,9 +2,13 @@
 
 Subscribes ``train_pass`` (each accepted pass advances the state once: passes are identified by
 (stamp, train_id)) and ``roughness_survey`` (rail_msgs/RoughnessSurvey: a survey re-fits K_b, a
-grinding event resets the state). Publishes ``corrugation/state`` (rail_msgs/CorrugationState,
-per pass or at most every ``state_period_s``) and ``speed_advisory`` (rail_msgs/SpeedAdvisory,
-every ``advisory_period_s``), both latched; serves ``evaluate_speed_distribution``. With
+grinding event resets the state). A survey or grinding is applied before the first pass stamped
+later than it, as batch mode applies it (one stamped after every pass so far waits for the next
+pass, or shutdown; one stamped before a pass already counted is applied on arrival and counted as
+late); surveys queued behind a backlog of passes are taken first. Publishes
+``corrugation/state`` (rail_msgs/CorrugationState, per pass or at most every ``state_period_s``)
+and ``speed_advisory`` (rail_msgs/SpeedAdvisory, every ``advisory_period_s``), both latched;
+serves ``evaluate_speed_distribution``. With
 ``checkpoint_path`` set, the state is written atomically every ``checkpoint_every_passes``
 passes, after every survey and at shutdown, and a restart resumes from it.
 """
@@ -20,7 +24,7 @@ from diagnostic_msgs.msg import DiagnosticStatus
 
 from rail_monitor.advice import plan
 from rail_monitor.advice.consequences import Consequences
-from rail_monitor.bagio.messages import corrugation_state_fields, speed_advisory_fields, time_ns
+from rail_monitor.bagio.messages import corrugation_state_fields, event_from_msg, speed_advisory_fields
 from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
@@ -28,7 +32,8 @@ from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.corrugation import advice, checkpoint, surveys
 from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.nodes.base import Sent, declare, wall_timer
+from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.nodes.base import Sent, declare, take_queued, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
@@ -72,7 +77,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self._last_state_t = float("-inf")
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
-        self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
+        self.pending: list[MaintenanceEvent] = []  # surveys and grinding waiting for a later pass, by stamp
+        self.survey_sub = self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
         wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
         self.listen()
@@ -81,11 +87,29 @@ class CorrugationEstimatorNode(PassConsumerNode):
         return {"checkpoint": self.checkpoint or "none", "passes": self.est.total_pass_count,
                 "lead_time_days": f"{self.est.cfg.lead_time_days:g}"}
 
+    def _on_train_passes(self, raws: list[bytes]) -> None:
+        # Surveys sent before these passes are in their queue by now (a replay sends each before the
+        # first later pass, acknowledged): take them first, so they wait for the right pass.
+        for msg in take_queued(self.survey_sub, 1000):
+            self._on_survey(msg)
+        super()._on_train_passes(raws)
+
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
+        start = 0
+        while self.pending:
+            n = surveys.split_before(table.stamp_ns[start:], self.pending[0].stamp_ns)
+            if start + n == len(table):
+                break
+            self._count(table.take(slice(start, start + n)))
+            self._apply(self.pending.pop(0))
+            start += n
+        self._count(table.take(slice(start, None)) if start else table)
+
+    def _count(self, table: PassTable) -> None:
         # The state and forecast after each counted pass, as advancing one pass at a time gives them.
         traj = self.est.advance_history(table)
-        if len(traj) < len(msgs):
-            self.counts["not counted (already counted, or older than the history)"] += len(msgs) - len(traj)
+        if len(traj) < len(table):
+            self.counts["not counted (already counted, or older than the history)"] += len(table) - len(traj)
         if not len(traj):
             return
         self.counts["counted"] += len(traj)
@@ -125,29 +149,39 @@ class CorrugationEstimatorNode(PassConsumerNode):
             advised, self.est.newest_ns, self.site.site_id)))
 
     def _on_survey(self, msg: RoughnessSurvey) -> None:
-        stamp = time_ns(msg.header.stamp)
+        event = event_from_msg(msg)
+        why = self.stamp_ahead(event.stamp_ns)  # one far-future survey would refuse every later one
+        if not why and event.stamp_ns <= max([self.est.last_survey_ns, *(e.stamp_ns for e in self.pending)]):
+            why = "not newer than the last survey or grinding applied"
+        if why:
+            self._refuse(why)
+        elif event.stamp_ns >= self.est.newest_ns:
+            self.pending.append(event)  # stamps rise (checked above)
+        else:
+            self.counts["applied late (passes after its stamp already counted)"] += 1
+            if self._apply(event):
+                self.publish_state()
+
+    def _apply(self, event: MaintenanceEvent) -> bool:
+        """Apply a survey or grinding to the state (refusals counted); whether it was applied."""
         try:
-            if stamp <= self.est.last_survey_ns:
-                raise ValueError("not newer than the last survey or grinding applied")
-            if self.stamp_ahead(stamp):  # one far-future survey would refuse every later one
-                raise ValueError(self.stamp_ahead(stamp))
-            if msg.kind == RoughnessSurvey.KIND_SURVEY:
-                fit = surveys.apply_survey(self.est, msg.wavelength_m, msg.amplitude_m, stamp)
-                self.counts["surveys"] += 1
-                if fit is not None:
-                    self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
-                                           f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
-            elif msg.kind == RoughnessSurvey.KIND_GRINDING:
-                surveys.apply_grinding(self.est, stamp, msg.wavelength_m, msg.amplitude_m)
-                self.counts["grindings"] += 1
-            else:
-                raise ValueError(f"unknown kind {msg.kind}")
+            fit = surveys.apply_event(self.est, event)
         except ValueError as exc:
-            self.surveys_rejected[str(exc)] += 1
-            self.get_logger().warning(f"roughness survey rejected: {exc}")
-            return
+            self._refuse(str(exc))
+            return False
+        if event.kind == surveys.KIND_GRINDING:
+            self.counts["grindings"] += 1
+        else:
+            self.counts["surveys"] += 1
+            if fit is not None:
+                self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
+                                       f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
         self.save()
-        self.publish_state()
+        return True
+
+    def _refuse(self, why: str) -> None:
+        self.surveys_rejected[why] += 1
+        self.get_logger().warning(f"roughness survey rejected: {why}")
 
     def _on_evaluate(self, req: EvaluateSpeedDistribution.Request,
                      res: EvaluateSpeedDistribution.Response) -> EvaluateSpeedDistribution.Response:
@@ -178,7 +212,10 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self._since_checkpoint = 0
 
     def close(self) -> None:
-        """Final checkpoint (run_node calls it at shutdown)."""
+        """The surveys and grinding later than every pass applied, and a final checkpoint (run_node
+        calls it at shutdown)."""
+        while self.pending:
+            self._apply(self.pending.pop(0))
         if self._since_checkpoint:
             self.save()
 
@@ -190,6 +227,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
                   "grinding_due": fc.grinding_due,
                   "state_age_s": f"{(time.time_ns() - self.est.newest_ns) / 1e9:.0f}" if self.est.newest_ns else "",
                   "last_grinding": format_iso_ns(self.est.last_grinding_ns) if self.est.last_grinding_ns else ""}
+        values["surveys pending"] = len(self.pending)
         values.update({f"survey rejected: {why}": n for why, n in sorted(self.surveys_rejected.items())})
         values.update({f"checkpoint skipped {i + 1}": why for i, why in enumerate(self.checkpoint_skipped)})
         return values

@@ -16,16 +16,17 @@ from rclpy.duration import Duration
 from rosgraph_msgs.msg import Clock
 from tqdm import tqdm
 
-from rail_monitor.bagio.messages import train_pass_fields
+from rail_monitor.bagio.messages import roughness_survey_fields, train_pass_fields
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import PUBLISH_SPECS, STAMP_SPECS, PublishParams, StampParams
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, publishable
 from rail_monitor.core.timeutil import NS_PER_S
+from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.nodes.base import DIAGNOSTICS_PERIOD_S, Diagnostics, RailNode, RateMeter, announce, declare
 from rail_monitor.nodes.convert import time_msg, to_msg
-from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, STREAM_QOS
-from rail_msgs.msg import TrainPass
+from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STREAM_QOS
+from rail_msgs.msg import RoughnessSurvey, TrainPass
 
 GRAPH_SETTLE_S = 1.0  # the graph's endpoints unchanged this long [s]: every node has subscribed
 
@@ -50,10 +51,13 @@ class PassSourceNode(RailNode):
         self.consumed: Callable[[], int] | None = None
         self.foreign_subscribers = False
         self.left_out: dict[str, int] = {}
+        self.event_pub = None  # roughness_survey, made when the history has surveys or grinding
+        self.events_sent = 0
+        self._bounds = (0, 0)  # stamps of the replay window [ns]
         self._status: dict[str, dict[str, str]] = {}  # latest /diagnostics values, by status name
         self.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, DIAGNOSTICS_QOS)
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
-                                   "left out": sum(self.left_out.values()),
+                                   "left out": sum(self.left_out.values()), "surveys sent": self.events_sent,
                                    **{f"left out: {why}": n for why, n in self.left_out.items()},
                                    "rate_per_s": f"{self.meter.rate():.1f}",
                                    "pass_time_ns": self.last_stamp_ns, "done": self.done.is_set()})
@@ -61,6 +65,10 @@ class PassSourceNode(RailNode):
     def passes(self) -> PassTable:
         """The passes to publish, in time order (subclasses)."""
         raise NotImplementedError
+
+    def events(self) -> list[MaintenanceEvent]:
+        """The surveys and grinding events of the history, in stamp order (none by default)."""
+        return []
 
     def _window(self, table: PassTable) -> PassTable:
         """The passes to publish: in time order, inside the offsets, publishable
@@ -71,10 +79,28 @@ class PassSourceNode(RailNode):
         if len(table) == 0:
             return table
         t0 = int(table.stamp_ns[0])
-        keep = table.stamp_ns >= t0 + int(self.cfg.start_offset_s * NS_PER_S)
-        if self.cfg.end_offset_s > 0.0:
-            keep &= table.stamp_ns <= t0 + int(self.cfg.end_offset_s * NS_PER_S)
+        end = t0 + int(self.cfg.end_offset_s * NS_PER_S) if self.cfg.end_offset_s > 0.0 else 2**63 - 1
+        self._bounds = (t0 + int(self.cfg.start_offset_s * NS_PER_S), end)
+        keep = (table.stamp_ns >= self._bounds[0]) & (table.stamp_ns <= end)
         return table.take(keep)
+
+    def advertise_events(self) -> None:
+        """Create the roughness_survey publisher (before the start-up wait, so that a recorder
+        discovers the topic in time; a source whose history has events calls it at construction)."""
+        if self.event_pub is None:
+            self.event_pub = self.create_publisher(RoughnessSurvey, "roughness_survey", EVENT_QOS)
+
+    def _send_event(self, event: MaintenanceEvent, ok: Callable[[], bool]) -> None:
+        """Publish a survey or grinding event. In other processes, wait until every subscriber holds
+        it before the next pass goes out (the estimator takes queued surveys before passes); in
+        this one, DDS has delivered it to the hosted subscribers when publish returns."""
+        self.event_pub.publish(to_msg(RoughnessSurvey, roughness_survey_fields(event, self.cfg.site_id)))
+        self.events_sent += 1
+        deadline = time.monotonic() + self.cfg.ack_timeout_s
+        while self.consumed is None and ok() and not self.event_pub.wait_for_all_acked(Duration(seconds=0.05)):
+            if time.monotonic() > deadline:
+                raise RailMonitorError(f"subscribers of {self.event_pub.topic_name} did not take a survey within "
+                                       f"{self.cfg.ack_timeout_s:g} s")
 
     def _publish_clock(self, ns: int) -> None:
         if self.clock_pub is not None:  # a ROS clock cannot run before 1970
@@ -100,6 +126,16 @@ class PassSourceNode(RailNode):
             now = self._endpoints()
             if now != last:
                 last, since = now, time.monotonic()
+
+    def _wait_for_event_subscriber(self, ok: Callable[[], bool]) -> None:
+        """Wait (at most wait_timeout_s) until roughness_survey has a subscriber: a survey sent to
+        nobody is lost (the topic is volatile)."""
+        deadline = time.monotonic() + self.cfg.wait_timeout_s
+        while ok() and self.event_pub.get_subscription_count() < 1:
+            if time.monotonic() > deadline:
+                self.get_logger().warning(f"nobody subscribes {self.event_pub.topic_name}: its surveys go unheard")
+                return
+            time.sleep(0.02)
 
     def _endpoints(self) -> list[tuple[str, int, int]]:
         """(topic, publishers, subscribers) of every topic under this node's namespace."""
@@ -168,9 +204,15 @@ class PassSourceNode(RailNode):
         ok = ok or (lambda: rclpy.ok(context=self.context))
         table = self._window(self.passes())
         self.total = len(table)
-        announce(self, site=self.cfg.site_id, passes=len(table), rate=f"{self.cfg.rate:g}",
+        lo, hi = self._bounds
+        events = [e for e in self.events() if lo <= e.stamp_ns <= hi] if len(table) else []
+        if events:
+            self.advertise_events()
+        announce(self, site=self.cfg.site_id, passes=len(table), surveys=len(events), rate=f"{self.cfg.rate:g}",
                  wait_for_subscribers=self.cfg.wait_for_subscribers)
         self._wait_for_subscribers(ok)
+        if events and self.cfg.wait_for_subscribers > 0:
+            self._wait_for_event_subscriber(ok)
         rate, frame = self.cfg.rate, self.cfg.site_id
         batch, period = self.cfg.ack_batch, self.cfg.clock_period_s
         stamps = table.stamp_ns
@@ -190,12 +232,16 @@ class PassSourceNode(RailNode):
                         # never past the pass itself: /clock must not step backwards
                         self._publish_clock(min(stamp, t0 + int((time.monotonic() - wall0) * rate * NS_PER_S)))
                 self._publish_clock(stamp)
+                while events and events[0].stamp_ns < stamp:  # before the first pass later than it
+                    self._send_event(events.pop(0), ok)
                 self.pub.publish(to_msg(TrainPass, train_pass_fields(table.row(i), frame)))
                 self.meter.tick()
                 self.last_stamp_ns = stamp
                 bar.update()
                 if (i + 1) % batch == 0:
                     self._throttle(i + 1, ok)
+            for event in events if ok() else []:
+                self._send_event(event, ok)
             self._throttle(self.meter.count, ok)
             if self.consumed is None and self.cfg.wait_for_subscribers > 0:
                 self._wait_for_graph(self.meter.count, ok)

@@ -107,9 +107,10 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
     publish the advice on the final state. After SIGINT or SIGTERM the waits share
     ``stop_timeout_s``: what is taken by then is recorded and the bag finished (no error)."""
     estimator, predictor, squeal, alerts = models
+    recorded_topics = _outputs(models) | ({source.event_pub.topic_name} if source.event_pub else set())
     if recorder is not None:
-        _wait(lambda: _outputs(models) <= set(recorder.counts), cfg.drain_timeout_s,
-              lambda: f"recorder did not subscribe to {sorted(_outputs(models) - set(recorder.counts))}")
+        _wait(lambda: recorded_topics <= set(recorder.counts), cfg.drain_timeout_s,
+              lambda: f"recorder did not subscribe to {sorted(recorded_topics - set(recorder.counts))}")
     t_replay = time.monotonic()
     published = source.run(lambda: not stop.is_set() and source.context.ok())
     stopping = stop.is_set()
@@ -129,6 +130,8 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
     bag = None
     if recorder is not None:
         sent = {source.pub.topic_name: published}
+        if source.event_pub is not None:
+            sent[source.event_pub.topic_name] = source.events_sent
         for m in models:
             sent.update(m.sent)
         wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
