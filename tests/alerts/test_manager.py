@@ -243,3 +243,45 @@ def test_bands_closer_than_the_key_resolution_get_distinct_keys():
     events = _state(m, 1, lam, [11e-6, 11e-6], thr, 0.0, True, 1)
     due = [a.key for a in events if a.kind == KIND_GRINDING_DUE]
     assert len(due) == 2 and len(set(due)) == 2
+
+
+def _residual(i: int, train: str, excess: float, vehicles=("V1", "V2", "V3"), loudest="", loudest_db=0.0,
+              drift=float("nan"), model="cnossos"):
+    from rail_monitor.measured.residuals import Residual
+
+    return Residual(i * DAY // 100, train, model, np.zeros(0), np.zeros(0), 0.0, 0.0, 0.0, excess, 0.0, drift, 2.0,
+                    0.6, excess, loudest, loudest_db, False, tuple(vehicles))
+
+
+def test_wheel_defect_alerts_name_the_vehicle_count_repeats_and_clear_with_hysteresis():
+    from rail_monitor.alerts.config import KIND_WHEEL_DEFECT
+
+    m = _manager(wheel_defect_raise_db=6.0, wheel_defect_clear_db=3.0, wheel_defect_vehicle_db=2.0)
+    seq = [_residual(0, "T1", 1.0),
+           _residual(1, "T1", 7.0, loudest="V2", loudest_db=5.0),       # vehicle V2 named: raised
+           _residual(2, "T2", 4.0, vehicles=("V2", "V9")),                # between the thresholds: stays
+           _residual(3, "T3", 8.0, loudest="V2", loudest_db=6.5),        # again: counted, no new event
+           _residual(4, "T4", 9.0),                                       # no vehicle named: the train
+           _residual(5, "T5", 1.0, vehicles=("V2", "V7")),                # V2 quiet again: cleared
+           _residual(6, "T6", 2.0, loudest="V8", loudest_db=7.5),        # a loud vehicle, train not: raised
+           _residual(7, "T4", 20.0, model="mechanics")]                   # the other model: ignored
+    events = m.on_residuals(seq)
+    assert [(e.key, e.active) for e in events] == [("vehicle V2", True), ("train T4", True), ("vehicle V2", False),
+                                                  ("vehicle V8", True)]
+    assert all(e.kind == KIND_WHEEL_DEFECT for e in events)
+    assert m.offences == {"vehicle V2": 2, "train T4": 1, "vehicle V8": 1}
+    assert "flagged 1 time(s)" in events[0].summary and events[3].value == 7.5
+    assert set(m.standing) == {(KIND_WHEEL_DEFECT, "train T4"), (KIND_WHEEL_DEFECT, "vehicle V8")}
+
+
+def test_the_drift_alert_raises_on_the_baseline_rise_and_clears_below_its_hysteresis():
+    from rail_monitor.alerts.config import KIND_NOISE_DRIFT
+
+    m = _manager(drift_raise_db=3.0, drift_clear_db=1.5)
+    drift = [float("nan"), 0.5, 2.9, 3.1, 2.0, 1.6, 1.4, 3.5]
+    events = m.on_residuals([_residual(i, f"T{i}", 0.0, drift=d) for i, d in enumerate(drift)])
+    assert [(e.kind, e.active, e.stamp_ns) for e in events] == [
+        (KIND_NOISE_DRIFT, True, 3 * DAY // 100), (KIND_NOISE_DRIFT, False, 6 * DAY // 100),
+        (KIND_NOISE_DRIFT, True, 7 * DAY // 100)]
+    with pytest.raises(ConfigError, match="drift alert needs hysteresis"):
+        _manager(drift_raise_db=2.0, drift_clear_db=2.0)

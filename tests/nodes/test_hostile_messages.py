@@ -14,6 +14,7 @@ every output, recorded.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -23,11 +24,12 @@ from rclpy.parameter import Parameter
 from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 
-from rail_monitor.bagio.messages import train_pass_fields
+from rail_monitor.bagio.messages import measured_pass_noise_fields, train_pass_fields
 from rail_monitor.bagio.reader import read_messages
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.measured.records import Measurement
 from rail_monitor.nodes import process
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.convert import time_msg, to_msg
@@ -36,7 +38,15 @@ from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STATE_QOS, STREAM_QOS
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
-from rail_msgs.msg import CorrugationState, RollingNoise, RoughnessSurvey, SquealPrediction, TrainPass
+from rail_monitor.noise.config import band_centres_hz
+from rail_msgs.msg import (
+    CorrugationState,
+    MeasuredPassNoise,
+    RollingNoise,
+    RoughnessSurvey,
+    SquealPrediction,
+    TrainPass,
+)
 from rail_msgs.srv import EvaluateSpeedDistribution
 
 from conftest import spinning, wait_until
@@ -105,6 +115,19 @@ def _hostile_outputs() -> tuple[list[SquealPrediction], list[RollingNoise]]:
     return squeal, noise
 
 
+def _hostile_measurements(first) -> list[MeasuredPassNoise]:
+    """A good measurement of the first pass (sent twice), and one of each kind the alert manager
+    must refuse: a NaN band, an absurd level, a receiver 30 m away, class 9, ids without levels,
+    and a pass that never was."""
+    bands = band_centres_hz()
+    good = Measurement(int(first.stamp_ns[0]), str(first.train_id[0]), 7.5, 1.2, 1, bands, np.full(len(bands), 70.0),
+                       80.0, 83.0, 85.0)
+    bad = [replace(good, leq_db=np.where(np.arange(len(bands)) == 2, np.nan, 70.0)), replace(good, tel_dba=1e6),
+           replace(good, receiver_distance_m=30.0), replace(good, instrument_class=9),
+           replace(good, vehicle_id=("V1", "V2")), replace(good, train_id="GHOST", stamp_ns=good.stamp_ns + 1)]
+    return [to_msg(MeasuredPassNoise, measured_pass_noise_fields(m, "curve_250")) for m in (good, good, *bad)]
+
+
 def _diagnostic(name: str, n_values: int) -> DiagnosticArray:
     status = DiagnosticStatus(level=DiagnosticStatus.ERROR, name=name, message="\x1b[2J" * 1000)
     status.values = [KeyValue(key=f"k{i}\x00", value="v" * 1000) for i in range(n_values)]
@@ -135,14 +158,14 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
         ("/clock", Clock, CLOCK_QOS), ("train_pass", TrainPass, STREAM_QOS),
         ("roughness_survey", RoughnessSurvey, EVENT_QOS), ("corrugation/state", CorrugationState, STATE_QOS),
         ("noise/squeal", SquealPrediction, STREAM_QOS), ("noise/rolling", RollingNoise, STREAM_QOS),
-        ("/diagnostics", DiagnosticArray, DIAGNOSTICS_QOS))}
+        ("noise/measured", MeasuredPassNoise, STREAM_QOS), ("/diagnostics", DiagnosticArray, DIAGNOSTICS_QOS))}
     client = hostile.create_client(EvaluateSpeedDistribution, "evaluate_speed_distribution")
     assert wait_until(lambda: pubs["train_pass"].get_subscription_count() >= 5 and client.service_is_ready()
                       and all(p.get_subscription_count() >= 1 for p in pubs.values()), 20)
     first = _valid_passes(site, 3, T0)
     for i in range(3):
         pubs["train_pass"].publish(to_msg(TrainPass, train_pass_fields(first.row(i), "curve_250")))
-    assert wait_until(lambda: est.counts["counted"] == 3, 10)
+    assert wait_until(lambda: est.counts["counted"] == 3 and alerts.inputs["noise/rolling"] >= 6, 10)
 
     bad_clock = Clock()
     bad_clock.clock.sec = -5
@@ -158,6 +181,7 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
                         ("corrugation/state", states),
                         ("corrugation/state", states_raw),
                         ("noise/squeal", squeals), ("noise/rolling", noises),
+                        ("noise/measured", _hostile_measurements(first)),
                         ("/diagnostics", [_diagnostic("fake", 2000)])):
         for m in msgs:
             pubs[topic].publish(m)
@@ -202,13 +226,20 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     pure = CorrugationEstimator(site, corrugation_config(site_values))
     pure.advance(PassTable.concat([first, after]))
     np.testing.assert_array_equal(est.est.log_components, pure.log_components)
+    # the measurements: the good one paired once (a residual per model), each bad one refused by reason
+    want = {"pass measured twice", "a band level or single number is not finite", "a level is outside 0-150 dB",
+            "receiver (30 m, 1.2 m) is not the model's (7.5 m, 1.2 m)", "instrument class 9 is not 1 or 2",
+            "vehicle_id and vehicle_lpaeq_dba differ in length, or a vehicle level is not a level",
+            "no prediction for this pass (no such pass, or it was rejected)"}
+    assert wait_until(lambda: set(alerts.tracker.refused) == want, 20), alerts.tracker.refused
+    assert sum(alerts.tracker.refused.values()) == 7 and alerts.sent[f"{NS}/noise/residual"] == 2
     assert wait_until(lambda: recorder.counts.get(f"{NS}/noise/rolling", 0) >= 14, 20)
     recorder.close()
     recorded = read_messages(recorder.writer.folder, ["rail_msgs/msg/SquealPrediction", "rail_msgs/msg/RollingNoise"])
     ids = [m.train_id for m in recorded["rail_msgs/msg/SquealPrediction"]]  # the hostile ones are recorded too
     assert [i for i in ids if i.startswith("OK-")] == [*first.train_id.tolist(), *after.train_id.tolist()]
     tally("hostile messages", f"{n_bad} TrainPass, {len(surveys)} surveys, {len(states)} states, {len(squeals)} squeal "
-          f"and {len(noises)} noise messages, a /clock before 1970, a 2000-entry diagnostic and {len(requests)} "
-          "service requests into the running graph",
+          f"and {len(noises)} noise messages, 7 bad measured pass-bys, a /clock before 1970, a 2000-entry "
+          f"diagnostic and {len(requests)} service requests into the running graph",
           "no node stopped; each refused and counted by reason; no alert from them; state of the valid passes; "
           "the 4 valid passes after them fully predicted and recorded", 0)

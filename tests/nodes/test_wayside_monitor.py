@@ -11,6 +11,7 @@ import signal
 import subprocess
 import time
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -20,10 +21,11 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rosbags.highlevel import AnyReader
 
-from rail_monitor.alerts.config import KIND_SQUEAL
+from rail_monitor.alerts.config import KIND_SQUEAL, KIND_WHEEL_DEFECT
 from rail_monitor.app.batch import run_models
 from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.app.report import build_report, load_run
+from rail_monitor.app.simulated_measurements import simulate_measurements
 from rail_monitor.bagio.messages import time_ns
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_bag_passes, read_messages
@@ -33,6 +35,7 @@ from rail_monitor.corrugation.checkpoint import load, resume
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent
+from rail_monitor.measured.records import Measurement
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.layout import PROCESSES, SOURCE
 from rail_monitor.nodes.qos import LATEST_QOS, STREAM_QOS
@@ -69,6 +72,20 @@ def _values() -> dict:
 def _slice():
     t = read_bag_passes(SAMPLE).sorted()
     return t.take(t.stamp_ns <= t.stamp_ns[0] + int(DAYS * 86400e9))
+
+
+def _measurements(events) -> list[Measurement]:
+    """Simulated measurements of every accepted pass of the slice (4 defective vehicles among the
+    fleets), and four the graph must refuse: a NaN band, an absurd level, a pass measured twice,
+    and a pass that does not exist."""
+    first = run_models(_slice(), _values(), events=events)
+    p = first.noise["cnossos"]
+    good = simulate_measurements(first.accepted, p.lp_db, p.lpaeq_tp_dba, p.lpafmax_dba, p.tel_dba,
+                                 p.band_centre_hz, (7.5, 1.2), seed=3, fleet_per_class=15).measurements
+    nan_band = replace(good[10], leq_db=np.where(np.arange(len(p.band_centre_hz)) == 4, np.nan, good[10].leq_db))
+    absurd = replace(good[11], lpaeq_tp_dba=400.0)
+    unknown = replace(good[12], train_id="NO-SUCH-TRAIN")
+    return [*good[:10], nan_band, absurd, *good[12:], good[40], unknown]
 
 
 def _events() -> list[MaintenanceEvent]:
@@ -122,7 +139,8 @@ def _assert_equal_runs(live, batch) -> None:
 # set (republished per series of events, so its count depends on batching) and the advisory
 # (published on a wall-clock period live, once on the final state in batch).
 COMPARED = ("rail_msgs/msg/TrainPass", "rail_msgs/msg/SquealPrediction", "rail_msgs/msg/RollingNoise",
-            "rail_msgs/msg/CorrugationState", "rail_msgs/msg/WaysideAlert")
+            "rail_msgs/msg/CorrugationState", "rail_msgs/msg/WaysideAlert", "rail_msgs/msg/NoiseResidual",
+            "rail_msgs/msg/RoughnessSurvey", "rail_msgs/msg/MeasuredPassNoise")
 
 
 FORECAST_TIME_NS = 1_000_000  # a forecast time is float arithmetic over ~1e17 ns: equal within 1 ms
@@ -166,11 +184,12 @@ def runs(tmp_path_factory) -> dict:
     os.environ["ROS_DOMAIN_ID"] = str(GRAPH_DOMAIN)
     live = tmp / "live"
     site = _site_file(tmp)
-    history = write_passes_bag(_slice(), tmp / "history", "curve_250", events=_events())
+    measured = _measurements(_events())
+    history = write_passes_bag(_slice(), tmp / "history", "curve_250", events=_events(), measurements=measured)
     r = run_cmd("rail-monitor", "monitor", str(history), "--site", str(site), "--output", str(live),
                 "--end-offset-s", str(DAYS * 86400), "--report", str(tmp / "live_report"), "--no-progress", timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
-    result = run_models(_slice(), _values(), events=_events())
+    result = run_models(_slice(), _values(), events=_events(), measurements=measured)
     write_bag(result, tmp / "batch", "curve_250")
     return {"tmp": tmp, "site": site, "history": history, "stdout": r.stdout, "live": load_run(live),
             "batch": load_run(tmp / "batch"),
@@ -196,6 +215,12 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
     states = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/CorrugationState"])["rail_msgs/msg/CorrugationState"]
     assert [m.calibration_surveys for m in states][-1] == 2 and min(m.pass_count for m in states) == 1
     assert runs["result"].estimator.calibration_surveys == 3  # the survey after the last pass, at the end
+    # measured noise: every good measurement gives a residual per model; the four bad ones none
+    # (their reasons: tests/measured/test_residuals.py)
+    residuals = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/NoiseResidual"])["rail_msgs/msg/NoiseResidual"]
+    assert len(residuals) == 2 * (n - 2)
+    kinds = {(a.kind, a.active) for a in live.alerts}
+    assert (KIND_WHEEL_DEFECT, True) in kinds
 
 
 def test_report_folder_has_images_and_a_page(runs):

@@ -12,9 +12,11 @@ from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 
 # WaysideAlert.KIND_* and SEVERITY_* values.
-KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED = range(1, 6)
+(KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED, KIND_WHEEL_DEFECT,
+ KIND_NOISE_DRIFT) = range(1, 8)
 KIND_NAMES = {KIND_GRINDING_DUE: "grinding due", KIND_GRINDING_FORECAST: "grinding forecast",
-              KIND_NOISE_LIMIT: "noise limit", KIND_SQUEAL: "squeal", KIND_INPUT_REJECTED: "inputs rejected"}
+              KIND_NOISE_LIMIT: "noise limit", KIND_SQUEAL: "squeal", KIND_INPUT_REJECTED: "inputs rejected",
+              KIND_WHEEL_DEFECT: "wheel defect", KIND_NOISE_DRIFT: "noise drift"}
 SEVERITY_INFO, SEVERITY_WARNING, SEVERITY_CRITICAL = range(3)
 NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")  # RollingNoise single numbers
 RISK_NAMES = ("none", "low", "medium", "high")
@@ -49,6 +51,17 @@ ALERT_SPECS: tuple[ParamSpec, ...] = (
               1, 100_000),
     ParamSpec("rejected_raise_share", 0.05, "Share of rejected messages that raises the alert [-].", 0.0, 1.0),
     ParamSpec("rejected_clear_share", 0.0, "Share at or below which it clears [-].", 0.0, 1.0),
+    ParamSpec("residual_model", "cnossos", "Source model whose measured-minus-predicted residuals the wheel-defect "
+              "and drift alerts use.", choices=("cnossos", "mechanics")),
+    ParamSpec("wheel_defect_raise_db", 6.0, "A pass this far above the site's baseline residual at 500-2000 Hz "
+              "raises a wheel-defect alert for its loudest vehicle (or the train) [dB].", 0.5, 60.0),
+    ParamSpec("wheel_defect_clear_db", 3.0, "A later pass of that vehicle (or train) below this clears it [dB].",
+              0.0, 60.0),
+    ParamSpec("wheel_defect_vehicle_db", 2.0, "The loudest vehicle segment is named when this far above the "
+              "train's mean (else the train) [dB].", 0.0, 60.0),
+    ParamSpec("drift_raise_db", 3.0, "The baseline residual's rise since it was first full that raises the drift "
+              "alert [dB].", 0.1, 60.0),
+    ParamSpec("drift_clear_db", 1.5, "The rise below which it clears [dB].", 0.0, 60.0),
 )
 # Every alert parameter may be changed on a running alert_manager (ros2 param set): an operator
 # tunes limits and windows without a restart; the same checks refuse a bad value with the reason.
@@ -65,7 +78,9 @@ def alert_config(values: Mapping[str, Any], lead_time_days: float, prefix: str =
     out = resolve(ALERT_SPECS, section(values, prefix), where=prefix, strict=True)
     for name, raise_key, clear_key in (("noise", "noise_raise_count", "noise_clear_count"),
                                        ("squeal", "squeal_raise_share", "squeal_clear_share"),
-                                       ("rejected", "rejected_raise_share", "rejected_clear_share")):
+                                       ("rejected", "rejected_raise_share", "rejected_clear_share"),
+                                       ("wheel defect", "wheel_defect_raise_db", "wheel_defect_clear_db"),
+                                       ("drift", "drift_raise_db", "drift_clear_db")):
         if out[clear_key] >= out[raise_key]:
             raise ConfigError(f"parameter '{prefix}{clear_key}' must be below '{prefix}{raise_key}' "
                               f"(the {name} alert needs hysteresis)")

@@ -5,7 +5,8 @@ The rules are in :mod:`rail_monitor.alerts`; thresholds in :mod:`rail_monitor.al
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections import Counter
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -16,8 +17,10 @@ from rail_monitor.alerts.config import (
     KIND_GRINDING_FORECAST,
     KIND_INPUT_REJECTED,
     KIND_NAMES,
+    KIND_NOISE_DRIFT,
     KIND_NOISE_LIMIT,
     KIND_SQUEAL,
+    KIND_WHEEL_DEFECT,
     SEVERITY_CRITICAL,
     SEVERITY_INFO,
     SEVERITY_WARNING,
@@ -57,6 +60,7 @@ class AlertManager:
         self._squeal = Window(cfg.squeal_window_passes)
         self._rejected = Window(cfg.rejected_window_passes)
         self._keys: dict[bytes, list[str]] = {}
+        self.offences: Counter[str] = Counter()  # passes flagged per wheel-defect key (repeat offenders)
 
     def retune(self, cfg: AlertConfig) -> None:
         """Take new limits and windows (a running node's parameters changed): each window keeps its
@@ -231,6 +235,47 @@ class AlertManager:
         """TrainPass messages in order, rejected or not."""
         return self._share(self._rejected, np.asarray(rejected, bool), KIND_INPUT_REJECTED, "train_pass",
                            np.asarray(stamp_ns), "rejected", "train passes rejected", full_window=False)
+
+    def on_residuals(self, residuals: Sequence[Any]) -> list[Alert]:
+        """NoiseResiduals in order (those of ``residual_model``; others are passed over): a wheel
+        defect suspect per vehicle (or train) with hysteresis, and the drift of the baseline."""
+        cfg, events = self.cfg, []
+        for r in residuals:
+            if r.model != cfg.residual_model:
+                continue
+            score = wheel_defect_score(r, cfg.wheel_defect_vehicle_db)
+            named = r.loudest_vehicle_id and r.loudest_vehicle_excess_db >= cfg.wheel_defect_vehicle_db
+            key = f"vehicle {r.loudest_vehicle_id}" if named else f"train {r.train_id}"
+            if score >= cfg.wheel_defect_raise_db:
+                self.offences[key] += 1
+                events.append(self._set(
+                    True, KIND_WHEEL_DEFECT, key, r.stamp_ns, SEVERITY_WARNING,
+                    f"wheel defect suspect: {key} (train {r.train_id}) {score:+.1f} dB over the site's baseline "
+                    f"at 500-2000 Hz or its train's mean, flagged {self.offences[key]} time(s)", score,
+                    cfg.wheel_defect_raise_db, "dB"))
+            elif score < cfg.wheel_defect_clear_db:
+                for k in [f"train {r.train_id}", *(f"vehicle {v}" for v in r.vehicle_id)]:
+                    if (KIND_WHEEL_DEFECT, k) in self.standing:
+                        events.append(self._set(False, KIND_WHEEL_DEFECT, k, r.stamp_ns, SEVERITY_INFO,
+                                                f"wheel defect suspect: {k} cleared ({score:+.1f} dB)", score,
+                                                cfg.wheel_defect_clear_db, "dB"))
+            if r.drift_db >= cfg.drift_raise_db or r.drift_db < cfg.drift_clear_db:
+                up = r.drift_db >= cfg.drift_raise_db
+                events.append(self._set(
+                    up, KIND_NOISE_DRIFT, r.model, r.stamp_ns, SEVERITY_WARNING if up else SEVERITY_INFO,
+                    f"{r.model} residual at 500-2000 Hz {r.drift_db:+.1f} dB since its baseline filled: the rail "
+                    f"roughens faster than the model says" if up else f"{r.model} residual drift cleared",
+                    r.drift_db, cfg.drift_raise_db if up else cfg.drift_clear_db, "dB"))
+        return [e for e in events if e]
+
+
+def wheel_defect_score(r: Any, vehicle_db: float) -> float:
+    """A residual's wheel-defect score [dB]: its 500-2000 Hz excess over the site's baseline, or
+    its loudest vehicle's excess over the train's mean where that names a vehicle (at least
+    vehicle_db), whichever is larger (NaN without a baseline or a named vehicle)."""
+    vehicle = r.loudest_vehicle_excess_db if r.loudest_vehicle_id and r.loudest_vehicle_excess_db >= vehicle_db \
+        else float("nan")
+    return float(np.fmax(r.excess_mid_db, vehicle))
 
 
 def describe(alert: Alert) -> str:

@@ -11,6 +11,7 @@ with the same outputs; :mod:`rail_monitor.app.batch_bag` records them as the liv
 
 from __future__ import annotations
 
+import bisect
 import os
 from collections import Counter
 from collections.abc import Mapping, Sequence
@@ -35,6 +36,9 @@ from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.forecast import Threads
 from rail_monitor.corrugation.records import StateSnapshot, Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent, apply_event, in_time_order, split_before
+from rail_monitor.measured.config import residual_config
+from rail_monitor.measured.records import Measurement
+from rail_monitor.measured.residuals import Residual, ResidualTracker, predictions_of
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
 from rail_monitor.noise.state_of_pass import state_index
@@ -64,6 +68,8 @@ class BatchResult:
     receiver: Any
     left_out: dict[str, int]          # passes the replayer would not send, by reason
     events: list[MaintenanceEvent] = field(default_factory=list)  # surveys and grinding taken, applied or not
+    measurements: list[Measurement] = field(default_factory=list)  # measured pass-bys taken, paired or not
+    residuals: list[Residual] = field(default_factory=list)        # measured minus predicted, in stamp order
 
     @classmethod
     def merged(cls, parts: Sequence[BatchResult], held: list[Alert], advice: SpeedAdvice | None) -> BatchResult:
@@ -78,7 +84,8 @@ class BatchResult:
                    Trajectory.concat(list(zip(starts, [p.trajectory for p in parts], strict=True))),
                    {m: NoisePrediction.concat([p.noise[m] for p in parts]) for m in last.noise},
                    [a for p in parts for a in p.alerts] + held, last.standing, advice, last.estimator, last.receiver,
-                   dict(left_out), [e for p in parts for e in p.events])
+                   dict(left_out), [e for p in parts for e in p.events], [m for p in parts for m in p.measurements],
+                   [r for p in parts for r in p.residuals])
 
 
 @dataclass
@@ -117,11 +124,14 @@ class BatchRun:
     events: the history's surveys and grinding events (MaintenanceEvent), each applied before the
     first pass stamped later than it, as the estimator node applies them when a replay sends them
     so; those after the last pass at finish(). One the node would refuse is counted in
-    ``events_refused`` by reason and changes nothing.
+    ``events_refused`` by reason and changes nothing. measurements: measured pass-bys
+    (rail_monitor.measured), paired with their passes' predictions and scored as the residual node
+    does (``tracker.refused`` counts the refused); their residuals feed the alerts.
     """
 
     def __init__(self, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
-                 threads: int = 0, events: Sequence[MaintenanceEvent] = ()) -> None:
+                 threads: int = 0, events: Sequence[MaintenanceEvent] = (),
+                 measurements: Sequence[Measurement] = ()) -> None:
         self.values = values
         self.site = site_from_values(values)
         self.margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
@@ -138,6 +148,11 @@ class BatchRun:
         self._pending = in_time_order(events)            # surveys and grinding not yet applied
         self.events_refused: Counter[str] = Counter()
         self.trailing_events: list[MaintenanceEvent] = []
+        self.trailing_measurements: list[Measurement] = []
+        self._measurements = sorted(measurements, key=lambda m: m.key)  # not yet taken, by pass
+        receiver = self.model.receiver
+        self.tracker = ResidualTracker(residual_config(values), self.model.band_hz,
+                                       (receiver.distance_m, receiver.height_m), self.model.models)
 
     def feed(self, passes: PassTable) -> BatchResult:
         """The outputs of the next chunk of the history, with the events due within it applied (the
@@ -190,13 +205,27 @@ class BatchRun:
             noise = _noise_on_states(pool, self.model, accepted, states.amplitude, traj.constants, on)
             squeal = squeal_job.result()
         self._tail = states.last_stamp()
+        measured, residuals = self._measured(table, accepted, noise)
+        self.alerts.on_residuals(residuals)
         events = sorted(self._held + _feed_alerts(self.alerts, table, reasons, accepted, squeal, traj, noise),
                         key=_alert_key)
         later = int(table.stamp_ns[-1]) if len(table) else np.iinfo(np.int64).min
         self._held = [a for a in events if a.stamp_ns >= later]  # may tie with the next chunk's first pass
         return BatchResult(self.site, table, reasons, accepted, squeal, traj, noise,
                            [a for a in events if a.stamp_ns < later], self.standing(), None, self.estimator,
-                           self.model.receiver, dict(left_out))
+                           self.model.receiver, dict(left_out), [], measured, residuals)
+
+    def _measured(self, table: PassTable, accepted: PassTable, noise: dict[str, NoisePrediction]
+                  ) -> tuple[list[Measurement], list[Residual]]:
+        """The measurements of this chunk's passes (stamped up to its last), paired with the
+        predictions as the residual node pairs them."""
+        if not (self._measurements or self.tracker.queue):
+            return [], []
+        last = int(table.stamp_ns.max()) if len(table) else np.iinfo(np.int64).min
+        n = bisect.bisect_right([m.stamp_ns for m in self._measurements], last)
+        taken, self._measurements = self._measurements[:n], self._measurements[n:]
+        out = [r for m in taken for r in self.tracker.add_measurement(m)]
+        return taken, out + self.tracker.add_predictions(predictions_of(accepted, noise))
 
     def standing(self) -> list[Alert]:
         return sorted(self.alerts.standing.values(), key=_alert_key)
@@ -206,19 +235,24 @@ class BatchRun:
         the surveys and grinding later than every pass, kept in ``trailing_events``)."""
         self.trailing_events = [self._apply(e) for e in self._pending]
         self._pending = []
+        self.trailing_measurements, self._measurements = self._measurements, []
+        for m in self.trailing_measurements:
+            self.tracker.add_measurement(m)
+        self.tracker.finish()
         held, self._held = self._held, []
         return held, advise_or_none(self.estimator, Consequences(self.site, self.model, squeal_config(self.values)))
 
 
 def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
-               threads: int = 0, events: Sequence[MaintenanceEvent] = ()) -> BatchResult:
+               threads: int = 0, events: Sequence[MaintenanceEvent] = (),
+               measurements: Sequence[Measurement] = ()) -> BatchResult:
     """Every model over the history ``passes`` for the site of the flat parameter ``values`` in one
-    call (estimator, threads, events: as for BatchRun)."""
-    run = BatchRun(values, estimator, threads, events)
+    call (estimator, threads, events, measurements: as for BatchRun)."""
+    run = BatchRun(values, estimator, threads, events, measurements)
     out = run.feed(passes)
     held, advice = run.finish()
     return replace(out, alerts=out.alerts + held, advice=advice, left_out=dict(run.left_out),
-                   events=out.events + run.trailing_events)
+                   events=out.events + run.trailing_events, measurements=out.measurements + run.trailing_measurements)
 
 
 def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:

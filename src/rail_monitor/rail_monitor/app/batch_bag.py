@@ -17,11 +17,13 @@ from rail_monitor.bagio import messages as fields
 from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
-from rail_monitor.bagio.topics import EVENT_TOPICS, GRAPH_TOPICS
+from rail_monitor.bagio.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
 from rail_monitor.core.errors import PassOrderError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.text import printable
 from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.measured.records import Measurement
+from rail_monitor.measured.residuals import Residual
 
 
 class BatchBag:
@@ -46,16 +48,24 @@ class BatchBag:
         self.bag.close()
 
     def _put(self, name: str, msg: dict[str, Any], stamp_ns: int) -> None:
-        typename = GRAPH_TOPICS[name][0] if name in GRAPH_TOPICS else EVENT_TOPICS[name][0]
-        self.bag.write(f"{self.ns}/{name}", serialize(typename, msg), stamp_ns)
+        if name in GRAPH_TOPICS:
+            typename = GRAPH_TOPICS[name][0]
+        else:  # declared with its first message, as the recorder records it once it is published
+            typename, qos = OPTIONAL_TOPICS[name]
+            self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
+        self.bag.write(f"{self.ns}/{name}", serialize(typename, msg), max(stamp_ns, 0))
 
     def events(self, events: list[MaintenanceEvent]) -> None:
-        """Surveys and grinding events given to the run, on the topic the replayer sends them on
-        (declared with the first, as the recorder records it once it is published)."""
+        """Surveys and grinding events given to the run, on the topic the replayer sends them on."""
         for event in events:
-            typename, qos = EVENT_TOPICS["roughness_survey"]
-            self.bag.add_topic(f"{self.ns}/roughness_survey", typename, [qos.as_metadata()])
-            self._put("roughness_survey", fields.roughness_survey_fields(event, self.frame), max(event.stamp_ns, 0))
+            self._put("roughness_survey", fields.roughness_survey_fields(event, self.frame), event.stamp_ns)
+
+    def measured(self, measurements: list[Measurement], residuals: list[Residual]) -> None:
+        """Measurements given to the run (as the replayer sends them) and the residuals computed."""
+        for m in measurements:
+            self._put("noise/measured", fields.measured_pass_noise_fields(m, self.frame), m.stamp_ns)
+        for r in residuals:
+            self._put("noise/residual", fields.noise_residual_fields(r, self.frame), r.stamp_ns)
 
     def add(self, result: BatchResult) -> None:
         """One chunk's passes and outputs, and its settled alert events."""
@@ -77,6 +87,7 @@ class BatchBag:
                           int(result.accepted.stamp_ns[i]))
         self._alerts(result.alerts)
         self.events(result.events)
+        self.measured(result.measurements, result.residuals)
 
     def _alerts(self, events: list[Alert]) -> None:
         for a in events:
@@ -118,13 +129,17 @@ class Recorded:
     notes: list[str] = field(default_factory=list)
     events: int = 0                                               # surveys and grinding events read
     events_refused: dict[str, int] = field(default_factory=dict)  # of those, refused by reason
+    measurements: int = 0                                         # measured pass-bys read
+    measurements_refused: dict[str, int] = field(default_factory=dict)
 
 
 def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: str | Path, namespace: str,
-               site: dict[str, str] | None = None, events: Sequence[MaintenanceEvent] = ()) -> Recorded:
+               site: dict[str, str] | None = None, events: Sequence[MaintenanceEvent] = (),
+               measurements: Sequence[Measurement] = ()) -> Recorded:
     """BatchRun over an iterable of PassTable chunks in time order (and the history's surveys and
-    grinding events), each recorded as it is done (memory: one chunk's outputs)."""
-    run = BatchRun(values, events=events)
+    grinding events, and its measured pass-bys), each recorded as it is done (memory: one chunk's
+    outputs)."""
+    run = BatchRun(values, events=events, measurements=measurements)
     out = Recorded()
     with BatchBag(folder, namespace, run.site.site_id, site=site) as bag:
         for chunk in chunks:
@@ -137,10 +152,12 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
                 out.days_to_threshold = float(result.trajectory.forecast.days_to_threshold[-1])
         held, advice = run.finish()
         bag.events(run.trailing_events)
+        bag.measured(run.trailing_measurements, [])
         bag.finish(held, advice, run.estimator.newest_ns)
     out.alert_events += len(held)
     out.left_out = dict(run.left_out)
     out.events, out.events_refused = len(events), dict(run.events_refused)
+    out.measurements, out.measurements_refused = len(measurements), dict(run.tracker.refused)
     return out
 
 
@@ -150,14 +167,14 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
     """The batch run of a history file recorded to a new bag folder. A bag is read and recorded chunk
     by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
     time order is read whole and sorted. A run that fails leaves no output behind."""
-    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_events
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_events, read_bag_measurements
 
     existed = folder.exists()
     try:
         if not (salvage or is_csv(Path(source))):
             try:
                 return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site,
-                                  read_bag_events(source))
+                                  read_bag_events(source), read_bag_measurements(source))
             except PassOrderError as exc:
                 note = f"{printable(str(source))}: {exc}; read whole to sort it"
                 _discard(folder, existed)
@@ -172,16 +189,18 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
 
 def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
            site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool) -> Recorded:
-    from rail_monitor.bagio.reader import read_bag_events, read_passes
+    from rail_monitor.bagio.reader import read_bag_events, read_bag_measurements, read_passes
 
     passes = read_passes(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
     events = [] if salvage else read_bag_events(source)  # a salvage recovers passes only
-    notes = [printable(passes.salvage.line(source)), "surveys and grinding events are not salvaged"] if salvage else []
+    measured = [] if salvage else read_bag_measurements(source)
+    notes = [printable(passes.salvage.line(source)), "surveys, grinding and measured noise are not salvaged"] \
+        if salvage else []
     skipped = getattr(passes, "skipped_rows", [])
     if skipped:
         notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "
                      + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
-    rec = run_to_bag([passes], values, folder, namespace, site, events)
+    rec = run_to_bag([passes], values, folder, namespace, site, events, measured)
     rec.notes = notes
     return rec
 

@@ -11,6 +11,7 @@ rosbags' deserialised objects alike (the two have the same attribute names).
 
 from __future__ import annotations
 
+from dataclasses import fields as dataclass_fields
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -20,6 +21,8 @@ from rail_monitor.alerts.manager import Alert
 from rail_monitor.core.timeutil import TIME_MSG_END_NS, fits_time_msg, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot
 from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.measured.records import Measurement
+from rail_monitor.measured.residuals import Predicted, Residual
 from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.predict import Corrugation, NoisePrediction
 from rail_monitor.squeal.config import RISK_HIGH
@@ -144,7 +147,47 @@ def roughness_survey_fields(event: MaintenanceEvent, frame_id: str) -> Fields:
             "amplitude_m": np.asarray(event.amplitude_m, float).tolist()}
 
 
+def measured_pass_noise_fields(m: Measurement, frame_id: str) -> Fields:
+    return {"header": header_fields(m.stamp_ns, frame_id), "train_id": m.train_id,
+            "receiver_distance_m": m.receiver_distance_m, "receiver_height_m": m.receiver_height_m,
+            "instrument_class": m.instrument_class, "band_centre_hz": np.asarray(m.band_centre_hz, float).tolist(),
+            "leq_db": np.asarray(m.leq_db, float).tolist(), "lpaeq_tp_dba": m.lpaeq_tp_dba,
+            "lpafmax_dba": m.lpafmax_dba, "tel_dba": m.tel_dba, "squeal_detected": m.squeal_detected,
+            "vehicle_id": list(m.vehicle_id), "vehicle_lpaeq_dba": np.asarray(m.vehicle_lpaeq_dba, float).tolist()}
+
+
+def noise_residual_fields(r: Residual, frame_id: str) -> Fields:
+    out = {f.name: getattr(r, f.name) for f in dataclass_fields(r) if f.name != "stamp_ns"}
+    out.update(header=header_fields(r.stamp_ns, frame_id), band_centre_hz=r.band_centre_hz.tolist(),
+               residual_db=r.residual_db.tolist(), vehicle_id=list(r.vehicle_id))
+    return out
+
+
 # -- back to records ------------------------------------------------------------------------------
+def measurement_from_msg(msg: Any) -> Measurement:
+    """A MeasuredPassNoise as a Measurement (its checks are measurement_refusal's)."""
+    return Measurement(time_ns(msg.header.stamp), str(msg.train_id), float(msg.receiver_distance_m),
+                       float(msg.receiver_height_m), int(msg.instrument_class), np.array(msg.band_centre_hz, float),
+                       np.array(msg.leq_db, float), float(msg.lpaeq_tp_dba), float(msg.lpafmax_dba),
+                       float(msg.tel_dba), bool(msg.squeal_detected), tuple(str(v) for v in msg.vehicle_id),
+                       np.array(msg.vehicle_lpaeq_dba, float))
+
+
+def predicted_from_msg(msg: Any) -> Predicted:
+    """A RollingNoise as the prediction a measurement is paired with."""
+    return Predicted(time_ns(msg.header.stamp), str(msg.train_id), str(msg.model), np.array(msg.lp_db, float),
+                     float(msg.lpaeq_tp_dba), float(msg.lpafmax_dba), float(msg.tel_dba))
+
+
+def residual_from_msg(msg: Any) -> Residual:
+    """A NoiseResidual as a Residual."""
+    names = [f.name for f in dataclass_fields(Residual) if f.name != "stamp_ns"]
+    values = {n: getattr(msg, n) for n in names}
+    values.update(band_centre_hz=np.array(msg.band_centre_hz, float), residual_db=np.array(msg.residual_db, float),
+                  vehicle_id=tuple(msg.vehicle_id))
+    return Residual(stamp_ns=time_ns(msg.header.stamp), **values)
+
+
 def event_from_msg(msg: Any) -> MaintenanceEvent:
     """A RoughnessSurvey as a MaintenanceEvent (its checks are apply_event's)."""
     return MaintenanceEvent(time_ns(msg.header.stamp), int(msg.kind), np.array(msg.wavelength_m, float),

@@ -15,11 +15,12 @@ from typing import Any
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.integrity import Claims, ScannedMessage, check_bag, scan_mcap
-from rail_monitor.bagio.messages import event_from_msg, pass_row
-from rail_monitor.bagio.typestore import ROUGHNESS_SURVEY, TRAIN_PASS, typestore
+from rail_monitor.bagio.messages import event_from_msg, measurement_from_msg, pass_row
+from rail_monitor.bagio.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS, typestore
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
+from rail_monitor.measured.records import Measurement
 
 
 def _one_line(exc: BaseException) -> str:
@@ -187,6 +188,15 @@ def read_bag_events(path: str | Path) -> list[MaintenanceEvent]:
         return []
     msgs = read_messages(path, [ROUGHNESS_SURVEY])[ROUGHNESS_SURVEY]
     return in_time_order([event_from_msg(m) for m in msgs])
+
+
+def read_bag_measurements(path: str | Path) -> list[Measurement]:
+    """The measured pass-bys (rail_msgs/MeasuredPassNoise, any topic) of a bag, by pass; none for
+    a CSV history."""
+    if is_csv(Path(path)):
+        return []
+    msgs = read_messages(path, [MEASURED_PASS_NOISE])[MEASURED_PASS_NOISE]
+    return sorted((measurement_from_msg(m) for m in msgs), key=lambda m: m.key)
 
 
 def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,

@@ -73,5 +73,9 @@ GRAPH_TOPICS: dict[str, tuple[str, Qos]] = {
     "noise/rolling": ("rail_msgs/msg/RollingNoise", STREAM), "alerts": ("rail_msgs/msg/WaysideAlert", ALERT),
     "alerts/standing": ("rail_msgs/msg/WaysideAlertArray", LATEST),
     "speed_advisory": ("rail_msgs/msg/SpeedAdvisory", LATEST)}
-# Inputs recorded beside the passes when there are any (a replay's or batch's surveys and grinding).
-EVENT_TOPICS: dict[str, tuple[str, Qos]] = {"roughness_survey": ("rail_msgs/msg/RoughnessSurvey", EVENT)}
+# Topics recorded only when they carry something: a replay's or batch's surveys and grinding,
+# measured pass-by noise, and the residuals computed from it.
+OPTIONAL_TOPICS: dict[str, tuple[str, Qos]] = {
+    "roughness_survey": ("rail_msgs/msg/RoughnessSurvey", EVENT),
+    "noise/measured": ("rail_msgs/msg/MeasuredPassNoise", STREAM),
+    "noise/residual": ("rail_msgs/msg/NoiseResidual", STREAM)}

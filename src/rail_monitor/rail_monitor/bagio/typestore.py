@@ -22,6 +22,7 @@ SEPARATOR = "=" * 80
 TRAIN_PASS = "rail_msgs/msg/TrainPass"
 CORRUGATION_STATE = "rail_msgs/msg/CorrugationState"
 ROUGHNESS_SURVEY = "rail_msgs/msg/RoughnessSurvey"
+MEASURED_PASS_NOISE = "rail_msgs/msg/MeasuredPassNoise"
 
 
 def _share_dir(package: str) -> Path:

@@ -72,6 +72,11 @@ def run(ns: argparse.Namespace) -> int:
               f"{sum(rec.events_refused.values())} refused")
     for why, count in rec.events_refused.items():
         print(f"batch: {count} survey or grinding event(s) refused: {why}")
+    if rec.measurements:
+        print(f"batch: {rec.measurements} measured pass-by(s) paired with their predictions, "
+              f"{sum(rec.measurements_refused.values())} refused")
+    for why, count in rec.measurements_refused.items():
+        print(f"batch: {count} measured pass-by(s) refused: {why}")
     t = time.monotonic() - t0
     print(f"batch: {rec.passes} passes through the models and recorded to {out} in {t:.2f} s "
           f"({rec.passes / max(t, 1e-9):.0f} passes/s)")

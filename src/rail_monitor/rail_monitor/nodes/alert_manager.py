@@ -1,7 +1,10 @@
 """alert_manager: raises and clears the site's WaysideAlerts from the model outputs.
 
-Subscribes ``train_pass`` (rejected inputs), ``noise/squeal``, ``noise/rolling`` and
-``corrugation/state`` (every state, in order); publishes each raise and clear on ``alerts``
+Subscribes ``train_pass`` (rejected inputs), ``noise/squeal``, ``noise/rolling``,
+``corrugation/state`` (every state, in order) and ``noise/measured`` (rail_msgs/MeasuredPassNoise:
+each measurement is paired with its pass's predictions, which this node takes anyway, and its
+residuals are published on ``noise/residual``, rail_msgs/NoiseResidual, and raise the wheel-defect
+and drift alerts; rail_monitor.measured); publishes each raise and clear on ``alerts``
 (rail_msgs/WaysideAlert; reliable, transient local, depth 1000) and the standing set on
 ``alerts/standing`` (rail_msgs/WaysideAlertArray; latched), so a late subscriber sees the
 standing alerts at once. Thresholds and hysteresis: ``alerts.*``
@@ -25,7 +28,10 @@ from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, S
 from rail_monitor.alerts.manager import Alert, AlertManager, describe
 from rail_monitor.bagio.messages import (
     corrugation_series,
+    measurement_from_msg,
     noise_refusal,
+    noise_residual_fields,
+    predicted_from_msg,
     squeal_refusal,
     stamps_ns,
     state_refusal,
@@ -36,17 +42,29 @@ from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import LEAD_TIME
-from rail_monitor.nodes.base import Sent, declare, read_views, runs, subscribe_batched, wall_timer
+from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
+from rail_monitor.measured.residuals import Residual, ResidualTracker
+from rail_monitor.nodes.base import Sent, declare, read_views, runs, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
-from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_SUB_QOS
-from rail_msgs.msg import CorrugationState, RollingNoise, SquealPrediction, WaysideAlert, WaysideAlertArray
+from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.noise.config import PREDICTED_SPECS, band_centres_hz, selected_models
+from rail_msgs.msg import (
+    CorrugationState,
+    MeasuredPassNoise,
+    NoiseResidual,
+    RollingNoise,
+    SquealPrediction,
+    WaysideAlert,
+    WaysideAlertArray,
+)
 
 
 class AlertManagerNode(PassConsumerNode):
     EXECUTABLE = "alert_manager"
-    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("corrugation.", (LEAD_TIME,)), ("alerts.", ALERT_SPECS))
+    PARAMETERS = (*PassConsumerNode.PARAMETERS, ("corrugation.", (LEAD_TIME,)), ("alerts.", ALERT_SPECS),
+                  ("residual.", RESIDUAL_SPECS), ("noise.", PREDICTED_SPECS))
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("alert_manager", **kwargs)
@@ -57,6 +75,13 @@ class AlertManagerNode(PassConsumerNode):
         self.sent = Sent()
         self.pub = self.create_publisher(WaysideAlert, "alerts", ALERT_QOS)
         self.standing_pub = self.create_publisher(WaysideAlertArray, "alerts/standing", LATEST_QOS)
+        noise = declare(self, PREDICTED_SPECS, prefix="noise.")
+        self.tracker = ResidualTracker(residual_config(declare(self, RESIDUAL_SPECS, prefix="residual."), prefix=""),
+                                       band_centres_hz(), (noise["receiver_distance_m"], noise["receiver_height_m"]),
+                                       selected_models(noise["model"]))
+        self.residual_pub = self.create_publisher(NoiseResidual, "noise/residual", STREAM_QOS)
+        self.measured_sub = subscribe_batched(self, MeasuredPassNoise, "noise/measured", self._on_measured,
+                                              STREAM_SUB_QOS, self.max_batch)
         # Each stream in its own order (streams do not interact): what is queued is taken at once and
         # fed as one series; alerts/standing (latched, latest only) is published once per series.
         for msg_type, topic, handle, qos in ((SquealPrediction, "noise/squeal", self._on_squeal, STREAM_SUB_QOS),
@@ -110,6 +135,26 @@ class AlertManagerNode(PassConsumerNode):
             events += self.alerts.on_noise(stamps_ns(mine), model, {
                 k: np.array([getattr(m, k) for m in mine]) for k in NOISE_METRICS})
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
+        # Measurements sent before these passes are queued by now (a replay sends each before the
+        # next pass, acknowledged): take them first, so they are scored in stamp order.
+        queued = take_queued(self.measured_sub, self.max_batch)
+        if queued:
+            self._on_measured(queued)
+        self._residuals(self.tracker.add_predictions([predicted_from_msg(m) for m in msgs]))
+
+    def _on_measured(self, msgs: list[MeasuredPassNoise]) -> None:
+        self.inputs["noise/measured"] += len(msgs)
+        before = sum(self.tracker.refused.values())
+        self._residuals([r for m in msgs for r in self.tracker.add_measurement(measurement_from_msg(m))])
+        if sum(self.tracker.refused.values()) > before:
+            self.get_logger().warning(f"noise/measured refused: {dict(self.tracker.refused)}",
+                                      throttle_duration_sec=self.log_throttle_s)
+
+    def _residuals(self, residuals: list[Residual]) -> None:
+        for r in residuals:
+            self.sent.publish(self.residual_pub, to_msg(NoiseResidual, noise_residual_fields(r, self.site.site_id)))
+        if residuals:
+            self._emit(self.alerts.on_residuals(residuals))
 
     def _on_states(self, raws: list[bytes]) -> None:
         views = read_views(CORRUGATION_STATE, raws, lambda exc: self._unreadable_on("corrugation/state", exc))
@@ -155,7 +200,9 @@ class AlertManagerNode(PassConsumerNode):
         events = self.alerts.events
         return {**super().diagnostic_values(), **{f"taken {k}": n for k, n in sorted(self.inputs.items())},
                 "standing": len(self.alerts.standing), "raised": sum(e.active for e in events),
-                "cleared": sum(not e.active for e in events),
+                "cleared": sum(not e.active for e in events), "residuals": self.sent[self.residual_pub.topic_name],
+                "measurements scored late": self.tracker.late,
+                **{f"noise/measured refused: {why}": n for why, n in sorted(self.tracker.refused.items())},
                 **{f"standing {KIND_NAMES[k]}": n for k, n in
                    sorted(Counter(kind for kind, _ in self.alerts.standing).items())}}
 

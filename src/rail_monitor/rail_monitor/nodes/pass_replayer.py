@@ -1,7 +1,8 @@
 """pass_replayer: replay TrainPass history from a rosbag2 bag (MCAP or sqlite3) or a CSV file.
 
 Publishes ``train_pass`` (rail_msgs/TrainPass), the bag's roughness surveys and grinding events
-on ``roughness_survey`` (each just before the first pass stamped later than it), and ``/clock``;
+on ``roughness_survey`` (each just before the first pass stamped later than it), its measured
+pass-bys on ``noise/measured`` (each after its pass), and ``/clock``;
 exits 0 when done. See
 rail_monitor.core.node_params.PUBLISH_SPECS for timing, offsets and flow control.
 """
@@ -10,12 +11,13 @@ from __future__ import annotations
 
 import sys
 
-from rail_monitor.bagio.reader import read_bag_events, read_passes
+from rail_monitor.bagio.reader import read_bag_events, read_bag_measurements, read_passes
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import REPLAYER_SPECS, ReplayerParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.measured.records import Measurement
 from rail_monitor.nodes.base import declare
 from rail_monitor.nodes.pass_source import PassSourceNode
 from rail_monitor.nodes.process import run_node
@@ -35,6 +37,9 @@ class PassReplayer(PassSourceNode):
         self._events = [] if self.src.salvage else read_bag_events(self.src.source)  # a salvage: passes only
         if self._events:
             self.advertise_events()
+        self._measured = [] if self.src.salvage else read_bag_measurements(self.src.source)
+        if self._measured:
+            self.advertise_measurements()
 
     def _load(self) -> PassTable:
         table = read_passes(self.src.source, self.src.source_topic or None, self.src.skip_bad_rows,
@@ -51,6 +56,9 @@ class PassReplayer(PassSourceNode):
 
     def events(self) -> list[MaintenanceEvent]:
         return self._events
+
+    def measurements(self) -> list[Measurement]:
+        return self._measured
 
 
 def main(args: list[str] | None = None) -> int:

@@ -16,17 +16,18 @@ from rclpy.duration import Duration
 from rosgraph_msgs.msg import Clock
 from tqdm import tqdm
 
-from rail_monitor.bagio.messages import roughness_survey_fields, train_pass_fields
+from rail_monitor.bagio.messages import measured_pass_noise_fields, roughness_survey_fields, train_pass_fields
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import PUBLISH_SPECS, STAMP_SPECS, PublishParams, StampParams
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, publishable
 from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.measured.records import Measurement
 from rail_monitor.nodes.base import DIAGNOSTICS_PERIOD_S, Diagnostics, RailNode, RateMeter, announce, declare
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STREAM_QOS
-from rail_msgs.msg import RoughnessSurvey, TrainPass
+from rail_msgs.msg import MeasuredPassNoise, RoughnessSurvey, TrainPass
 
 GRAPH_SETTLE_S = 1.0  # the graph's endpoints unchanged this long [s]: every node has subscribed
 
@@ -53,11 +54,14 @@ class PassSourceNode(RailNode):
         self.left_out: dict[str, int] = {}
         self.event_pub = None  # roughness_survey, made when the history has surveys or grinding
         self.events_sent = 0
+        self.measured_pub = None  # noise/measured, made when the history has measured pass-bys
+        self.measurements_sent = 0
         self._bounds = (0, 0)  # stamps of the replay window [ns]
         self._status: dict[str, dict[str, str]] = {}  # latest /diagnostics values, by status name
         self.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, DIAGNOSTICS_QOS)
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
                                    "left out": sum(self.left_out.values()), "surveys sent": self.events_sent,
+                                   "measurements sent": self.measurements_sent,
                                    **{f"left out: {why}": n for why, n in self.left_out.items()},
                                    "rate_per_s": f"{self.meter.rate():.1f}",
                                    "pass_time_ns": self.last_stamp_ns, "done": self.done.is_set()})
@@ -68,6 +72,10 @@ class PassSourceNode(RailNode):
 
     def events(self) -> list[MaintenanceEvent]:
         """The surveys and grinding events of the history, in stamp order (none by default)."""
+        return []
+
+    def measurements(self) -> list[Measurement]:
+        """The measured pass-bys of the history, in stamp order (none by default)."""
         return []
 
     def _window(self, table: PassTable) -> PassTable:
@@ -90,16 +98,34 @@ class PassSourceNode(RailNode):
         if self.event_pub is None:
             self.event_pub = self.create_publisher(RoughnessSurvey, "roughness_survey", EVENT_QOS)
 
+    def advertise_measurements(self) -> None:
+        """Create the noise/measured publisher (as advertise_events)."""
+        if self.measured_pub is None:
+            self.measured_pub = self.create_publisher(MeasuredPassNoise, "noise/measured", STREAM_QOS)
+
     def _send_event(self, event: MaintenanceEvent, ok: Callable[[], bool]) -> None:
         """Publish a survey or grinding event. In other processes, wait until every subscriber holds
         it before the next pass goes out (the estimator takes queued surveys before passes); in
         this one, DDS has delivered it to the hosted subscribers when publish returns."""
         self.event_pub.publish(to_msg(RoughnessSurvey, roughness_survey_fields(event, self.cfg.site_id)))
         self.events_sent += 1
+        self._acknowledged(self.event_pub, ok)
+
+    def _send_measurement(self, m: Measurement, ok: Callable[[], bool]) -> None:
+        """Publish a measured pass-by, held by every subscriber before the next pass goes out (the
+        alert manager scores measurements in stamp order as long as each comes before any later
+        pass's predictions)."""
+        self.measured_pub.publish(to_msg(MeasuredPassNoise, measured_pass_noise_fields(m, self.cfg.site_id)))
+        self.measurements_sent += 1
+        self._acknowledged(self.measured_pub, ok)
+
+    def _acknowledged(self, pub, ok: Callable[[], bool]) -> None:
+        """In other processes, wait until every subscriber of pub holds what it sent (at most
+        ack_timeout_s); in this one, DDS has delivered it to the hosted subscribers already."""
         deadline = time.monotonic() + self.cfg.ack_timeout_s
-        while self.consumed is None and ok() and not self.event_pub.wait_for_all_acked(Duration(seconds=0.05)):
+        while self.consumed is None and ok() and not pub.wait_for_all_acked(Duration(seconds=0.05)):
             if time.monotonic() > deadline:
-                raise RailMonitorError(f"subscribers of {self.event_pub.topic_name} did not take a survey within "
+                raise RailMonitorError(f"subscribers of {pub.topic_name} did not take its messages within "
                                        f"{self.cfg.ack_timeout_s:g} s")
 
     def _publish_clock(self, ns: int) -> None:
@@ -208,8 +234,11 @@ class PassSourceNode(RailNode):
         events = [e for e in self.events() if lo <= e.stamp_ns <= hi] if len(table) else []
         if events:
             self.advertise_events()
-        announce(self, site=self.cfg.site_id, passes=len(table), surveys=len(events), rate=f"{self.cfg.rate:g}",
-                 wait_for_subscribers=self.cfg.wait_for_subscribers)
+        measured = [m for m in self.measurements() if lo <= m.stamp_ns <= hi] if len(table) else []
+        if measured:
+            self.advertise_measurements()
+        announce(self, site=self.cfg.site_id, passes=len(table), surveys=len(events), measured=len(measured),
+                 rate=f"{self.cfg.rate:g}", wait_for_subscribers=self.cfg.wait_for_subscribers)
         self._wait_for_subscribers(ok)
         if events and self.cfg.wait_for_subscribers > 0:
             self._wait_for_event_subscriber(ok)
@@ -234,6 +263,8 @@ class PassSourceNode(RailNode):
                 self._publish_clock(stamp)
                 while events and events[0].stamp_ns < stamp:  # before the first pass later than it
                     self._send_event(events.pop(0), ok)
+                while measured and measured[0].stamp_ns < stamp:  # after its own pass
+                    self._send_measurement(measured.pop(0), ok)
                 self.pub.publish(to_msg(TrainPass, train_pass_fields(table.row(i), frame)))
                 self.meter.tick()
                 self.last_stamp_ns = stamp
@@ -242,6 +273,8 @@ class PassSourceNode(RailNode):
                     self._throttle(i + 1, ok)
             for event in events if ok() else []:
                 self._send_event(event, ok)
+            for m in measured if ok() else []:
+                self._send_measurement(m, ok)
             self._throttle(self.meter.count, ok)
             if self.consumed is None and self.cfg.wait_for_subscribers > 0:
                 self._wait_for_graph(self.meter.count, ok)

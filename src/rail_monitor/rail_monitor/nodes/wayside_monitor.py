@@ -107,7 +107,7 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
     publish the advice on the final state. After SIGINT or SIGTERM the waits share
     ``stop_timeout_s``: what is taken by then is recorded and the bag finished (no error)."""
     estimator, predictor, squeal, alerts = models
-    recorded_topics = _outputs(models) | ({source.event_pub.topic_name} if source.event_pub else set())
+    recorded_topics = _outputs(models) | {p.topic_name for p in (source.event_pub, source.measured_pub) if p}
     if recorder is not None:
         _wait(lambda: recorded_topics <= set(recorder.counts), cfg.drain_timeout_s,
               lambda: f"recorder did not subscribe to {sorted(recorded_topics - set(recorder.counts))}")
@@ -123,15 +123,17 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
          lambda: f"models took {[m.taken for m in models]} of {published} passes")
     wait(lambda: alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
          and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
-         and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name],
+         and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name]
+         and alerts.inputs["noise/measured"] >= source.measurements_sent,
          lambda: f"alert_manager took {dict(alerts.inputs)}")
     estimator.publish_advisory()  # the advice on the final state
     recorded: dict[str, int] = {}
     bag = None
     if recorder is not None:
         sent = {source.pub.topic_name: published}
-        if source.event_pub is not None:
-            sent[source.event_pub.topic_name] = source.events_sent
+        for pub, n in ((source.event_pub, source.events_sent), (source.measured_pub, source.measurements_sent)):
+            if pub is not None:
+                sent[pub.topic_name] = n
         for m in models:
             sent.update(m.sent)
         wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),

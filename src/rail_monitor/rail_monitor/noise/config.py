@@ -53,6 +53,20 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
+# What a consumer of noise/rolling must know of it: the models published and the receiver.
+PREDICTED_SPECS = tuple(s for s in NOISE_SPECS if s.name in ("model", "receiver_distance_m", "receiver_height_m"))
+
+
+def selected_models(model: str) -> tuple[str, ...]:
+    """The source models a ``noise.model`` value selects."""
+    return MODELS if model == "both" else (model,)
+
+
+def band_centres_hz() -> np.ndarray:
+    """The nominal 1/3-octave band centres every noise prediction is given on [Hz]."""
+    return cn.tables().band_hz
+
+
 def _receiver(self) -> Receiver:
     return Receiver(self.receiver_distance_m, self.receiver_height_m, self.source_height_m, self.ground_depth_m,
                     self.ground_reflection)

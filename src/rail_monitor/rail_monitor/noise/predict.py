@@ -37,7 +37,7 @@ from rail_monitor.models import cnossos as cn
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
-from rail_monitor.noise.config import MODELS, NoiseConfig
+from rail_monitor.noise.config import MODELS, NoiseConfig, selected_models
 
 # What roughness_growth_increase_db is measured against, for every label that shows it.
 INCREASE_REFERENCE = ("the same pass on the site's baseline rail roughness (noise.rail_roughness: as ground, "
@@ -147,7 +147,7 @@ class RollingNoiseModel:
     @property
     def models(self) -> tuple[str, ...]:
         """The source models the site's ``noise.model`` selects."""
-        return MODELS if self.cfg.model == "both" else (self.cfg.model,)
+        return selected_models(self.cfg.model)
 
     def _baseline(self) -> np.ndarray:
         source = self.cfg.rail_roughness

@@ -1,0 +1,29 @@
+"""The ``residual.*`` parameters: pairing, the prediction's uncertainty and the running baseline."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
+
+RESIDUAL_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("prediction_sd_db", 2.0, "Standard uncertainty of a predicted 1/3-octave band level [dB] (the "
+              "model's, at a site it was not calibrated at).", 0.0, 20.0),
+    ParamSpec("baseline_passes", 200, "Measured passes in the running median of the 500-2000 Hz residual: "
+              "the site's baseline [-].", 5, 100_000),
+    ParamSpec("baseline_min_passes", 20, "Passes the baseline needs before passes are scored against it [-].",
+              1, 100_000),
+    ParamSpec("outlier_db", 6.0, "A pass this far above the baseline is left out of it [dB].", 0.5, 60.0),
+    ParamSpec("receiver_tolerance_m", 0.5, "A measurement's receiver may differ from the model's by this "
+              "(distance and height) [m].", 0.0, 100.0),
+    ParamSpec("held_predictions", 20_000, "Predictions kept for measurements still to come [-].", 10, 10_000_000),
+)
+
+ResidualConfig = values_type("ResidualConfig", RESIDUAL_SPECS, "Residual parameters (names and units as in "
+                             "RESIDUAL_SPECS).", __name__)
+
+
+def residual_config(values: Mapping[str, Any], prefix: str = "residual.") -> ResidualConfig:
+    """Checked residual parameters from flat values (keys under prefix)."""
+    return values_of(ResidualConfig, resolve(RESIDUAL_SPECS, section(values, prefix), where=prefix, strict=True))
