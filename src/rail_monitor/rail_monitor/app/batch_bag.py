@@ -163,39 +163,43 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
 
 def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
                    site: dict[str, str] | None = None, topic: str | None = None, chunk: int = 5_000,
-                   skip_bad_rows: bool = False, salvage: bool = False) -> Recorded:
+                   skip_bad_rows: bool = False, salvage: bool = False, measured: str | Path | None = None
+                   ) -> Recorded:
     """The batch run of a history file recorded to a new bag folder. A bag is read and recorded chunk
     by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
-    time order is read whole and sorted. A run that fails leaves no output behind."""
-    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_events, read_bag_measurements
+    time order is read whole and sorted. Its measured pass-bys are measured's (a noise station's
+    CSV or a bag), else a bag history's own. A run that fails leaves no output behind."""
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_events, read_measurements
 
     existed = folder.exists()
     try:
+        ms = read_measurements(measured, skip_bad_rows=skip_bad_rows) if measured else [] if salvage else \
+            read_measurements(source, history=True)
         if not (salvage or is_csv(Path(source))):
             try:
                 return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site,
-                                  read_bag_events(source), read_bag_measurements(source))
+                                  read_bag_events(source), ms)
             except PassOrderError as exc:
                 note = f"{printable(str(source))}: {exc}; read whole to sort it"
                 _discard(folder, existed)
-                rec = _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage)
+                rec = _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, ms)
                 rec.notes.insert(0, note)
                 return rec
-        return _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage)
+        return _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, ms)
     except BaseException:
         _discard(folder, existed)
         raise
 
 
 def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
-           site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool) -> Recorded:
-    from rail_monitor.bagio.reader import read_bag_events, read_bag_measurements, read_passes
+           site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool,
+           measured: list[Measurement]) -> Recorded:
+    from rail_monitor.bagio.reader import read_bag_events, read_passes
 
     passes = read_passes(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
     events = [] if salvage else read_bag_events(source)  # a salvage recovers passes only
-    measured = [] if salvage else read_bag_measurements(source)
-    notes = [printable(passes.salvage.line(source)), "surveys, grinding and measured noise are not salvaged"] \
-        if salvage else []
+    notes = [printable(passes.salvage.line(source)), "surveys, grinding and the bag's measured noise are not "
+             "salvaged"] if salvage else []
     skipped = getattr(passes, "skipped_rows", [])
     if skipped:
         notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "

@@ -30,18 +30,18 @@ from rail_monitor.core.passes import FRICTION_BY_NAME, FRICTION_NAMES, KMH_PER_M
 from rail_monitor.core.timeutil import NS_PER_S, checked_ns, format_iso_ns, parse_iso_ns
 
 
-def _time_utc(text: str) -> int:
+def time_utc(text: str) -> int:
     return parse_iso_ns(text)
 
 
-def _time_unix_s(text: str) -> int:
+def time_unix_s(text: str) -> int:
     seconds = float(text)
     if not math.isfinite(seconds):
         raise ValueError(f"{text!r} is not a finite time")
     return checked_ns(round(seconds * NS_PER_S))
 
 
-def _time_unix_ns(text: str) -> int:
+def time_unix_ns(text: str) -> int:
     return checked_ns(int(text))
 
 
@@ -59,13 +59,17 @@ def _count(text: str) -> int:
     return value
 
 
+TIME_COLUMNS: dict[str, Callable[[str], int]] = {"time_utc": time_utc, "time_unix_s": time_unix_s,
+                                                  "time_unix_ns": time_unix_ns}
+
+
 def _scaled(factor: float) -> Callable[[str], float]:
     return lambda text: float(text) * factor
 
 
 # quantity -> {column name: parser to the PassTable column's SI value}; None marks "optional".
 _QUANTITIES: dict[str, tuple[str, dict[str, Callable[[str], object]], object]] = {
-    "time": ("stamp_ns", {"time_utc": _time_utc, "time_unix_s": _time_unix_s, "time_unix_ns": _time_unix_ns}, None),
+    "time": ("stamp_ns", TIME_COLUMNS, None),
     "train_id": ("train_id", {"train_id": str}, None),
     "vehicle_class": ("vehicle_class", {"vehicle_class": str}, None),
     "vehicle_count": ("vehicle_count", {"vehicle_count": _count}, 0),
@@ -99,21 +103,39 @@ def _read_text(path: Path) -> str:
                          "export the CSV as UTF-8") from None
 
 
-def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
-    """Read a detector CSV. A malformed row is an error naming its line, unless skip_bad_rows
-    (then it is left out and counted in the returned table's ``skipped`` attribute)."""
-    path = Path(path)
+def csv_lines(path: Path, expected: str) -> tuple[int, list[str], list[tuple[int, str]]]:
+    """A CSV file's header (its line number and stripped column names) and its data lines (line
+    number, text), comments and blank lines left out; InputError without a header (expected: the
+    columns to name in that error)."""
     text = _read_text(path)
     # Lines end at \n alone (str.splitlines would also split at U+2028 and other separators inside a field).
     lines = [(n, line.removesuffix("\r")) for n, line in enumerate(text.split("\n"), start=1)
              if line.strip() and not line.lstrip().startswith("#")]
     if not lines:
-        raise InputError(f"{path}: no header line (expected columns such as time_utc,train_id,...)")
+        raise InputError(f"{path}: no header line (expected columns such as {expected})")
     try:
-        header_line, header = lines[0][0], next(csv.reader([lines[0][1]]))
+        header = next(csv.reader([lines[0][1]]))
     except csv.Error as exc:
         raise InputError(f"{path}: line {lines[0][0]}: {exc}") from None
-    header = [h.strip() for h in header]
+    return lines[0][0], [h.strip() for h in header], lines[1:]
+
+
+def csv_cells(line: str, header: list[str]) -> list[str]:
+    """The fields of a data line; ValueError when they do not match the header."""
+    try:
+        cells = next(csv.reader([line]))
+    except csv.Error as exc:
+        raise ValueError(str(exc)) from None
+    if len(cells) != len(header):
+        raise ValueError(f"{len(cells)} fields where the header has {len(header)}")
+    return cells
+
+
+def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
+    """Read a detector CSV. A malformed row is an error naming its line, unless skip_bad_rows
+    (then it is left out and counted in the returned table's ``skipped`` attribute)."""
+    path = Path(path)
+    header_line, header, lines = csv_lines(path, "time_utc,train_id,...")
     parsers: dict[int, tuple[str, Callable[[str], object]]] = {}
     seen: dict[str, str] = {}
     for i, col in enumerate(header):
@@ -136,11 +158,9 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
         raise InputError(f"{path}: missing column: vehicle_count or axle_count")
 
     rows, skipped, why = [], 0, []
-    for n, line in lines[1:]:
+    for n, line in lines:
         try:
-            cells = next(csv.reader([line]))
-            if len(cells) != len(header):
-                raise ValueError(f"{len(cells)} fields where the header has {len(header)}")
+            cells = csv_cells(line, header)
             row = {target: default for _, (target, _, default) in _QUANTITIES.items()}
             for i, (target, parse) in parsers.items():
                 try:
@@ -148,7 +168,7 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
                 except (ValueError, RailMonitorError) as exc:
                     raise ValueError(f"column {header[i]!r}: {exc}") from None
             rows.append(row)
-        except (ValueError, csv.Error) as exc:
+        except ValueError as exc:
             if not skip_bad_rows:
                 raise InputError(f"{path}: line {n}: {exc}") from None
             skipped += 1

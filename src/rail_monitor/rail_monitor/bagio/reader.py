@@ -190,11 +190,16 @@ def read_bag_events(path: str | Path) -> list[MaintenanceEvent]:
     return in_time_order([event_from_msg(m) for m in msgs])
 
 
-def read_bag_measurements(path: str | Path) -> list[Measurement]:
-    """The measured pass-bys (rail_msgs/MeasuredPassNoise, any topic) of a bag, by pass; none for
-    a CSV history."""
+def read_measurements(path: str | Path, history: bool = False, skip_bad_rows: bool = False) -> list[Measurement]:
+    """Measured pass-bys, by pass: a noise station's CSV (bagio.measured_csv; skip_bad_rows as
+    there), or the MeasuredPassNoise messages (any topic) of a bag. history: path is a pass
+    history, whose CSV holds passes, not measurements (then none)."""
     if is_csv(Path(path)):
-        return []
+        if history:
+            return []
+        from rail_monitor.bagio.measured_csv import read_measured_csv
+
+        return sorted(read_measured_csv(path, skip_bad_rows), key=lambda m: m.key)
     msgs = read_messages(path, [MEASURED_PASS_NOISE])[MEASURED_PASS_NOISE]
     return sorted((measurement_from_msg(m) for m in msgs), key=lambda m: m.key)
 

@@ -52,7 +52,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         s.add_argument("--no-report", action="store_true", help="record only: no summary or report")
         s.add_argument("--overwrite", action="store_true", default=name == "demo",
                        help="replace an existing output folder that rail_monitor created")
-        add_specs(s, MONITOR_SPECS + PUBLISH_SPECS, skip=("site_id", "wait_for_subscribers", "wait_timeout_s"))
+        add_specs(s, MONITOR_SPECS + PUBLISH_SPECS + REPLAYER_SPECS,
+                  skip=("site_id", "wait_for_subscribers", "wait_timeout_s", "source"))
         s.set_defaults(func=demo if name == "demo" else monitor)
 
 

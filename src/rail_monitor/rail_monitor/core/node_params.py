@@ -42,6 +42,8 @@ REPLAYER_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("skip_bad_rows", False, "CSV: leave malformed rows out (counted) instead of failing."),
     ParamSpec("salvage", False, "MCAP: read the passes in every complete chunk of a file cut off mid-write "
               "(a killed recorder, a full disk) instead of failing."),
+    ParamSpec("measured_source", "", "Measured pass-bys to replay: a noise station's CSV or a bag; empty: the "
+              "source bag's own (none for a CSV source)."),
 )
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from rail_monitor.bagio.reader import read_bag_events, read_bag_measurements, read_passes
+from rail_monitor.bagio.reader import read_bag_events, read_measurements, read_passes
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import REPLAYER_SPECS, ReplayerParams
 from rail_monitor.core.params import values_of
@@ -37,7 +37,9 @@ class PassReplayer(PassSourceNode):
         self._events = [] if self.src.salvage else read_bag_events(self.src.source)  # a salvage: passes only
         if self._events:
             self.advertise_events()
-        self._measured = [] if self.src.salvage else read_bag_measurements(self.src.source)
+        given = self.src.measured_source
+        self._measured = read_measurements(given, skip_bad_rows=self.src.skip_bad_rows) if given else [] \
+            if self.src.salvage else read_measurements(self.src.source, history=True)
         if self._measured:
             self.advertise_measurements()
 
