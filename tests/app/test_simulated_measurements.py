@@ -63,3 +63,16 @@ def test_any_chunking_gives_the_one_call_residuals(loop, site_values):
         np.testing.assert_array_equal([a.excess_mid_db, a.baseline_mid_db, a.drift_db],
                                       [b.excess_mid_db, b.baseline_mid_db, b.drift_db])
     assert got.alerts == whole.alerts and not run.tracker.refused
+
+
+def test_the_report_lists_the_defective_vehicles_and_plots_measured_against_predicted(loop, tmp_path):
+    from rail_monitor.app.batch_bag import write_bag
+    from rail_monitor.app.report import build_report, load_run
+
+    _, sim, result = loop
+    bag = write_bag(result, tmp_path / "bag", "curve_250")
+    build_report(load_run(bag), load_parameter_file(SITE_FILE), tmp_path / "report")
+    page = (tmp_path / "report" / "index.html").read_text()
+    assert (tmp_path / "report" / "measured.png").stat().st_size > 10_000
+    section = page.split("wheel-defect suspects (repeat offenders)")[1].split("<h2>")[0]
+    assert all(f"vehicle {v}" in section for v in sim.defective)

@@ -73,3 +73,15 @@ def test_batch_pairs_a_station_csv_as_it_pairs_a_bag_s_measurements(tmp_path, si
               for x in "ab")
     assert len(ra) == len(rb) == 2 * len(ms)
     assert [r.excess_mid_db for r in ra] == pytest.approx([r.excess_mid_db for r in rb], nan_ok=True, rel=0, abs=0)
+    # the export has the measured levels and each model's residuals, row by row on their passes
+    assert main(["export", str(tmp_path / "a"), "--format", "csv"]) == 0
+    import csv
+
+    rows = list(csv.DictReader(line for line in (tmp_path / "a_export" / "passes.csv").read_text().splitlines()
+                               if not line.startswith("#")))
+    by_id = {r["train_id"]: r for r in rows}
+    m = ms[5]
+    got = by_id[m.train_id]
+    assert float(got["measured_lpaeq_tp_dba"]) == pytest.approx(m.lpaeq_tp_dba, abs=1e-9)
+    want = next(r for r in ra if r.train_id == m.train_id and r.model == "cnossos")
+    assert float(got["cnossos_residual_mid_db"]) == pytest.approx(want.residual_mid_db, abs=1e-9)

@@ -117,8 +117,31 @@ def pass_table(run: RunData, values: Mapping[str, Any]) -> Table:
             Column(f"{model}_increase_since_grinding_db", "dB", f"rolling noise ({model}): LpAeq,Tp minus "
                    f"{INCREASE_REFERENCE}", _pick(nz["roughness_growth_increase_db"], i)),
         ]
+    cols += _measured_columns(run, keys)
     cols += _state_columns(run, p.stamp_ns)
     return Table("passes", cols)
+
+
+def _measured_columns(run: RunData, keys: list[tuple[str, int]]) -> list[Column]:
+    """The measured pass-by and its residual per model (empty where a pass was not measured)."""
+    cols = []
+    if len(run.measured.get("train_id", ())):
+        m = run.measured
+        i = _lookup(keys, list(zip(m["train_id"].tolist(), m["stamp_ns"].tolist(), strict=True)))
+        cols += [Column(f"measured_{name}", unit, text, _pick(m[name], i, "")) for name, unit, text in (
+            ("lpaeq_tp_dba", "dB(A)", "measured LpAeq,Tp"), ("lpafmax_dba", "dB(A)", "measured LpAFmax"),
+            ("tel_dba", "dB(A)", "measured TEL"), ("squeal_detected", "-", "the station's squeal flag"))]
+    for model, r in run.residuals.items():
+        i = _lookup(keys, list(zip(r["train_id"].tolist(), r["stamp_ns"].tolist(), strict=True)))
+        cols += [Column(f"{model}_{name}", unit, f"measured minus predicted ({model}): {text}", _pick(r[name], i, ""))
+                 for name, unit, text in (
+                     ("residual_lpaeq_dba", "dB(A)", "LpAeq,Tp"),
+                     ("residual_mid_db", "dB", "energy sum of the 500-2000 Hz bands"),
+                     ("baseline_mid_db", "dB", "the site's running median of the 500-2000 Hz residual before the pass"),
+                     ("excess_mid_db", "dB", "500-2000 Hz residual over the baseline (wheel-defect score)"),
+                     ("loudest_vehicle_id", "-", "the vehicle segment loudest above its train's mean"),
+                     ("loudest_vehicle_excess_db", "dB(A)", "its LpAeq over the train's energy mean"))]
+    return cols
 
 
 def _state_columns(run: RunData, stamps: np.ndarray) -> list[Column]:

@@ -27,7 +27,11 @@ from rail_monitor.core.site import site_from_values
 from rail_monitor.core.text import printable
 from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns, format_local_ns
 
-_TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory")
+_TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory",
+          "MeasuredPassNoise", "NoiseResidual")
+_MEASURED = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "squeal_detected", "instrument_class")
+_RESIDUAL = ("residual_lpaeq_dba", "residual_lpafmax_dba", "residual_tel_dba", "residual_mid_db", "baseline_mid_db",
+             "drift_db", "excess_mid_db", "loudest_vehicle_id", "loudest_vehicle_excess_db")
 _STATE = ("amplitude_m", "threshold_m", "post_grinding_m", "growth_per_axle_pass")
 _STATE_NUMBERS = ("days_to_threshold", "passes_to_threshold", "passes_per_day", "worst_band", "pass_count",
                   "axle_pass_count", "total_pass_count")
@@ -44,6 +48,8 @@ class RunData:
     noise: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)
     alerts: list[Alert] = field(default_factory=list)
     advisory: Any = None
+    measured: dict[str, np.ndarray] = field(default_factory=dict)               # MeasuredPassNoise fields
+    residuals: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)   # NoiseResidual fields, by model
 
 
 def load_run(bag: str | Path) -> RunData:
@@ -128,9 +134,23 @@ def _run_of(path: Path, got: dict[str, list[Any]]) -> RunData:
         run.noise[model]["train_id"] = np.array([m.train_id for m in ms], object)
         run.noise[model]["lp_db"] = np.array([list(m.lp_db) for m in ms])
         run.noise[model]["band_centre_hz"] = np.array(ms[0].band_centre_hz)
+    measured = got["rail_msgs/msg/MeasuredPassNoise"]
+    if measured:
+        run.measured = _columns(measured, _MEASURED)
+    for model in sorted({m.model for m in got["rail_msgs/msg/NoiseResidual"]}):
+        run.residuals[model] = _columns([m for m in got["rail_msgs/msg/NoiseResidual"] if m.model == model],
+                                        _RESIDUAL)
     run.alerts = sorted((alert_from_msg(m) for m in al), key=lambda a: (a.stamp_ns, a.kind, a.key, a.active))
     run.advisory = advisories[-1] if advisories else None
     return run
+
+
+def _columns(msgs: list[Any], names: tuple[str, ...]) -> dict[str, np.ndarray]:
+    """Fields of messages as arrays, with their stamps [ns] and train ids."""
+    out = {k: np.array([getattr(m, k) for m in msgs]) for k in names}
+    out["stamp_ns"] = np.array([time_ns(m.header.stamp) for m in msgs], np.int64)
+    out["train_id"] = np.array([m.train_id for m in msgs], object)
+    return out
 
 
 # -- summary ------------------------------------------------------------------------------------

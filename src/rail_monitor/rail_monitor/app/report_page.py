@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from rail_monitor import __version__
-from rail_monitor.alerts.config import KIND_NAMES
+from rail_monitor.alerts.config import KIND_NAMES, alert_config
 from rail_monitor.app import report_plots, report_tables
 from rail_monitor.app.export import pass_table
 from rail_monitor.app.report import RunData
@@ -140,7 +140,8 @@ def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_ext
               "noise": report_tables.noise_percentiles(t, lim, models),
               "classes": report_tables.by_class(t, lim, models),
               "friction": report_tables.friction_comparison(t, lim, zone),
-              "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run)}
+              "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run),
+              "offenders": report_tables.repeat_offenders(t, values, zone)}
     head = headline(run, t, lim, tables, zone)
     figures = [("timeline", "Passes and squealing passes per day, and the day's highest pass-by level against "
                 "the limit.", report_plots.timeline(report_tables.daily(t, lim, models, zone), models, lim, zone))]
@@ -154,6 +155,11 @@ def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_ext
     if len(run.squeal.get("risk", ())):
         figures.append(("squeal", "Squeal amplitude against crabbing velocity: every pass and the model per "
                         "friction state.", report_plots.squeal(run.squeal, figures_extra["curves"])))
+    if run.residuals:
+        figures.append(("measured", "Measured pass-by noise against the prediction, and the 500-2000 Hz residual "
+                        "against the site's running baseline (the wheel-defect and drift alerts' reference).",
+                        report_plots.measured(t, list(run.residuals), alert_config(values, 60.0).residual_model,
+                                              zone)))
     figures.append(("speeds", "Speed distributions, shares of train passes: the history, the recent passes, "
                     "and the advised distribution (per class in the speed advice table).",
                     report_plots.speeds(run.passes.speed_mps, run.advisory)))
@@ -226,6 +232,8 @@ def _html(run, values, head, tables, lim, figures, meta) -> str:
 
     friction = (f"<h2>Friction modifier: before and after</h2>{_html_table(tables['friction'])}"
                 if tables["friction"] else "")
+    measured = (f"<h2>Measured noise: wheel-defect suspects (repeat offenders)</h2>"
+                f"{_html_table(tables['offenders'], 25)}{fig('measured')}" if "measured" in figs else "")
     advice = (f"<h2>Speed advice per class</h2>{_html_table(tables['advice'])}<p class=\"meta\">Shares of each "
               "class's trains per speed band at its recent mean speed, cutting the peak corrugation growth "
               "without raising the mean noise by more than the limit or the squealing share.</p>"
@@ -249,6 +257,7 @@ forecast, the others the fastest growth rate of the band.</p>
 {fig('timeline')}
 {friction}
 <h2>Squealing trains (loudest first)</h2>{_html_table(tables['squealers'], 25)}
+{measured}
 <h1>Appendix for engineers</h1>
 {fig('corrugation')}{fig('noise')}{fig('squeal')}{advice}{fig('speeds')}
 <h2>Alerts (raise and clear events)</h2>{_html_table(alerts)}

@@ -183,3 +183,28 @@ def timeline(days: Mapping[str, np.ndarray], models: list[str], lim: Mapping[str
     _time_axis(ax2, zone)
     ax1.set_title(f"Daily timeline ({zone} days)", fontsize="medium")
     return fig
+
+
+def measured(t: Mapping[str, np.ndarray], models: list[str], residual_model: str, zone: str) -> Figure:
+    """Measured against predicted LpAeq,Tp per pass for each model (with the 1:1 line), and the
+    residual at 500-2000 Hz per pass against time with the site's running baseline."""
+    fig, (a, b) = plt.subplots(1, 2, figsize=(11, 4.2))
+    m = np.asarray(t["measured_lpaeq_tp_dba"], float)
+    for model in models:
+        predicted = m - np.asarray(t[f"{model}_residual_lpaeq_dba"], float)
+        a.scatter(predicted, m, s=5, alpha=0.5, label=model)
+    lo, hi = np.nanmin(m) - 2, np.nanmax(m) + 2
+    a.plot([lo, hi], [lo, hi], "k--", lw=0.8, label="measured = predicted")
+    a.set(xlabel="predicted LpAeq,Tp [dB(A)]", ylabel="measured LpAeq,Tp [dB(A)]", title="Measured against predicted")
+    a.legend(fontsize=8)
+    ok = np.isfinite(np.asarray(t[f"{residual_model}_residual_mid_db"], float))
+    when = _dates(np.asarray(t["stamp_ns"])[ok])
+    b.scatter(when, np.asarray(t[f"{residual_model}_residual_mid_db"], float)[ok], s=4, alpha=0.5,
+              label=f"{residual_model}, per pass")
+    b.plot(when, np.asarray(t[f"{residual_model}_baseline_mid_db"], float)[ok], "k-", lw=1.2,
+           label="the site's baseline (running median)")
+    b.set(ylabel="measured minus predicted, 500-2000 Hz [dB]", title="Residual and baseline")
+    b.legend(fontsize=8)
+    _time_axis(b, zone)
+    fig.tight_layout()
+    return fig

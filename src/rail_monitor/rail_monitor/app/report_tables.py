@@ -205,3 +205,26 @@ def speed_advice(run: Any) -> list[dict]:
                          "squealing recent [%]": 100.0 * a.class_squeal_share_current[c],
                          "squealing advised [%]": 100.0 * a.class_squeal_share_recommended[c]})
     return rows
+
+
+def repeat_offenders(t: Mapping[str, np.ndarray], values: Mapping[str, Any], zone: str) -> list[dict]:
+    """The vehicles (or trains) whose measured passes scored as a wheel-defect suspect
+    (alerts.wheel_defect_*; rail_monitor.alerts.manager.wheel_defect_score), most often flagged
+    first."""
+    cfg = alert_config(values, 60.0)
+    model = cfg.residual_model
+    if f"{model}_excess_mid_db" not in t:
+        return []
+    excess = np.asarray(t[f"{model}_excess_mid_db"], float)
+    loud = np.asarray(t[f"{model}_loudest_vehicle_excess_db"], float)
+    named = np.array([bool(v) for v in t[f"{model}_loudest_vehicle_id"]]) & (loud >= cfg.wheel_defect_vehicle_db)
+    score = np.fmax(excess, np.where(named, loud, np.nan))
+    rows: dict[str, dict] = {}
+    for i in np.flatnonzero(score >= cfg.wheel_defect_raise_db).tolist():
+        key = f"vehicle {t[f'{model}_loudest_vehicle_id'][i]}" if named[i] else f"train {t['train_id'][i]}"
+        row = rows.setdefault(key, {"vehicle or train": key, "passes flagged": 0, "largest score [dB]": -np.inf})
+        row["passes flagged"] += 1
+        row["largest score [dB]"] = round(max(row["largest score [dB]"], float(score[i])), 1)
+        row["last flagged (local)"] = format_local_ns(int(t["stamp_ns"][i]), zone)
+        row["last train"] = t["train_id"][i]
+    return sorted(rows.values(), key=lambda r: (-r["passes flagged"], -r["largest score [dB]"]))
