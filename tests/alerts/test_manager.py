@@ -246,11 +246,11 @@ def test_bands_closer_than_the_key_resolution_get_distinct_keys():
 
 
 def _residual(i: int, train: str, excess: float, vehicles=("V1", "V2", "V3"), loudest="", loudest_db=0.0,
-              drift=float("nan"), model="cnossos"):
+              drift=float("nan"), model="cnossos", squeal=(False, 0)):
     from rail_monitor.measured.residuals import Residual
 
     return Residual(i * DAY // 100, train, model, np.zeros(0), np.zeros(0), 0.0, 0.0, 0.0, excess, 0.0, drift, 2.0,
-                    0.6, excess, loudest, loudest_db, False, tuple(vehicles))
+                    0.6, excess, loudest, loudest_db, squeal[0], tuple(vehicles), squeal[1])
 
 
 def test_wheel_defect_alerts_name_the_vehicle_count_repeats_and_clear_with_hysteresis():
@@ -285,3 +285,17 @@ def test_the_drift_alert_raises_on_the_baseline_rise_and_clears_below_its_hyster
         (KIND_NOISE_DRIFT, True, 7 * DAY // 100)]
     with pytest.raises(ConfigError, match="drift alert needs hysteresis"):
         _manager(drift_raise_db=2.0, drift_clear_db=2.0)
+
+
+def test_squeal_measured_but_not_predicted_or_the_reverse_raises_on_its_share_of_the_window():
+    from rail_monitor.alerts.config import KIND_SQUEAL_MISMATCH
+
+    m = _manager(squeal_mismatch_window_passes=10, squeal_mismatch_raise_share=0.3, squeal_mismatch_clear_share=0.1,
+                 squeal_min_risk="medium")
+    # 10 agreeing passes, then 4 measured squealing with risk low (not predicted), then agreement again
+    seq = [(True, 3), (False, 0)] * 5 + [(True, 1)] * 4 + [(False, 1)] * 10
+    events = m.on_residuals([_residual(i, f"T{i}", 0.0, squeal=q) for i, q in enumerate(seq)])
+    assert [(e.kind, e.key, e.active, e.stamp_ns) for e in events] == [
+        (KIND_SQUEAL_MISMATCH, "measured, not predicted", True, 12 * DAY // 100),
+        (KIND_SQUEAL_MISMATCH, "measured, not predicted", False, 22 * DAY // 100)]
+    assert m.on_residuals([_residual(30, "T", 0.0, squeal=(True, 3), model="mechanics")] * 20) == []

@@ -12,7 +12,7 @@ import pytest
 
 from rail_monitor.measured.config import residual_config
 from rail_monitor.measured.records import Measurement
-from rail_monitor.measured.residuals import INSTRUMENT_SD_DB, UNPAIRED, Predicted, ResidualTracker
+from rail_monitor.measured.residuals import INSTRUMENT_SD_DB, SQUEAL, UNPAIRED, Predicted, ResidualTracker
 from rail_monitor.noise.config import MODELS, band_centres_hz
 
 BANDS = band_centres_hz()
@@ -28,7 +28,8 @@ def _pair(i: int, excess: float = 0.0) -> tuple[Measurement, list[Predicted]]:
     leq = lp + 1.0 + excess * mid + RNG.normal(0.0, 0.1, len(BANDS))
     m = Measurement(stamp, f"T{i}", 7.5, 1.2, 1, BANDS.copy(), leq, 80.0, 83.0, 85.0, False,
                     ("A", "B", "C", "D"), np.array([80.0, 80.0, 80.0 + excess, 80.0]))
-    return m, [Predicted(stamp, f"T{i}", model, lp + k, 79.0, 82.0, 84.0) for k, model in enumerate(MODELS)]
+    return m, [*(Predicted(stamp, f"T{i}", model, lp + k, 79.0, 82.0, 84.0) for k, model in enumerate(MODELS)),
+               Predicted(stamp, f"T{i}", SQUEAL, np.zeros(0), math.nan, math.nan, math.nan, 2)]
 
 
 def _tracker(**over) -> ResidualTracker:
@@ -59,7 +60,7 @@ def test_residuals_equal_an_independent_energy_difference():
     t = _tracker()
     m, p = _pair(0, excess=4.0)
     out = t.add_measurement(m) + t.add_predictions(p)
-    assert [r.model for r in out] == list(MODELS)
+    assert [r.model for r in out] == list(MODELS) and {r.squeal_risk for r in out} == {2}  # the squeal model's
     r = out[0]
     np.testing.assert_allclose(r.residual_db, m.leq_db - p[0].lp_db, rtol=0, atol=1e-12)
     sel = [i for i, f in enumerate(BANDS) if 500 <= f <= 2000]  # the 500-2000 Hz thirds

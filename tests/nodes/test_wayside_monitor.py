@@ -81,7 +81,8 @@ def _measurements(events) -> list[Measurement]:
     first = run_models(_slice(), _values(), events=events)
     p = first.noise["cnossos"]
     good = simulate_measurements(first.accepted, p.lp_db, p.lpaeq_tp_dba, p.lpafmax_dba, p.tel_dba,
-                                 p.band_centre_hz, (7.5, 1.2), seed=3, fleet_per_class=15).measurements
+                                 p.band_centre_hz, (7.5, 1.2), seed=3, fleet_per_class=15,
+                                 squealing=first.squeal["risk"] >= 2).measurements
     nan_band = replace(good[10], leq_db=np.where(np.arange(len(p.band_centre_hz)) == 4, np.nan, good[10].leq_db))
     absurd = replace(good[11], lpaeq_tp_dba=400.0)
     unknown = replace(good[12], train_id="NO-SUCH-TRAIN")
@@ -226,7 +227,7 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
 def test_report_folder_has_images_and_a_page(runs):
     files = sorted(runs["report"].iterdir())
     pngs = [f for f in files if f.suffix == ".png"]
-    assert {f.stem for f in pngs} == {"timeline", "corrugation", "noise", "squeal", "speeds"}
+    assert {f.stem for f in pngs} == {"timeline", "corrugation", "noise", "squeal", "speeds", "measured"}
     for f in pngs:
         assert f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f.stat().st_size > 10_000
     page = (runs["report"] / "index.html").read_text()

@@ -20,6 +20,7 @@ from rail_monitor.alerts.config import (
     KIND_NOISE_DRIFT,
     KIND_NOISE_LIMIT,
     KIND_SQUEAL,
+    KIND_SQUEAL_MISMATCH,
     KIND_WHEEL_DEFECT,
     SEVERITY_CRITICAL,
     SEVERITY_INFO,
@@ -61,6 +62,7 @@ class AlertManager:
         self._rejected = Window(cfg.rejected_window_passes)
         self._keys: dict[bytes, list[str]] = {}
         self.offences: Counter[str] = Counter()  # passes flagged per wheel-defect key (repeat offenders)
+        self._mismatch = {k: Window(cfg.squeal_mismatch_window_passes) for k in MISMATCHES}
 
     def retune(self, cfg: AlertConfig) -> None:
         """Take new limits and windows (a running node's parameters changed): each window keeps its
@@ -69,6 +71,7 @@ class AlertManager:
         self._noise = {model: w.resized(cfg.noise_window_passes) for model, w in self._noise.items()}
         self._squeal = self._squeal.resized(cfg.squeal_window_passes)
         self._rejected = self._rejected.resized(cfg.rejected_window_passes)
+        self._mismatch = {k: w.resized(cfg.squeal_mismatch_window_passes) for k, w in self._mismatch.items()}
 
     # -- raise / clear ----------------------------------------------------------------------------
     def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
@@ -240,9 +243,8 @@ class AlertManager:
         """NoiseResiduals in order (those of ``residual_model``; others are passed over): a wheel
         defect suspect per vehicle (or train) with hysteresis, and the drift of the baseline."""
         cfg, events = self.cfg, []
+        residuals = [r for r in residuals if r.model == cfg.residual_model]
         for r in residuals:
-            if r.model != cfg.residual_model:
-                continue
             score = wheel_defect_score(r, cfg.wheel_defect_vehicle_db)
             named = r.loudest_vehicle_id and r.loudest_vehicle_excess_db >= cfg.wheel_defect_vehicle_db
             key = f"vehicle {r.loudest_vehicle_id}" if named else f"train {r.train_id}"
@@ -266,7 +268,17 @@ class AlertManager:
                     f"{r.model} residual at 500-2000 Hz {r.drift_db:+.1f} dB since its baseline filled: the rail "
                     f"roughens faster than the model says" if up else f"{r.model} residual drift cleared",
                     r.drift_db, cfg.drift_raise_db if up else cfg.drift_clear_db, "dB"))
+        if residuals:
+            stamps = np.array([r.stamp_ns for r in residuals], np.int64)
+            predicted = counts_as_squeal(np.array([r.squeal_risk for r in residuals]), cfg.squeal_min_risk)
+            measured = np.array([r.squeal_detected for r in residuals], bool)
+            for key, hits in zip(MISMATCHES, (measured & ~predicted, predicted & ~measured), strict=True):
+                events += self._share(self._mismatch[key], hits, KIND_SQUEAL_MISMATCH, key, stamps,
+                                      "squeal_mismatch", f"squeal {key}", full_window=True)
         return [e for e in events if e]
+
+
+MISMATCHES = ("measured, not predicted", "predicted, not measured")  # the squeal-mismatch alerts' keys
 
 
 def wheel_defect_score(r: Any, vehicle_db: float) -> float:

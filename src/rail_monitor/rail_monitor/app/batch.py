@@ -205,7 +205,7 @@ class BatchRun:
             noise = _noise_on_states(pool, self.model, accepted, states.amplitude, traj.constants, on)
             squeal = squeal_job.result()
         self._tail = states.last_stamp()
-        measured, residuals = self._measured(table, accepted, noise)
+        measured, residuals = self._measured(table, accepted, noise, squeal["risk"])
         self.alerts.on_residuals(residuals)
         events = sorted(self._held + _feed_alerts(self.alerts, table, reasons, accepted, squeal, traj, noise),
                         key=_alert_key)
@@ -215,8 +215,8 @@ class BatchRun:
                            [a for a in events if a.stamp_ns < later], self.standing(), None, self.estimator,
                            self.model.receiver, dict(left_out), [], measured, residuals)
 
-    def _measured(self, table: PassTable, accepted: PassTable, noise: dict[str, NoisePrediction]
-                  ) -> tuple[list[Measurement], list[Residual]]:
+    def _measured(self, table: PassTable, accepted: PassTable, noise: dict[str, NoisePrediction],
+                  squeal_risk: np.ndarray) -> tuple[list[Measurement], list[Residual]]:
         """The measurements of this chunk's passes (stamped up to its last), paired with the
         predictions as the residual node pairs them."""
         if not (self._measurements or self.tracker.queue):
@@ -225,7 +225,7 @@ class BatchRun:
         n = bisect.bisect_right([m.stamp_ns for m in self._measurements], last)
         taken, self._measurements = self._measurements[:n], self._measurements[n:]
         out = [r for m in taken for r in self.tracker.add_measurement(m)]
-        return taken, out + self.tracker.add_predictions(predictions_of(accepted, noise))
+        return taken, out + self.tracker.add_predictions(predictions_of(accepted, noise, squeal_risk))
 
     def standing(self) -> list[Alert]:
         return sorted(self.alerts.standing.values(), key=_alert_key)

@@ -10,7 +10,8 @@ gets the day's weather offset (normal, ``weather_sd_db``, one per day: temperatu
 change propagation and rail roughness alike) and the instrument's error (normal, the standard
 uncertainty of its IEC 61672-1 class, rail_monitor.measured.residuals.INSTRUMENT_SD_DB). The
 single numbers move with the A-weighted total; a vehicle segment's LpAeq is the train's with
-that vehicle's offset alone, plus the instrument's error.
+that vehicle's offset alone, plus the instrument's error. The station's squeal flag is the given
+squealing, wrong on a share of passes.
 """
 
 from __future__ import annotations
@@ -40,9 +41,12 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
                           tel_dba: np.ndarray, band_hz: np.ndarray, receiver_m: tuple[float, float], seed: int,
                           fleet_per_class: int = 40, defective: int = 4, defect_db: float = 12.0,
                           wheel_spread_db: float = 1.0, weather_sd_db: float = 0.5,
-                          instrument_class: int = 1) -> MeasuredSeries:
+                          instrument_class: int = 1, squealing: np.ndarray | None = None,
+                          squeal_error: float = 0.02) -> MeasuredSeries:
     """Measurements of passes (rows matching the predictions: lp_db (N, B) [dB] on band_hz [Hz],
-    the single numbers (N,) [dB(A)]) at receiver_m (distance, height) [m]."""
+    the single numbers (N,) [dB(A)]) at receiver_m (distance, height) [m]. squealing: whether
+    each pass squeals (the squeal model's prediction, say); the station's flag is that, wrong on
+    a share squeal_error of passes (none squeal without it)."""
     rng = np.random.Generator(np.random.PCG64(seed))
     classes = sorted(set(passes.vehicle_class.tolist()))
     fleets = {c: [f"{c.upper()}-V{k:03d}" for k in range(fleet_per_class)] for c in classes}
@@ -58,6 +62,8 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
     weather = dict(zip(np.unique(days).tolist(), rng.normal(0.0, weather_sd_db, len(np.unique(days))).tolist(),
                        strict=True))
     out, consists = [], []
+    flags = np.zeros(len(passes), bool) if squealing is None else np.asarray(squealing, bool).copy()
+    flags ^= rng.random(len(passes)) < (0.0 if squealing is None else squeal_error)
     for i in range(len(passes)):
         fleet = fleets[passes.vehicle_class[i]]
         n = int(min(max(passes.vehicle_count[i], 1), len(fleet)))
@@ -69,6 +75,7 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
         own = a_weighted_total(base[None, :] + mid[None, :] * o[:, None], x) + rng.normal(0.0, sd, n)
         out.append(Measurement(int(passes.stamp_ns[i]), str(passes.train_id[i]), receiver_m[0], receiver_m[1],
                                instrument_class, band_hz.copy(), leq, float(lpaeq_tp_dba[i]) + shift,
-                               float(lpafmax_dba[i]) + shift, float(tel_dba[i]) + shift, False, vehicles, own))
+                               float(lpafmax_dba[i]) + shift, float(tel_dba[i]) + shift, bool(flags[i]), vehicles,
+                               own))
         consists.append(vehicles)
     return MeasuredSeries(out, bad, consists)

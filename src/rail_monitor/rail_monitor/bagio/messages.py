@@ -22,7 +22,7 @@ from rail_monitor.core.timeutil import TIME_MSG_END_NS, fits_time_msg, from_sec_
 from rail_monitor.corrugation.records import Forecast, StateSnapshot
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
-from rail_monitor.measured.residuals import Predicted, Residual
+from rail_monitor.measured.residuals import SQUEAL, Predicted, Residual
 from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.predict import Corrugation, NoisePrediction
 from rail_monitor.squeal.config import RISK_HIGH
@@ -174,7 +174,10 @@ def measurement_from_msg(msg: Any) -> Measurement:
 
 
 def predicted_from_msg(msg: Any) -> Predicted:
-    """A RollingNoise as the prediction a measurement is paired with."""
+    """A RollingNoise, or a SquealPrediction (its risk), as the prediction a measurement is paired with."""
+    if hasattr(msg, "risk"):
+        return Predicted(time_ns(msg.header.stamp), str(msg.train_id), SQUEAL, np.zeros(0), float("nan"),
+                         float("nan"), float("nan"), int(msg.risk))
     return Predicted(time_ns(msg.header.stamp), str(msg.train_id), str(msg.model), np.array(msg.lp_db, float),
                      float(msg.lpaeq_tp_dba), float(msg.lpafmax_dba), float(msg.tel_dba))
 

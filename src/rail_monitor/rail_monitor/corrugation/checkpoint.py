@@ -4,7 +4,7 @@ previous good file.
 The file is a numpy .npz (zip members with CRCs): a JSON ``meta`` record (version, site, counts,
 times), the band centres, ln Z of every component, K_b, the last survey and the post-grinding
 amplitudes, the calibration (growth since the last survey per friction state, the covariance of
-ln K_b, each band's level variance) and the kept passes' columns.
+ln K_b, each band's level variance), the last year's growth per day and the kept passes' columns.
 """
 
 from __future__ import annotations
@@ -21,15 +21,18 @@ import numpy as np
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.history import COLUMNS, KeptPasses
+from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
 
-VERSION = 4
+VERSION = 5
 # 1: before grinding_amplitude (read as the post-grinding default); 1-2: before the contact regime
 # (their kept passes read as in partial slip, at their class's nominal load, as they were counted);
 # 1-3: before the calibration (read as the prior about their K_b, no growth since the last survey,
-# each band's level known to the post-grinding uncertainty).
-READABLE_VERSIONS = (1, 2, 3, 4)
+# each band's level known to the post-grinding uncertainty); 1-4: before the daily growth of the
+# last year (read as none: the forecast interval uses the recent window until a year has passed).
+READABLE_VERSIONS = (1, 2, 3, 4, 5)
 CALIBRATION_ARRAYS = ("growth_by_state", "calibration_cov", "level_var")
+SEASON_ARRAYS = ("season_growth", "season_passes", "season_first_day")
 CONTACT_COLUMNS = ("regime", "load", "creepage")
 _COUNTS = ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns", "last_survey_ns")
 
@@ -57,6 +60,8 @@ def save(est: CorrugationEstimator, path: str | Path) -> None:
     np.savez(buf, meta=np.array(json.dumps(meta)), bands=est.bands, log_components=est.log_components,
              k_b=est.k_b, survey_log_amplitude=est.survey_log_amplitude, grinding_amplitude=est.grinding_amplitude,
              growth_by_state=est.growth_by_state, calibration_cov=est.calibration.cov, level_var=est.level_var,
+             season_growth=est.season.growth, season_passes=est.season.passes,
+             season_first_day=np.array(est.season.first_day),
              **{f"recent_{n}": est.kept.train_id.astype(str) if n == "train_id" else getattr(est.kept, n)
                 for n in COLUMNS})
     tmp = path.with_name(f".{path.name}.tmp")
@@ -82,9 +87,10 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
             data = {k: z[k] for k in z.files}  # zip member CRCs are checked as each is read
         meta = json.loads(str(data["meta"]))
         version = meta.get("version") if isinstance(meta, dict) else None
-        wanted = COLUMNS if version in (3, VERSION) else tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
+        wanted = COLUMNS if version in (3, 4, VERSION) else tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
         missing = {"bands", "log_components", "k_b", "survey_log_amplitude", *(f"recent_{n}" for n in wanted),
-                   *(CALIBRATION_ARRAYS if version == VERSION else ())} - set(data)
+                   *(CALIBRATION_ARRAYS if version in (4, VERSION) else ()),
+                   *(SEASON_ARRAYS if version == VERSION else ())} - set(data)
         if missing:
             raise KeyError(f"arrays missing: {', '.join(sorted(missing))}")
     except FileNotFoundError:
@@ -153,12 +159,20 @@ def _state(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarray]) -
               or not np.all(np.isfinite(cols["creepage"]))):
         raise ValueError("kept passes hold an unknown class, friction state, regime, speed, load or creepage")
     calibrated = _calibration(est, meta, data, k_b)
+    season = DailyGrowth(est.log_components.shape)
+    if "season_growth" in data:  # version 5
+        season.growth = np.asarray(data["season_growth"], float)
+        season.passes = np.asarray(data["season_passes"]).astype(np.int64, casting="same_kind")
+        season.first_day = int(data["season_first_day"])
+        if season.growth.shape != (len(season.passes), 4, *est.log_components.shape) \
+                or not np.all(np.isfinite(season.growth)) or np.any(season.passes < 0):
+            raise ValueError("season arrays have the wrong shape, are not finite or count negative passes")
     counts = {key: int(meta[key]) for key in _COUNTS}
     if any(v < 0 for v in counts.values()):
         raise ValueError("negative counts")
     return {"log_components": log_components, "survey_log_amplitude": survey, "grinding_amplitude": grinding,
             **counts, "newest_train_id": str(meta.get("newest_train_id", "")), "kept": KeptPasses(**cols),
-            **calibrated, "_k_b": k_b}
+            **calibrated, "season": season, "_k_b": k_b}
 
 
 def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarray], k_b: np.ndarray) -> dict:

@@ -27,6 +27,7 @@ from rail_monitor.corrugation.config import CorrugationConfig
 from rail_monitor.corrugation.growth import GrowthTables
 from rail_monitor.corrugation.history import KeptPasses
 from rail_monitor.corrugation.records import Forecast, ForecastInterval, StateSnapshot, Trajectory
+from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
 from rail_monitor.models import corrugation as cg
 
@@ -62,6 +63,7 @@ class CorrugationEstimator:
         self.post_grinding_var = np.full(len(self.bands), calibration.log_variance(cfg.post_grinding_uncertainty_db))
         self.level_var = self.post_grinding_var.copy()
         self.kept = KeptPasses()
+        self.season = DailyGrowth(self.log_components.shape)  # the last year day by day (forecast interval)
         self.threads: fcst.Threads | None = None  # threads a history's forecasts may use (batch: its pool)
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
         # (B, P). A window's growth is a difference of two, so it is the same however the passes
@@ -110,6 +112,7 @@ class CorrugationEstimator:
         for f in np.unique(friction).tolist():  # cumsum: sequential, as the passes one by one
             self.growth_by_state[f - 1] = np.cumsum(
                 np.concatenate([self.growth_by_state[f - 1][None], growth[friction == f]]), axis=0)[-1]
+        self.season.add(new.stamp_ns, friction, growth, self.k_b)
         summed = np.cumsum(np.concatenate([self._growth_total[None], growth]), axis=0)
         self._growth_before = np.concatenate([self._growth_before, summed[:-1]])
         self._growth_total = summed[-1].copy()
@@ -246,13 +249,15 @@ class CorrugationEstimator:
 
     def forecast_interval(self) -> ForecastInterval:
         """P10, P50 and P90 of the days to threshold over the K_b posterior and the level variance
-        of each band, at the recent traffic (:func:`.forecast.interval`)."""
+        of each band (:func:`.forecast.interval`): at the traffic and friction mix of the same
+        season a year earlier where the history spans a year, else at the recent traffic."""
         rate, axles = self.traffic()
         axles = axles if np.isfinite(axles) else self.site.mean_axles_per_train
         days_per_axle_pass = 1.0 / (rate * axles) if np.isfinite(rate) and rate > 0 else np.inf
+        season = self.season.profile(self.newest_ns)
         return fcst.interval(self.log_components, self.growth_by_state, self.recent_growth_by_state(),
                              self.calibration, np.sqrt(self.level_var), self.threshold, days_per_axle_pass,
-                             self.newest_ns)
+                             self.newest_ns, None if season is None else season * self.k_b[None, :, None, None])
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic (see :func:`.forecast.traffic`)."""

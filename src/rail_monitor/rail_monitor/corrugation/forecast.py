@@ -88,7 +88,7 @@ def traffic(kept: KeptPasses, min_traffic_days: float) -> tuple[float, float]:
 
 def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth_by_state: np.ndarray,
              posterior: calibration.KbPosterior, level_sd: np.ndarray, threshold: np.ndarray,
-             days_per_axle_pass: float, newest_ns: int) -> ForecastInterval:
+             days_per_axle_pass: float, newest_ns: int, season: np.ndarray | None = None) -> ForecastInterval:
     """P10, P50 and P90 of the days to threshold, per band and of the first band, over the
     uncertainty of K_b and of the present roughness.
 
@@ -99,17 +99,50 @@ def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth
     (both growths scale with exp(delta_f), first order in K_b) and an independent error of each
     band's level, and is forecast as the state is; the quantiles are those of the draws (so the
     same state gives the same interval in every process). The traffic and its friction mix are
-    the recent window's.
+    the recent window's, or with season (the log growth per day and friction state of the year
+    before the newest pass, (365, 4, B, P), at the posterior median) that year's repeated: day j
+    ahead grows as day j a year earlier did, day by day through the first year, then at that
+    year's mean per day.
     """
     rng = np.random.Generator(np.random.PCG64(INTERVAL_SEED))
     delta = rng.standard_normal((INTERVAL_DRAWS, len(posterior.mean))) @ np.linalg.cholesky(posterior.cov).T
     level = level_sd * rng.standard_normal((INTERVAL_DRAWS, len(threshold)))
     state = log_components + np.einsum("df,fbp->dbp", np.expm1(delta), growth_since_survey) + level[:, :, None]
-    growth = np.einsum("df,fbp->dbp", np.exp(delta), growth_by_state)
-    axle_passes = cg.passes_to_band_level(state, growth, np.log(threshold))
-    with np.errstate(invalid="ignore"):
-        days = np.where(axle_passes == 0.0, 0.0, axle_passes * days_per_axle_pass)
+    if season is not None:
+        days = _seasonal_days(state, np.exp(delta), season, np.log(threshold))
+    else:
+        growth = np.einsum("df,fbp->dbp", np.exp(delta), growth_by_state)
+        axle_passes = cg.passes_to_band_level(state, growth, np.log(threshold))
+        with np.errstate(invalid="ignore"):
+            days = np.where(axle_passes == 0.0, 0.0, axle_passes * days_per_axle_pass)
     q = (0.1, 0.5, 0.9)
     first = np.quantile(days.min(axis=1), q, method="inverted_cdf")
     due = np.array([newest_ns + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0 for d in first.tolist()], np.int64)
-    return ForecastInterval(np.quantile(days, q, axis=0, method="inverted_cdf"), first, due)
+    return ForecastInterval(np.quantile(days, q, axis=0, method="inverted_cdf"), first, due,
+                            "recent" if season is None else "season")
+
+
+def _seasonal_days(state: np.ndarray, scale: np.ndarray, season: np.ndarray, log_threshold: np.ndarray,
+                   block: int = 25) -> np.ndarray:
+    """Days to each band's threshold (D, B) of D states ln Z (D, B, P) growing day by day as the
+    season's days (S, 4, B, P), each friction state's growth scaled per draw (D, 4); past the
+    season, at its mean per day. Within a day the level is interpolated linearly in ln Z."""
+    out = np.empty(state.shape[:2])
+    year = season.sum(axis=0)                                         # (4, B, P)
+    for lo in range(0, len(state), block):
+        s, k = state[lo:lo + block], scale[lo:lo + block]
+        daily = np.einsum("df,jfbp->djbp", k, season)                 # (d, S, B, P)
+        path = s[:, None] + np.cumsum(daily, axis=1)
+        level = cg.band_log_amplitude(np.concatenate([s[:, None], path], axis=1))  # (d, S + 1, B)
+        over = level >= log_threshold
+        first = np.argmax(over, axis=1)                               # first day at or past it
+        crossed = over.any(axis=1)
+        before = np.take_along_axis(level, np.maximum(first - 1, 0)[:, None], axis=1)[:, 0]
+        at = np.take_along_axis(level, first[:, None], axis=1)[:, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            frac = np.where(at > before, (log_threshold - before) / (at - before), 1.0)
+        days = np.where(first == 0, 0.0, first - 1 + np.clip(frac, 0.0, 1.0))
+        mean = np.einsum("df,fbp->dbp", k, year) / len(season)
+        later = len(season) + cg.passes_to_band_level(path[:, -1], mean, log_threshold)
+        out[lo:lo + block] = np.where(crossed, days, later)
+    return out

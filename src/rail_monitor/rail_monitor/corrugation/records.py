@@ -30,6 +30,7 @@ class ForecastInterval:
     band_days: np.ndarray
     days: np.ndarray
     due_ns: np.ndarray
+    basis: str = "recent"          # the traffic forecast: "recent" window, or "season" a year earlier
 
 
 @dataclass(frozen=True)

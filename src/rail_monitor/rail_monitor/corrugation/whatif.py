@@ -130,8 +130,9 @@ def summary(r: CorrugationWhatIf) -> dict[str, Any]:
     iv = r.interval
     if iv is not None:
         out["forecast_interval"] = {
-            "basis": "K_b posterior and each band's level uncertainty; traffic and friction mix of the recent "
-                     f"{est.cfg.history_days:g} days",
+            "basis": "K_b posterior and each band's level uncertainty; traffic and friction mix of " + (
+                "the same days a year earlier" if iv.basis == "season" else f"the recent {est.cfg.history_days:g} "
+                "days (the history spans less than a year)"),
             "days_to_threshold_p10_p50_p90": iv.days.tolist(),
             "grinding_due_p10_p50_p90": [format_iso_ns(int(ns)) if ns else "never" for ns in iv.due_ns.tolist()]}
     if r.advice is not None:

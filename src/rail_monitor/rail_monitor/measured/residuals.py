@@ -19,12 +19,13 @@ instrument's, taken as the IEC 61672-1:2013 acceptance limit at 1 kHz (class 1: 
 GUM, 4.3.7).
 
 Order: measurements are scored in stamp order (train_id breaking ties), each once its pass's
-prediction of every model is in, so the baseline is the same however a measurement and its own
-pass's predictions interleave, live or in batch, as long as it arrives before any later pass's
-predictions (a replay sends it after its pass and before the next). One that arrives after a
-later measurement was scored is scored on arrival and counted in ``late``. A measurement waits
-while a pass at or after its stamp may still be predicted; once every model has predicted a
-later pass and none predicted its own, it is refused (no such pass, or the pass was rejected).
+prediction of every model (the squeal model's risk too) is in, so the baseline is the same
+however a measurement and its own pass's predictions interleave, live or in batch, as long as
+it arrives before any later pass's predictions (a replay sends it after its pass and before the
+next). One that arrives after a later measurement was scored is scored on arrival and counted in
+``late``. A measurement waits while a pass at or after its stamp may still be predicted; once
+every model has predicted a later pass and none predicted its own, it is refused (no such pass,
+or the pass was rejected).
 """
 
 from __future__ import annotations
@@ -58,7 +59,7 @@ class Predicted:
     lpaeq_tp_dba: float
     lpafmax_dba: float
     tel_dba: float
-    squeal_predicted: bool = False
+    squeal_risk: int = 0        # model "squeal": the pass's SquealPrediction risk (RISK_*); noise models: unused
 
 
 @dataclass(frozen=True)
@@ -84,6 +85,7 @@ class Residual:
     loudest_vehicle_excess_db: float
     squeal_detected: bool
     vehicle_id: tuple[str, ...] = ()
+    squeal_risk: int = 0        # the squeal model's risk of the pass (SquealPrediction.RISK_*)
 
 
 class Baseline:
@@ -125,13 +127,18 @@ def compare(m: Measurement, p: Predicted, band_hz: np.ndarray) -> dict[str, floa
             "residual_mid_db": mid_db, "loudest_vehicle_id": loudest, "loudest_vehicle_excess_db": excess}
 
 
+SQUEAL = "squeal"  # the squeal model's "prediction" of a pass: its risk only
+
+
 class ResidualTracker:
-    """Pairs measurements with their pass's predictions (every model's), scores them in stamp
-    order against a baseline per model, and counts what it refuses by reason."""
+    """Pairs measurements with their pass's predictions (every noise model's, and the squeal
+    model's risk), scores them in stamp order against a baseline per noise model, and counts what
+    it refuses by reason."""
 
     def __init__(self, cfg: ResidualConfig, band_hz: np.ndarray, receiver_m: tuple[float, float],
                  models: Sequence[str]) -> None:
-        self.cfg, self.receiver_m, self.models = cfg, receiver_m, tuple(models)
+        self.cfg, self.receiver_m, self.noise_models = cfg, receiver_m, tuple(models)
+        self.models = (*self.noise_models, SQUEAL)
         self.band_hz = np.asarray(band_hz, float)
         self.predictions: OrderedDict[tuple[int, str], dict[str, Predicted]] = OrderedDict()
         self.newest = {m: -1 for m in self.models}       # newest stamp predicted per model [ns]
@@ -139,7 +146,7 @@ class ResidualTracker:
         self.waiting: dict[tuple[int, str], Measurement] = {}
         self.scored: OrderedDict[tuple[int, str], None] = OrderedDict()
         self.baselines = {m: Baseline(cfg.baseline_passes, cfg.baseline_min_passes, cfg.outlier_db)
-                          for m in self.models}
+                          for m in self.noise_models}
         self.refused: Counter[str] = Counter()
         self.taken = 0
         self.late = 0  # measurements scored after a later one
@@ -194,20 +201,24 @@ class ResidualTracker:
         while len(self.scored) > self.cfg.held_predictions:
             self.scored.popitem(last=False)
         out = []
-        for model in self.models:
+        risk = predicted[SQUEAL].squeal_risk
+        for model in self.noise_models:
             raw = compare(m, predicted[model], self.band_hz)
             base, excess, drift = self.baselines[model].score(float(raw["residual_mid_db"]))
             out.append(Residual(m.stamp_ns, m.train_id, model, self.band_hz, baseline_mid_db=base, drift_db=drift,
                                 prediction_sd_db=self.cfg.prediction_sd_db,
                                 measurement_sd_db=INSTRUMENT_SD_DB[m.instrument_class], excess_mid_db=excess,
-                                squeal_detected=m.squeal_detected, vehicle_id=tuple(m.vehicle_id), **raw))
+                                squeal_detected=m.squeal_detected, vehicle_id=tuple(m.vehicle_id),
+                                squeal_risk=risk, **raw))
         return out
 
 
-def predictions_of(passes: Any, noise: Mapping[str, Any]) -> list[Predicted]:
-    """Each pass's prediction by each model (rows of passes, a PassTable, and of each model's
-    NoisePrediction), pass by pass."""
+def predictions_of(passes: Any, noise: Mapping[str, Any], squeal_risk: np.ndarray) -> list[Predicted]:
+    """Each pass's prediction by each noise model and its squeal risk (rows of passes, a
+    PassTable, of each model's NoisePrediction and of squeal_risk), pass by pass."""
     stamps, trains = passes.stamp_ns.tolist(), passes.train_id.tolist()
     cols = {m: (p.lp_db, p.lpaeq_tp_dba.tolist(), p.lpafmax_dba.tolist(), p.tel_dba.tolist()) for m, p in noise.items()}
-    return [Predicted(stamps[i], trains[i], m, lp[i], a[i], f[i], t[i])
-            for i in range(len(stamps)) for m, (lp, a, f, t) in cols.items()]
+    none = np.zeros(0)
+    return [p for i in range(len(stamps)) for p in (
+        *(Predicted(stamps[i], trains[i], m, lp[i], a[i], f[i], t[i]) for m, (lp, a, f, t) in cols.items()),
+        Predicted(stamps[i], trains[i], SQUEAL, none, math.nan, math.nan, math.nan, int(squeal_risk[i])))]

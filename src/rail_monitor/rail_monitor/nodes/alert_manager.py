@@ -126,6 +126,7 @@ class AlertManagerNode(PassConsumerNode):
         msgs = self._usable("noise/squeal", msgs, squeal_refusal)
         if msgs:
             self._emit(self.alerts.on_squeal(stamps_ns(msgs), np.array([m.risk for m in msgs])))
+            self._predicted(msgs)
 
     def _on_noise(self, msgs: list[RollingNoise]) -> None:
         msgs = self._usable("noise/rolling", msgs, noise_refusal)
@@ -135,8 +136,12 @@ class AlertManagerNode(PassConsumerNode):
             events += self.alerts.on_noise(stamps_ns(mine), model, {
                 k: np.array([getattr(m, k) for m in mine]) for k in NOISE_METRICS})
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
-        # Measurements sent before these passes are queued by now (a replay sends each before the
-        # next pass, acknowledged): take them first, so they are scored in stamp order.
+        self._predicted(msgs)
+
+    def _predicted(self, msgs: list[Any]) -> None:
+        """Predictions for the measurements. Measurements sent before these passes are queued by
+        now (a replay sends each before the next pass, acknowledged): they are taken first, so
+        they are scored in stamp order."""
         queued = take_queued(self.measured_sub, self.max_batch)
         if queued:
             self._on_measured(queued)
