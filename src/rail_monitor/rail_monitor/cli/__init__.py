@@ -22,6 +22,7 @@ from rail_monitor.cli import (
     info,
     predict_corrugation,
     predict_noise,
+    predict_roughness,
     predict_squeal,
     report,
     simulate,
@@ -40,7 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_parsers(sub)
     s = sub.add_parser("predict", help="run one model on physical inputs")
     models = s.add_subparsers(dest="model", required=True)
-    for verb in (predict_squeal, predict_corrugation, predict_noise):
+    for verb in (predict_squeal, predict_corrugation, predict_noise, predict_roughness):
         verb.add_parser(models)
     batch.add_parser(sub)
     report.add_parser(sub)

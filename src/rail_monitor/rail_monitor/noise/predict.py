@@ -173,6 +173,23 @@ class RollingNoiseModel:
         extra = np.where(inside, grown[..., nearest], 0.0)
         return level(power(self.baseline_db) + extra)
 
+    def rail_share(self, passes: PassTable, corrugation: Corrugation | None = None) -> np.ndarray:
+        """The rail's share of the combined effective roughness energy per pass and band (N, B)
+        [-]: CNOSSOS's tables read at lambda = v / f (each mapped on its own, the ``reference``
+        rule), joints' impact roughness counted with the rail; the contact filter acts on both
+        alike, so it cancels. ``passes`` valid with class defaults filled."""
+        rail = self.rail_roughness_db(corrugation)
+        out = np.empty((len(passes), len(self.band)))
+        for name in set(passes.vehicle_class.tolist()):
+            rows = passes.vehicle_class == name
+            speed = passes.speed_mps[rows]
+            on_rail = power(cn.at_band_frequencies(rail if rail.ndim == 1 else rail[rows], speed, self.band_hz))
+            if self.impact_db is not None:
+                on_rail = on_rail + power(cn.at_band_frequencies(self.impact_db, speed, self.band_hz))
+            wheel = power(cn.at_band_frequencies(self.classes[name].wheel_db, speed, self.band_hz))
+            out[rows] = on_rail / (on_rail + wheel)
+        return out
+
     def predict(self, passes: PassTable, model: str | None = None,
                 corrugation: Corrugation | None = None) -> NoisePrediction:
         """RollingNoise fields per pass (arrays over passes; bands last), vectorised.
