@@ -34,6 +34,8 @@ def test_two_surveys_refit_k_b(site_, tables):
         surveys.apply_survey(est, [5.0], [1e-6])
     with pytest.raises(ValueError, match="positive"):
         surveys.apply_survey(est, est.bands, -first)
+    with pytest.raises(ValueError, match="not a roughness survey"):
+        surveys.apply_survey(est, np.full(10**6, 0.05), np.full(10**6, 1e-6))
 
 
 def test_survey_level_is_the_kalman_update(site_, tables):

@@ -46,6 +46,7 @@ def _tracker(**over) -> ResidualTracker:
     ({"instrument_class": 3}, "instrument class 3"),
     ({"vehicle_id": ("A",)}, "vehicle_id and vehicle_lpaeq_dba"),
     ({"stamp_ns": 0}, "stamp not set"),
+    ({"band_centre_hz": np.full(10**6, 500.0), "leq_db": np.full(10**6, 70.0)}, "more bands than the model's"),
 ])
 def test_a_bad_measurement_is_refused_with_its_reason_and_changes_nothing(change, why):
     t = _tracker()

@@ -125,7 +125,7 @@ class BatchRun:
     first pass stamped later than it, as the estimator node applies them when a replay sends them
     so; those after the last pass at finish(). One the node would refuse is counted in
     ``events_refused`` by reason and changes nothing. measurements: measured pass-bys
-    (rail_monitor.measured), paired with their passes' predictions and scored as the residual node
+    (rail_monitor.measured), paired with their passes' predictions and scored as alert_manager
     does (``tracker.refused`` counts the refused); their residuals feed the alerts.
     """
 
@@ -218,7 +218,7 @@ class BatchRun:
     def _measured(self, table: PassTable, accepted: PassTable, noise: dict[str, NoisePrediction],
                   squeal_risk: np.ndarray) -> tuple[list[Measurement], list[Residual]]:
         """The measurements of this chunk's passes (stamped up to its last), paired with the
-        predictions as the residual node pairs them."""
+        predictions as alert_manager pairs them."""
         if not (self._measurements or self.tracker.queue):
             return [], []
         last = int(table.stamp_ns.max()) if len(table) else np.iinfo(np.int64).min

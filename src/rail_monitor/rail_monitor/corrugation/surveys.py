@@ -24,6 +24,7 @@ from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.models import calibration
 
 KIND_SURVEY, KIND_GRINDING = 1, 2  # as rail_msgs/RoughnessSurvey's KIND_*
+MAX_SURVEY_BANDS = 1000  # a trolley survey has tens of 1/3-octave bands
 
 
 @dataclass(frozen=True)
@@ -85,6 +86,8 @@ def match_bands(bands: np.ndarray, wavelength: np.ndarray, amplitude: np.ndarray
     wavelength, amplitude = np.asarray(wavelength, float), np.asarray(amplitude, float)
     if wavelength.shape != amplitude.shape or wavelength.ndim != 1:
         raise ValueError("wavelength_m and amplitude_m must be 1-D and the same length")
+    if len(wavelength) > MAX_SURVEY_BANDS:
+        raise ValueError(f"more than {MAX_SURVEY_BANDS} wavelengths: not a roughness survey")
     if not (np.all(np.isfinite(amplitude)) and np.all(amplitude > 0) and np.all(wavelength > 0)):
         raise ValueError("survey wavelengths and amplitudes must be finite and positive")
     out = np.full(len(bands), np.nan)

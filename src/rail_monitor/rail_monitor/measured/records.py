@@ -15,6 +15,7 @@ import numpy as np
 
 LEVEL_RANGE_DB = (0.0, 150.0)
 INSTRUMENT_CLASSES = (1, 2)
+MAX_VEHICLES = 1000  # segments of one train: more is no train (and would cost memory to check)
 
 
 @dataclass(frozen=True)
@@ -56,6 +57,8 @@ def measurement_refusal(m: Measurement, model_band_hz: np.ndarray, receiver_m: t
     bands, leq = np.asarray(m.band_centre_hz, float), np.asarray(m.leq_db, float)
     if bands.ndim != 1 or bands.shape != leq.shape or not len(bands):
         return "band_centre_hz and leq_db differ in length, or are empty"
+    if len(bands) > len(model_band_hz) or len(m.vehicle_id) > MAX_VEHICLES:
+        return f"more bands than the model's {len(model_band_hz)}, or more than {MAX_VEHICLES} vehicle segments"
     if not (np.all(np.isfinite(bands)) and np.all(bands > 0)):
         return "a band centre is not positive and finite"
     levels = np.array([*leq.tolist(), m.lpaeq_tp_dba, m.lpafmax_dba, m.tel_dba])
