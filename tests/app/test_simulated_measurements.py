@@ -77,3 +77,16 @@ def test_the_report_lists_the_defective_vehicles_and_plots_measured_against_pred
     assert (tmp_path / "report" / "measured.png").stat().st_size > 10_000
     section = page.split("wheel-defect suspects (repeat offenders)")[1].split("<h2>")[0]
     assert all(f"vehicle {v}" in section for v in sim.defective)
+
+
+def test_a_chunk_longer_than_the_tracker_holds_pairs_every_measurement(loop):
+    # The tracker keeps residual.held_predictions passes' predictions; one call over 3,838 passes with
+    # 100 kept pairs each measurement all the same, as the default does (the pairing goes block by block).
+    passes, sim, whole = loop
+    values = {**load_parameter_file(SITE_FILE), "residual.held_predictions": 100}
+    run = BatchRun(values, measurements=sim.measurements)
+    got = run.feed(passes)
+    run.finish()
+    assert not run.tracker.refused and len(got.residuals) == len(whole.residuals)
+    assert [r.excess_mid_db for r in got.residuals] == pytest.approx([r.excess_mid_db for r in whole.residuals],
+                                                                     nan_ok=True, rel=0, abs=0)

@@ -139,3 +139,11 @@ def test_a_pass_measured_twice_or_never_predicted_is_refused():
     assert t.refused[UNPAIRED] == 1 and not t.queue
     t.add_measurement(m3)
     assert not t.queue
+
+
+def test_measurements_waiting_for_passes_are_bounded():
+    t = _tracker(held_predictions=10)
+    for i in range(12):
+        t.add_measurement(_pair(10**6 + i)[0])  # far ahead of every prediction
+    assert len(t.queue) == 10 and t.refused["too many measurements waiting for their passes "
+                                            "(residual.held_predictions)"] == 2

@@ -47,6 +47,7 @@ from rail_monitor.squeal.predict import predict as predict_squeal
 
 HISTORY_CHUNK = 50_000  # passes per advance_history call: bounds its (passes x bands x components) arrays
 NOISE_CHUNK = 20_000  # passes per noise prediction: bounds the (passes x time steps) arrays of LpAFmax
+PAIR_BLOCK = 1_000  # passes whose predictions are given to the residual tracker at once (at most half it holds)
 
 
 @dataclass
@@ -221,11 +222,26 @@ class BatchRun:
         predictions as alert_manager pairs them."""
         if not (self._measurements or self.tracker.queue):
             return [], []
-        last = int(table.stamp_ns.max()) if len(table) else np.iinfo(np.int64).min
-        n = bisect.bisect_right([m.stamp_ns for m in self._measurements], last)
-        taken, self._measurements = self._measurements[:n], self._measurements[n:]
-        out = [r for m in taken for r in self.tracker.add_measurement(m)]
-        return taken, out + self.tracker.add_predictions(predictions_of(accepted, noise, squeal_risk))
+        taken: list[Measurement] = []
+        out: list[Residual] = []
+
+        def take(upto: int) -> None:  # the measurements stamped up to upto, as the replayer sends them
+            n = bisect.bisect_right([m.stamp_ns for m in self._measurements], upto)
+            taken.extend(self._measurements[:n])
+            out.extend(r for m in self._measurements[:n] for r in self.tracker.add_measurement(m))
+            del self._measurements[:n]
+
+        # Block by block, so that the tracker holds no more than a block of predictions unpaired
+        # (it keeps residual.held_predictions, however long the chunk).
+        predicted = predictions_of(accepted, noise, squeal_risk)
+        per, cut = len(self.tracker.models), np.iinfo(np.int64).min
+        block = max(1, min(PAIR_BLOCK, self.tracker.cfg.held_predictions // 2))
+        for lo in range(0, len(accepted), block):
+            cut = max(cut, int(accepted.stamp_ns[lo:lo + block].max()))
+            take(cut)
+            out.extend(self.tracker.add_predictions(predicted[lo * per:(lo + block) * per]))
+        take(max(cut, int(table.stamp_ns.max()) if len(table) else cut))
+        return taken, out
 
     def standing(self) -> list[Alert]:
         return sorted(self.alerts.standing.values(), key=_alert_key)

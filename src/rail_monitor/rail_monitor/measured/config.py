@@ -17,7 +17,8 @@ RESIDUAL_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("outlier_db", 6.0, "A pass this far above the baseline is left out of it [dB].", 0.5, 60.0),
     ParamSpec("receiver_tolerance_m", 0.5, "A measurement's receiver may differ from the model's by this "
               "(distance and height) [m].", 0.0, 100.0),
-    ParamSpec("held_predictions", 20_000, "Predictions kept for measurements still to come [-].", 10, 10_000_000),
+    ParamSpec("held_predictions", 20_000, "Predictions kept for measurements still to come, and measurements "
+              "kept waiting for their passes' predictions [-].", 10, 10_000_000),
 )
 
 ResidualConfig = values_type("ResidualConfig", RESIDUAL_SPECS, "Residual parameters (names and units as in "

@@ -157,6 +157,8 @@ class ResidualTracker:
         why = measurement_refusal(m, self.band_hz, self.receiver_m, self.cfg.receiver_tolerance_m)
         if not why and (m.key in self.waiting or m.key in self.scored):
             why = "pass measured twice"
+        if not why and len(self.queue) >= self.cfg.held_predictions:  # far-future stamps must not pile up
+            why = "too many measurements waiting for their passes (residual.held_predictions)"
         if why:
             self.refused[why] += 1
             return []
