@@ -79,3 +79,18 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
                                own))
         consists.append(vehicles)
     return MeasuredSeries(out, bad, consists)
+
+
+def station_on_true_rail(passes: PassTable, values: dict, k_b_factor: float, seed: int) -> MeasuredSeries:
+    """A station measuring every valid pass of a true rail whose K_b is the configured one times
+    k_b_factor (CNOSSOS-EU's prediction on that rail, with simulate_measurements' deviations; its
+    squeal flag the squeal model's risk medium or above)."""
+    from rail_monitor.app.batch import run_models
+    from rail_monitor.app.simulated_surveys import true_estimator
+    from rail_monitor.core.site import site_from_values
+
+    truth = run_models(passes, values, estimator=true_estimator(site_from_values(values), values, k_b_factor))
+    p = truth.noise["cnossos"] if "cnossos" in truth.noise else next(iter(truth.noise.values()))
+    receiver = truth.receiver
+    return simulate_measurements(truth.accepted, p.lp_db, p.lpaeq_tp_dba, p.lpafmax_dba, p.tel_dba, p.band_centre_hz,
+                                 (receiver.distance_m, receiver.height_m), seed, squealing=truth.squeal["risk"] >= 2)

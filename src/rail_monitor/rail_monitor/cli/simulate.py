@@ -17,6 +17,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--days", type=float, help="override simulator.days [day]")
     s.add_argument("--seed", type=int, help="override simulator.seed [-]")
     s.add_argument("--force", action="store_true", help="replace an existing bag folder that rail_monitor created")
+    t = s.add_argument_group("a measured site: a true rail, its surveys and a noise station (into the bag)")
+    t.add_argument("--k-b-factor", type=float, default=1.0, help="the true rail's K_b over the configured one [-]")
+    t.add_argument("--surveys-every-days", type=float, default=0.0,
+                   help="roughness surveys of the true rail, 1 dB per band, every so many days (0: none)")
+    t.add_argument("--measured", action="store_true", help="a noise station measuring every pass of the true rail "
+                   "(4 vehicles with wheel flats among the fleets; their ids are printed)")
+    t.add_argument("--measured-csv", help="also write the station's measurements as its CSV")
     s.set_defaults(func=run)
 
 
@@ -35,11 +42,43 @@ def run(ns: argparse.Namespace) -> int:
     table = simulate(site, simulator_config(values))
     if not ns.out and not ns.csv:
         raise RailMonitorError("give --out BAG and/or --csv FILE")
+    if ns.k_b_factor <= 0 or ns.surveys_every_days < 0:
+        raise RailMonitorError("--k-b-factor must be positive and --surveys-every-days not negative")
+    events, measured = _measured_site(ns, values, site, table)
     if ns.out:
         fresh_output(Path(ns.out), ns.force)
-        write_passes_bag(table, ns.out, site.site_id)
-        print(f"wrote {len(table)} passes to bag {ns.out}")
+        write_passes_bag(table, ns.out, site.site_id, events=events, measurements=measured)
+        print(f"wrote {len(table)} passes, {len(events)} surveys and {len(measured)} measured pass-bys to bag "
+              f"{ns.out}")
     if ns.csv:
         write_csv(table, ns.csv)
         print(f"wrote {len(table)} passes to {ns.csv}")
     return 0
+
+
+def _measured_site(ns: argparse.Namespace, values: dict, site, table) -> tuple[list, list]:
+    """The true rail's surveys and the station's measurements the options ask for."""
+    events, measured = [], []
+    if ns.surveys_every_days > 0:
+        from rail_monitor.app.simulated_surveys import simulate_surveys
+        from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
+
+        series = simulate_surveys(site, values, table, ns.k_b_factor, ns.surveys_every_days, 1.0,
+                                  int(values["simulator.seed"]) + 100)
+        events = [MaintenanceEvent(int(t), KIND_SURVEY, series.wavelength_m, series.amplitude_m[k])
+                  for k, t in enumerate(series.stamp_ns.tolist())]
+        print(f"true rail: K_b x {ns.k_b_factor:g} = {', '.join(f'{k:.3g}' for k in series.true_k_b)} "
+              "(dry, wet, modifier, contaminated)")
+    if ns.measured or ns.measured_csv:
+        from rail_monitor.app.simulated_measurements import station_on_true_rail
+
+        station = station_on_true_rail(table, values, ns.k_b_factor, int(values["simulator.seed"]))
+        measured = station.measurements
+        print(f"noise station: {len(measured)} measured pass-bys; vehicles with wheel flats: "
+              f"{', '.join(sorted(station.defective))}")
+        if ns.measured_csv:
+            from rail_monitor.bagio.measured_csv import write_measured_csv
+
+            write_measured_csv(measured, ns.measured_csv)
+            print(f"wrote the station's measurements to {ns.measured_csv}")
+    return events, measured
