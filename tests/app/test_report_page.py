@@ -14,8 +14,8 @@ import pytest
 from rail_monitor.app import report_plots, report_tables
 from rail_monitor.app.batch import run_models
 from rail_monitor.app.batch_bag import write_bag
-from rail_monitor.app.export import pass_table
 from rail_monitor.app.report import build_report, load_run
+from rail_monitor.app.run_tables import pass_table
 from rail_monitor.bagio.reader import read_passes
 
 from conftest import EXAMPLE_CSV, SITE_FILE

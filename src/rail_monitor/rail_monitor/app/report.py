@@ -199,7 +199,7 @@ def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12)
 def _limit_lines(run: RunData, values: Mapping[str, Any], shown: int = 5) -> list[str]:
     """Noise percentiles against the limit, and the loudest squealing trains."""
     from rail_monitor.app import report_tables
-    from rail_monitor.app.export import pass_table
+    from rail_monitor.app.run_tables import pass_table
 
     t = pass_table(run, values).as_dict()
     lim = report_tables.limits(values)

@@ -19,8 +19,8 @@ import numpy as np
 from rail_monitor import __version__
 from rail_monitor.alerts.config import KIND_NAMES, alert_config
 from rail_monitor.app import report_plots, report_tables
-from rail_monitor.app.export import pass_table
 from rail_monitor.app.report import RunData
+from rail_monitor.app.run_tables import pass_table
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.text import jsonable, printable
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns

@@ -2,7 +2,7 @@
 vehicle class, per day, before and after a friction modifier, and the squealing trains.
 
 Every table is a list of rows (dicts, units in the keys), computed from the per-pass table of
-:func:`rail_monitor.app.export.pass_table` (one row per pass with every model output), so the
+:func:`rail_monitor.app.run_tables.pass_table` (one row per pass with every model output), so the
 report, the export and the console agree by construction.
 """
 

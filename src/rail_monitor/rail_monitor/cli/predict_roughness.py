@@ -32,9 +32,9 @@ def run(ns: argparse.Namespace) -> int:
     measured = read_measurements(ns.measured) if ns.measured else read_measurements(history, history=True)
     result = run_models(read_passes(history), values, events=read_bag_events(history), measurements=measured)
     ind = indirect_of_run(result, values, ns.days)
-    bands = [{"wavelength_m": float(ind.wavelength_m[k]), "indirect_db": _num(ind.level_db[k]),
-              "sd_db": _num(ind.sd_db[k]), "model_db": float(ind.model_db[k]),
-              "indirect_rms_m": _num(ind.amplitude_m[k]), "pass_bands": int(ind.passes[k]),
+    bands = [{"wavelength_m": float(ind.wavelength_m[k]), "indirect_db": float(ind.level_db[k]),
+              "sd_db": float(ind.sd_db[k]), "model_db": float(ind.model_db[k]),
+              "indirect_rms_m": float(ind.amplitude_m[k]), "pass_bands": int(ind.passes[k]),
               "rail_share": float(ind.rail_share[k])} for k in range(len(ind.wavelength_m))]
     if ns.json:
         print_json({"what": LABEL, "window_days": ns.days, "measured_passes": len(measured), "bands": bands})
@@ -47,9 +47,6 @@ def run(ns: argparse.Namespace) -> int:
     return 0
 
 
-def _num(x: float) -> float | None:
-    return None if x != x else float(x)
-
-
-def _cell(x: float | None, width: int = 9) -> str:
-    return f"{'-':>{width}}" if x is None else f"{x:{width}.2f}"
+def _cell(x: float, width: int = 9) -> str:
+    """A level, or '-' where there is no estimate (NaN; print_json writes it as null)."""
+    return f"{'-':>{width}}" if x != x else f"{x:{width}.2f}"
