@@ -21,8 +21,8 @@ from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 def indirect_of_run(result: BatchResult, values: Mapping[str, Any], days: float) -> IndirectRoughness:
     """The indirect rail roughness on the corrugation state's bands from the measured passes of the
     last ``days`` [day] of a run (``alerts.residual_model``'s residuals), against the final state."""
-    model_name = alert_config(values, 60.0).residual_model
     est = result.estimator
+    model_name = alert_config(values, est.cfg.lead_time_days).residual_model
     since = est.newest_ns - int(days * NS_PER_DAY)
     mine = {(r.stamp_ns, r.train_id): r for r in result.residuals if r.model == model_name and r.stamp_ns > since}
     if not mine:

@@ -4,9 +4,16 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rail_monitor.cli.common import add_site_option, fresh_output, site_values
 from rail_monitor.core.errors import RailMonitorError
+
+if TYPE_CHECKING:  # the command imports the models only when it runs
+    from rail_monitor.core.passes import PassTable
+    from rail_monitor.core.site import Site
+    from rail_monitor.corrugation.surveys import MaintenanceEvent
+    from rail_monitor.measured.records import Measurement
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -56,7 +63,8 @@ def run(ns: argparse.Namespace) -> int:
     return 0
 
 
-def _measured_site(ns: argparse.Namespace, values: dict, site, table) -> tuple[list, list]:
+def _measured_site(ns: argparse.Namespace, values: dict, site: Site, table: PassTable
+                   ) -> tuple[list[MaintenanceEvent], list[Measurement]]:
     """The true rail's surveys and the station's measurements the options ask for."""
     events, measured = [], []
     if ns.surveys_every_days > 0:

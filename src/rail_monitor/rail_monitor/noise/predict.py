@@ -25,7 +25,7 @@ per band.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
@@ -180,8 +180,7 @@ class RollingNoiseModel:
         alike, so it cancels. ``passes`` valid with class defaults filled."""
         rail = self.rail_roughness_db(corrugation)
         out = np.empty((len(passes), len(self.band)))
-        for name in set(passes.vehicle_class.tolist()):
-            rows = passes.vehicle_class == name
+        for name, rows in _class_rows(passes):
             speed = passes.speed_mps[rows]
             on_rail = power(cn.at_band_frequencies(rail if rail.ndim == 1 else rail[rows], speed, self.band_hz))
             if self.impact_db is not None:
@@ -231,8 +230,7 @@ class RollingNoiseModel:
         # Every component of the model, even with no passes (an empty history gives empty arrays).
         terms = next(iter(self.classes.values()))
         components = {c: np.full((n, nb), -np.inf) for c in (terms.cnossos if model == "cnossos" else terms.mechanics)}
-        for name in set(passes.vehicle_class.tolist()):
-            rows = passes.vehicle_class == name
+        for name, rows in _class_rows(passes):
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
             lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
                                             None if filter_db is None else filter_db[rows])
@@ -256,6 +254,12 @@ class RollingNoiseModel:
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + filter_db
         return lr, terms.mechanics
+
+
+def _class_rows(passes: PassTable) -> Iterator[tuple[str, np.ndarray]]:
+    """(vehicle class, its rows' mask) for each class among passes: the class terms are per class."""
+    for name in set(passes.vehicle_class.tolist()):
+        yield name, passes.vehicle_class == name
 
 
 def _total(components: dict[str, np.ndarray]) -> np.ndarray:
