@@ -46,3 +46,13 @@ def test_hertz_stiffness_is_the_derivative_of_load_against_approach():
     # and a wheel on a rail is an ellipse elongated along the rail (a > b) with a mean pressure p0 * 2/3
     assert c.a[1] > c.b[1]
     assert load[1] / (np.pi * c.a[1] * c.b[1]) == pytest.approx(2 / 3 * c.p0[1], rel=1e-12)
+
+
+@pytest.mark.parametrize("ratio", [1.05, 1.5, 3.0, 10.0, 1e3, 1e8])
+def test_hertz_axis_ratio_is_the_root_to_1e_12(ratio):
+    # Johnson (1985) eq. 4.37 fixes k from B/A; the solved k brackets the root within 1e-12 (its
+    # own equation evaluated on either side), and k falls as B/A grows (the bisection's premise).
+    k = hertz._axis_ratio(ratio)
+    above, below = (hertz._ratio_for_axis_ratio(k * (1.0 + s)) for s in (-1e-12, 1e-12))
+    assert above >= ratio * (1.0 - 1e-12) and below <= ratio * (1.0 + 1e-12)
+    assert hertz._axis_ratio(ratio * 1.01) < k < 1.0

@@ -75,11 +75,20 @@ def _axis_ratio(curvature_ratio: float) -> float:
     """Minor/major axis ratio k of the contact ellipse for a curvature ratio B_1/A_1 >= 1."""
     if curvature_ratio <= 1.0 + 1e-12:
         return 1.0
-    # B_1/A_1 grows monotonically as k falls; bracket in log k down to k = 1e-6 (ratio ~ 1e10).
-    f = lambda log_k: np.log(_ratio_for_axis_ratio(np.exp(log_k))) - np.log(curvature_ratio)  # noqa: E731
-    from scipy.optimize import brentq  # lazy: scipy.optimize costs 0.3 s to import
-
-    return float(np.exp(brentq(f, np.log(1e-6), np.log(1.0 - 1e-9), xtol=1e-14, rtol=1e-14)))
+    # B_1/A_1 grows monotonically as k falls: bisect in log k between k = 1e-6 (ratio ~ 1e10) and
+    # k = 1 - 1e-9 until the bracket is two adjacent doubles (about 60 halvings, once per geometry;
+    # scipy.optimize would cost 23 MB and 0.3 s to import in every node).
+    target = np.log(curvature_ratio)
+    lo, hi = np.log(1e-6), np.log(1.0 - 1e-9)    # ratio(lo) > target > ratio(hi)
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if not lo < mid < hi:
+            break
+        if np.log(_ratio_for_axis_ratio(np.exp(mid))) > target:
+            lo = mid
+        else:
+            hi = mid
+    return float(np.exp(0.5 * (lo + hi)))
 
 
 def _k_minus_e_over_m(k: FloatArray) -> FloatArray:
