@@ -123,6 +123,23 @@ def test_the_baseline_is_the_running_median_of_the_non_outliers():
     assert flagged == [i for i in range(60) if i % 13 == 7 and i > 5]
 
 
+@pytest.mark.parametrize("size", [1, 2, 7, 20])
+def test_the_baseline_median_is_numpys_bit_for_bit(size):
+    # The window is kept sorted beside its arrival order; its median must be numpy's of the same
+    # values exactly (live and batch compare residuals bit for bit, and earlier versions used numpy's).
+    from rail_monitor.measured.residuals import Baseline
+
+    rng = np.random.default_rng(size)
+    b = Baseline(size, 1, 6.0)
+    values = np.round(rng.normal(0.0, 2.0, 400), 1)  # ties, repeats and outliers
+    values[::37] = np.nan
+    for v in values.tolist():
+        if len(b.window):
+            assert b.median() == float(np.median(list(b.window)))
+        b.score(v)
+        assert sorted(b.window) == b._sorted and len(b.window) <= size
+
+
 def test_a_pass_measured_twice_or_never_predicted_is_refused():
     t = _tracker()
     m0, p0 = _pair(0)

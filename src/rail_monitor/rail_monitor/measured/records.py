@@ -9,6 +9,7 @@ segments do not pair ids with levels.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,10 +44,19 @@ class Measurement:
 
 
 def band_index(model_band_hz: np.ndarray, band_hz: np.ndarray) -> np.ndarray:
-    """The model band of each measured band (nominal centres within 3 %), -1 where none is."""
-    ratio = np.abs(np.log(np.asarray(band_hz, float)[:, None] / np.asarray(model_band_hz, float)[None, :]))
+    """The model band of each measured band (nominal centres within 3 %), -1 where none is
+    (read-only: a station sends the same bands with every pass, so each set is matched once)."""
+    return _band_index(np.asarray(model_band_hz, float).tobytes(), np.asarray(band_hz, float).tobytes())
+
+
+@functools.lru_cache(maxsize=64)
+def _band_index(model_band_hz: bytes, band_hz: bytes) -> np.ndarray:
+    bands, model = np.frombuffer(band_hz), np.frombuffer(model_band_hz)
+    ratio = np.abs(np.log(bands[:, None] / model[None, :]))
     nearest = np.argmin(ratio, axis=1)
-    return np.where(ratio[np.arange(len(nearest)), nearest] < 0.03, nearest, -1)
+    out = np.where(ratio[np.arange(len(nearest)), nearest] < 0.03, nearest, -1)
+    out.flags.writeable = False
+    return out
 
 
 def measurement_refusal(m: Measurement, model_band_hz: np.ndarray, receiver_m: tuple[float, float],

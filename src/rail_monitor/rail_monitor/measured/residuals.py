@@ -92,19 +92,28 @@ class Baseline:
     """The running median of the 500-2000 Hz residual and its value when first full."""
 
     def __init__(self, passes: int, min_passes: int, outlier_db: float) -> None:
-        self.window: deque[float] = deque(maxlen=passes)
+        self.window: deque[float] = deque(maxlen=passes)   # in arrival order
+        self._sorted: list[float] = []                     # the same values, sorted (the median in O(log n))
         self.min_passes, self.outlier_db = min_passes, outlier_db
         self.reference = math.nan
+
+    def median(self) -> float:
+        """The window's median, as numpy's (the mean of the middle two of an even count) [dB]."""
+        s, n = self._sorted, len(self._sorted)
+        return s[n // 2] if n % 2 else (s[n // 2 - 1] + s[n // 2]) / 2.0
 
     def score(self, mid_db: float) -> tuple[float, float, float]:
         """(baseline before this pass, excess of the pass over it, drift of the baseline) [dB];
         then the pass joins the window unless it is an outlier or not finite."""
-        base = float(np.median(self.window)) if len(self.window) >= self.min_passes else math.nan
+        base = self.median() if len(self.window) >= self.min_passes else math.nan
         if math.isnan(self.reference) and len(self.window) == self.window.maxlen:
             self.reference = base
         excess = mid_db - base
         if math.isfinite(mid_db) and not excess > self.outlier_db:
+            if len(self.window) == self.window.maxlen:
+                del self._sorted[bisect.bisect_left(self._sorted, self.window[0])]
             self.window.append(mid_db)
+            bisect.insort(self._sorted, mid_db)
         return base, excess, base - self.reference
 
 
