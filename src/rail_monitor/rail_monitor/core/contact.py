@@ -65,20 +65,23 @@ def creep_stiffness(site: Site, patch: HertzContact, k1: np.ndarray) -> np.ndarr
     return squeal.lateral_creep_stiffness(kalker, k1, c.k3_convention, c.creep_reduction_factor)
 
 
-def contact_state(site: Site, passes: PassTable, friction_state: np.ndarray | None = None) -> ContactState:
+def contact_state(site: Site, passes: PassTable, friction_state: np.ndarray | None = None,
+                  patch: HertzContact | None = None) -> ContactState:
     """The contact state of each pass (valid for the site, class defaults filled:
     :func:`rail_monitor.core.passes.with_class_defaults`), in its own friction state or, where
-    given, in friction_state (TrainPass.FRICTION_* per pass) instead."""
+    given, in friction_state (TrainPass.FRICTION_* per pass) instead. patch: the passes' Hertz
+    patch when already computed (it does not depend on the friction state)."""
     friction = passes.friction_state if friction_state is None else friction_state
     return contact_state_of(site, passes.vehicle_class, friction, passes.wheel_load_n,
-                            np.sin(np.abs(passes.angle_of_attack_rad)), passes.speed_mps)
+                            np.sin(np.abs(passes.angle_of_attack_rad)), passes.speed_mps, patch)
 
 
 def contact_state_of(site: Site, vehicle_class: np.ndarray, friction_state: np.ndarray, load_n: np.ndarray,
-                     creepage: np.ndarray, speed_mps: np.ndarray) -> ContactState:
+                     creepage: np.ndarray, speed_mps: np.ndarray, patch: HertzContact | None = None) -> ContactState:
     """The contact state from its inputs per pass: class names, TrainPass.FRICTION_* codes, wheel
-    load [N], lateral creepage [-] and speed [m/s]."""
-    patch = site.contact_patch(wheel_radius(site, vehicle_class), load_n)
+    load [N], lateral creepage [-] and speed [m/s] (patch: as for contact_state)."""
+    if patch is None:
+        patch = site.contact_patch(wheel_radius(site, vehicle_class), load_n)
     k1, k2 = site.contact.creep(friction_state)
     k3 = creep_stiffness(site, patch, k1)
     saturation = load_n / k3
