@@ -149,13 +149,13 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
                 time.sleep(0.05)
             time.sleep(2.0)
             out: dict[str, Any] = {"processes": len(procs)}
-            c0 = sum(cpu_s(p.pid) for p in procs)
+            idle0 = [cpu_s(p.pid) for p in procs]
             time.sleep(idle_s)
-            out["idle_core"] = (sum(cpu_s(p.pid) for p in procs) - c0) / idle_s
+            idle = [(cpu_s(p.pid) - c) / idle_s for p, c in zip(procs, idle0, strict=True)]
+            out["idle_core"], out["idle_per_process"] = sum(idle), dict(zip(names, idle, strict=True))
             n = 3
             for rate in rates:
                 ids, per0, t_start = [], [cpu_s(p.pid) for p in procs], time.monotonic()
-                c0 = sum(per0)
                 count = max(int(rate * seconds), 1)
                 for k in range(count):
                     delay = t_start + k / rate - time.monotonic()
@@ -201,7 +201,8 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             f"from the disk cache (the run before: {cold['seconds']:.2f} s); includes the {GRAPH_SETTLE_S:g} s its "
             "replayer lets the graph settle when another process listens (the probe)"),
            (f"live graph idle ({g['processes']} processes)", f"{100 * g['idle_core']:.1f} % of a core",
-            f"over {idle_s:g} s with no passes")]
+            f"over {idle_s:g} s with no passes; by process: "
+            + ", ".join(f"{name} {100 * c:.1f} %" for name, c in g["idle_per_process"].items()))]
     for rate in rates:
         r = g[rate]
         out.append((f"live graph, {rate:g} passes/s arriving one at a time", f"{100 * r['core']:.0f} % of a core",

@@ -169,23 +169,24 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
     by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
     time order is read whole and sorted. Its measured pass-bys are measured's (a noise station's
     CSV or a bag), else a bag history's own. A run that fails leaves no output behind."""
-    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_events, read_measurements
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_inputs, read_measurements
 
     existed = folder.exists()
     try:
-        ms = read_measurements(measured, skip_bad_rows=skip_bad_rows) if measured else [] if salvage else \
-            read_measurements(source, history=True)
+        # A salvage recovers passes only; a CSV history has no surveys or measurements.
+        events, ms = ([], []) if salvage else read_bag_inputs(source, measurements=not measured)
+        if measured:
+            ms = read_measurements(measured, skip_bad_rows=skip_bad_rows)
         if not (salvage or is_csv(Path(source))):
             try:
-                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site,
-                                  read_bag_events(source), ms)
+                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms)
             except PassOrderError as exc:
                 note = f"{printable(str(source))}: {exc}; read whole to sort it"
                 _discard(folder, existed)
-                rec = _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, ms)
+                rec = _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, events, ms)
                 rec.notes.insert(0, note)
                 return rec
-        return _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, ms)
+        return _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, events, ms)
     except BaseException:
         _discard(folder, existed)
         raise
@@ -193,11 +194,10 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
 
 def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
            site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool,
-           measured: list[Measurement]) -> Recorded:
-    from rail_monitor.bagio.reader import read_bag_events, read_passes
+           events: list[MaintenanceEvent], measured: list[Measurement]) -> Recorded:
+    from rail_monitor.bagio.reader import read_passes
 
     passes = read_passes(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
-    events = [] if salvage else read_bag_events(source)  # a salvage recovers passes only
     notes = [printable(passes.salvage.line(source)), "surveys, grinding and the bag's measured noise are not "
              "salvaged"] if salvage else []
     skipped = getattr(passes, "skipped_rows", [])

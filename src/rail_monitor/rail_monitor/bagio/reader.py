@@ -190,6 +190,18 @@ def read_bag_events(path: str | Path) -> list[MaintenanceEvent]:
     return in_time_order([event_from_msg(m) for m in msgs])
 
 
+def read_bag_inputs(path: str | Path, measurements: bool = True) -> tuple[list[MaintenanceEvent], list[Measurement]]:
+    """What a history bag carries besides its passes, read together (one check of the bag, one
+    read of its file): the surveys and grinding events in stamp order and, with measurements,
+    the measured pass-bys by pass (as read_bag_events and read_measurements); none for a CSV."""
+    if is_csv(Path(path)):
+        return [], []
+    types = [ROUGHNESS_SURVEY, MEASURED_PASS_NOISE] if measurements else [ROUGHNESS_SURVEY]
+    msgs = read_messages(path, types)
+    return (in_time_order([event_from_msg(m) for m in msgs[ROUGHNESS_SURVEY]]),
+            sorted((measurement_from_msg(m) for m in msgs.get(MEASURED_PASS_NOISE, ())), key=lambda m: m.key))
+
+
 def read_measurements(path: str | Path, history: bool = False, skip_bad_rows: bool = False) -> list[Measurement]:
     """Measured pass-bys, by pass: a noise station's CSV (bagio.measured_csv; skip_bad_rows as
     there), or the MeasuredPassNoise messages (any topic) of a bag. history: path is a pass
