@@ -44,3 +44,26 @@ def test_a_late_topic_is_taken_and_an_idle_graph_never_wakes_discovery(ros_conte
         assert not tap._watcher.is_alive()
         other.destroy_node()
         node.destroy_node()
+
+
+def test_a_publisher_the_subscription_cannot_match_is_reported_by_the_one_event_handler(ros_context, monkeypatch):
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    seen: list[object] = []
+    monkeypatch.setattr(TopicTap, "_incompatible", lambda self, topic: seen.append)
+    node = rclpy.create_node("tap_qos_test", context=ros_context)
+    other = rclpy.create_node("tap_qos_publisher", context=ros_context)
+    other.create_publisher(RoughnessSurvey, "qos_survey", EVENT_QOS)  # reliable: the tap subscribes reliable
+    tap = TopicTap(node, [], 0.02, lambda *_: None, lambda *_: None)
+    try:
+        with spinning(ros_context, node, other):
+            assert wait_until(lambda: tap.subs.get("/qos_survey") is not None, timeout_s=10.0)
+            handlers = tap.subs["/qos_survey"].event_handlers
+            assert len(handlers) == 1  # rclpy's defaults would add an incompatible-type handler too
+            best_effort = QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT)
+            other.create_publisher(RoughnessSurvey, "qos_survey", best_effort)
+            assert wait_until(lambda: len(seen) > 0, timeout_s=10.0)
+    finally:
+        tap.close()
+        other.destroy_node()
+        node.destroy_node()

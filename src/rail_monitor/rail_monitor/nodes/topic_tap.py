@@ -16,10 +16,12 @@ from __future__ import annotations
 import importlib
 import threading
 from collections.abc import Callable
+from typing import Any
 
 from rclpy.callback_groups import MutuallyExclusiveCallbackGroup
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
-from rclpy.qos import QoSProfile
+from rclpy.qos import QoSProfile, qos_policy_name_from_kind
 
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.params import values_of
@@ -113,9 +115,19 @@ class TopicTap:
             typename = types[0]
             msg_type = import_type(typename)
             self._on_topic(topic, typename, offered)
+            # One QoS event handler, not rclpy's default two: every event handler is walked at each of
+            # the executor's wake-ups, and the type cannot clash (a topic of several types is not taken).
+            events = SubscriptionEventCallbacks(incompatible_qos=self._incompatible(topic), use_default_callbacks=False)
             self.subs[topic] = subscribe_batched(
                 node, msg_type, topic, lambda msgs, t=topic: self._on_messages(t, msgs), subscription_qos(offered),
-                TAKE_AT_ONCE, raw=True, callback_group=self.group)
+                TAKE_AT_ONCE, raw=True, callback_group=self.group, event_callbacks=events)
+
+    def _incompatible(self, topic: str) -> Callable[[Any], None]:
+        def warn(event: Any) -> None:
+            self.node.get_logger().warning(
+                f"a publisher of {topic} offers a QoS this subscription cannot match "
+                f"({qos_policy_name_from_kind(event.last_policy_kind)}); its messages are not taken")
+        return warn
 
 
 def import_type(typename: str) -> type:
