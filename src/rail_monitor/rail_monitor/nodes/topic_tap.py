@@ -6,7 +6,7 @@ as rosbag2 adapts it), and hands the serialised messages (CDR bytes, no decode) 
 
 The looking is done by a thread of its own, outside the executor: rclpy has no graph-change event,
 and a timer would wake the executor five times a second to rebuild its wait set (about 1 ms each
-in the recorder, 40 % of the idle graph's CPU), where a graph query costs a few tens of µs. The
+in the recorder, a third of the idle graph's CPU), where a graph query costs a few tens of µs. The
 thread wakes the executor (a guard condition) only when a wanted topic has a publisher and is not
 taken yet; subscribing stays in the executor, serialised with the message callbacks.
 """
