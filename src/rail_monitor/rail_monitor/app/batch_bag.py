@@ -169,14 +169,11 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
     by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
     time order is read whole and sorted. Its measured pass-bys are measured's (a noise station's
     CSV or a bag), else a bag history's own. A run that fails leaves no output behind."""
-    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_bag_inputs, read_measurements
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_history_inputs
 
     existed = folder.exists()
     try:
-        # A salvage recovers passes only; a CSV history has no surveys or measurements.
-        events, ms = ([], []) if salvage else read_bag_inputs(source, measurements=not measured)
-        if measured:
-            ms = read_measurements(measured, skip_bad_rows=skip_bad_rows)
+        events, ms = read_history_inputs(source, measured, skip_bad_rows, salvage)
         if not (salvage or is_csv(Path(source))):
             try:
                 return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms)

@@ -184,36 +184,40 @@ def read_messages(path: str | Path, typenames: Collection[str]) -> dict[str, lis
 def read_bag_events(path: str | Path) -> list[MaintenanceEvent]:
     """The roughness surveys and grinding events (rail_msgs/RoughnessSurvey, any topic) of a bag,
     in stamp order; none for a CSV history."""
-    if is_csv(Path(path)):
-        return []
-    msgs = read_messages(path, [ROUGHNESS_SURVEY])[ROUGHNESS_SURVEY]
-    return in_time_order([event_from_msg(m) for m in msgs])
+    return read_bag_inputs(path, measurements=False)[0]
 
 
-def read_bag_inputs(path: str | Path, measurements: bool = True) -> tuple[list[MaintenanceEvent], list[Measurement]]:
-    """What a history bag carries besides its passes, read together (one check of the bag, one
-    read of its file): the surveys and grinding events in stamp order and, with measurements,
-    the measured pass-bys by pass (as read_bag_events and read_measurements); none for a CSV."""
-    if is_csv(Path(path)):
-        return [], []
-    types = [ROUGHNESS_SURVEY, MEASURED_PASS_NOISE] if measurements else [ROUGHNESS_SURVEY]
-    msgs = read_messages(path, types)
-    return (in_time_order([event_from_msg(m) for m in msgs[ROUGHNESS_SURVEY]]),
-            sorted((measurement_from_msg(m) for m in msgs.get(MEASURED_PASS_NOISE, ())), key=lambda m: m.key))
-
-
-def read_measurements(path: str | Path, history: bool = False, skip_bad_rows: bool = False) -> list[Measurement]:
+def read_measurements(path: str | Path, skip_bad_rows: bool = False) -> list[Measurement]:
     """Measured pass-bys, by pass: a noise station's CSV (bagio.measured_csv; skip_bad_rows as
-    there), or the MeasuredPassNoise messages (any topic) of a bag. history: path is a pass
-    history, whose CSV holds passes, not measurements (then none)."""
+    there), or the MeasuredPassNoise messages (any topic) of a bag."""
     if is_csv(Path(path)):
-        if history:
-            return []
         from rail_monitor.bagio.measured_csv import read_measured_csv
 
         return sorted(read_measured_csv(path, skip_bad_rows), key=lambda m: m.key)
-    msgs = read_messages(path, [MEASURED_PASS_NOISE])[MEASURED_PASS_NOISE]
-    return sorted((measurement_from_msg(m) for m in msgs), key=lambda m: m.key)
+    return read_bag_inputs(path, events=False)[1]
+
+
+def read_bag_inputs(path: str | Path, events: bool = True, measurements: bool = True
+                    ) -> tuple[list[MaintenanceEvent], list[Measurement]]:
+    """What a history bag carries besides its passes, read together (one check of the bag, one
+    read of its file): its surveys and grinding events in stamp order, and its measured pass-bys
+    by pass (each only when asked for); none for a CSV history, which holds passes only."""
+    if is_csv(Path(path)):
+        return [], []
+    msgs = read_messages(path, [t for t, wanted in ((ROUGHNESS_SURVEY, events), (MEASURED_PASS_NOISE, measurements))
+                                if wanted])
+    return (in_time_order([event_from_msg(m) for m in msgs.get(ROUGHNESS_SURVEY, ())]),
+            sorted((measurement_from_msg(m) for m in msgs.get(MEASURED_PASS_NOISE, ())), key=lambda m: m.key))
+
+
+def read_history_inputs(source: str | Path, measured: str | Path | None = None, skip_bad_rows: bool = False,
+                        salvage: bool = False) -> tuple[list[MaintenanceEvent], list[Measurement]]:
+    """The surveys and grinding events and the measured pass-bys that go with a pass history: the
+    history bag's own (one read), the measurements from ``measured`` instead when given (a noise
+    station's CSV or a bag; skip_bad_rows as there). A salvage recovers passes only, so then none
+    of the history's own."""
+    events, own = ([], []) if salvage else read_bag_inputs(source, measurements=not measured)
+    return events, read_measurements(measured, skip_bad_rows) if measured else own
 
 
 def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,

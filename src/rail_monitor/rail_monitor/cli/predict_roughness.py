@@ -25,13 +25,11 @@ def add_parser(models: argparse._SubParsersAction) -> None:
 def run(ns: argparse.Namespace) -> int:
     from rail_monitor.app.batch import run_models
     from rail_monitor.app.indirect_roughness import indirect_of_run
-    from rail_monitor.bagio.reader import read_bag_inputs, read_measurements, read_passes
+    from rail_monitor.bagio.reader import read_history_inputs, read_passes
 
     values = site_values(ns.site)
     history = Path(ns.history)
-    events, measured = read_bag_inputs(history, measurements=not ns.measured)
-    if ns.measured:
-        measured = read_measurements(ns.measured)
+    events, measured = read_history_inputs(history, ns.measured)
     result = run_models(read_passes(history), values, events=events, measurements=measured)
     ind = indirect_of_run(result, values, ns.days)
     bands = [{"wavelength_m": float(ind.wavelength_m[k]), "indirect_db": float(ind.level_db[k]),

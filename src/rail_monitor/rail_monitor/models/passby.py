@@ -83,14 +83,15 @@ def _close(d: float, r: float) -> bool:
     return r * r - d * d < 1e-6 * d * d
 
 
-def kernel_antiderivative(x: ArrayLike, d: float, r: float, at_d: FloatArray | None = None) -> FloatArray:
-    """G(x) = integral of g from 0 to x [1/m] for horizontal distance d and path distance R [m].
-
-    at_d: _atan_over(x, d), when already computed for another path at the same x (the arctangents
-    are most of a pass-by's cost; each is computed once).
-    """
+def kernel_antiderivative(x: ArrayLike, d: float, r: float) -> FloatArray:
+    """G(x) = integral of g from 0 to x [1/m] for horizontal distance d and path distance R [m]."""
     x = np.asarray(x, float)
-    at_d = _atan_over(x, d) if at_d is None else at_d
+    return _antiderivative_with(x, d, r, _atan_over(x, d))
+
+
+def _antiderivative_with(x: FloatArray, d: float, r: float, at_d: FloatArray) -> FloatArray:
+    """G(x) given at_d = _atan_over(x, d), which the direct and image paths share at the same x
+    (the arctangents are most of a pass-by's cost; each is computed once)."""
     at_r = _atan_over(x, r)
     # R = d: d^2 / (d^2 + x^2)^2 integrates to x / (2 (d^2 + x^2)) + atan(x/d) / (2 d)
     broad = (0.5 * x / (d * d + x * x) + 0.5 * at_d if _close(d, r)
@@ -199,7 +200,7 @@ def _f_weighted_peak(c1: FloatArray, c2: FloatArray, length: FloatArray, speed: 
     tau = F_TIME_CONSTANT_S
     t = (np.arange(-6 * steps_per_tau, 3 * steps_per_tau + 1) / steps_per_tau) * tau
     s = 0.5 * length[:, None] + speed[:, None] * t[None, :]     # front position along the track [m]
-    g = kernel_antiderivative
+    g = _antiderivative_with
     rear = s - length[:, None]
     front_d, rear_d = _atan_over(s, d), _atan_over(rear, d)  # shared by the direct and image paths
     x = c1[:, None] * (g(s, d, r1, front_d) - g(rear, d, r1, rear_d)) \

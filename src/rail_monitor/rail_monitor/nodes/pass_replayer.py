@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from rail_monitor.bagio.reader import read_bag_inputs, read_measurements, read_passes
+from rail_monitor.bagio.reader import read_history_inputs, read_passes
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import REPLAYER_SPECS, ReplayerParams
 from rail_monitor.core.params import values_of
@@ -34,12 +34,8 @@ class PassReplayer(PassSourceNode):
             raise RailMonitorError("parameter 'source' is empty: give a bag or CSV path (-p source:=PATH)")
         self.skipped = 0
         self._table = self._load()  # read up front: a bad file fails before anything is published
-        given = self.src.measured_source
-        # A salvage: passes only (and the measurements of a station's file, when given).
-        self._events, self._measured = ([], []) if self.src.salvage else read_bag_inputs(self.src.source,
-                                                                                          measurements=not given)
-        if given:
-            self._measured = read_measurements(given, skip_bad_rows=self.src.skip_bad_rows)
+        self._events, self._measured = read_history_inputs(self.src.source, self.src.measured_source or None,
+                                                           self.src.skip_bad_rows, self.src.salvage)
         if self._events:
             self.advertise_events()
         if self._measured:
