@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_bands as cb
 
 T = cn.tables()
 
@@ -47,7 +48,7 @@ def test_hand_computed_band_disc_brake_class_e_monoblock_medium_pad():
     """
     _, a3 = cn.contact_filter(50e3, 0.92)
     lr = cn.total_roughness(cn.rail_roughness("E"), cn.wheel_roughness("disc"), a3)
-    lrf = cn.at_band_frequencies(lr, 20.0)
+    lrf = cb.at_band_frequencies(lr, 20.0)
     _, track = cn.track_transfer("monoblock", 400e6)
     _, veh = cn.vehicle_transfer(0.92)
     power = cn.rolling_sound_power(lrf, 4, track, veh)
@@ -58,36 +59,6 @@ def test_hand_computed_band_disc_brake_class_e_monoblock_medium_pad():
     assert power.vehicle[i] == pytest.approx(hand_lr + 94.9 + 10 * np.log10(4), abs=1e-9)
     assert power.superstructure[i] == pytest.approx(hand_lr + 10 * np.log10(4), abs=1e-9)
     assert power.track[i] == pytest.approx(98.202, abs=5e-4)
-
-
-@pytest.mark.parametrize("rule", cn.INTERPOLATION_RULES)
-def test_both_rules_reproduce_table_values_where_bands_fall_on_table_wavelengths(rule):
-    """At 20 m/s, v / f_i is a table wavelength for most nominal bands (e.g. 1 kHz -> 20 mm)."""
-    level = _col("rail_roughness_M_average_network")
-    out = cn.at_band_frequencies(level, 20.0, rule=rule)
-    lam = 20.0 / T.band_hz
-    on_grid = np.isclose(lam[:, None], T.wavelength_m[None, :], rtol=1e-12).any(axis=1)
-    assert on_grid.sum() >= 15
-    expected = np.interp(lam[on_grid], T.wavelength_m, level)
-    np.testing.assert_allclose(out[on_grid], expected, atol=1e-9)
-
-
-def test_rules_differ_between_table_wavelengths_and_hold_the_ends():
-    level = _col("rail_roughness_M_average_network")
-    # 31.5 m/s at 1 kHz: 31.5 mm, a node; 33 m/s: between 31.5 and 40 mm, where the rules part.
-    ref = cn.at_band_frequencies(level, 33.0, rule="reference")
-    energy = cn.at_band_frequencies(level, 33.0, rule="energy_log_frequency")
-    assert np.max(np.abs(ref - energy)) > 0.05
-    lo, hi = (0.0315, -0.8), (0.040, -0.3)
-    i = list(T.band_hz).index(1000)
-    w = (0.033 - lo[0]) / (hi[0] - lo[0])
-    assert ref[i] == pytest.approx(lo[1] + w * (hi[1] - lo[1]), abs=1e-9)
-    we = np.log(0.033 / lo[0]) / np.log(hi[0] / lo[0])
-    assert energy[i] == pytest.approx(10 * np.log10((1 - we) * 10 ** (lo[1] / 10) + we * 10 ** (hi[1] / 10)),
-                                      abs=1e-9)
-    # Beyond the grid (120 m/s at 50 Hz: 2.4 m) both hold the 2000 mm value.
-    for rule in cn.INTERPOLATION_RULES:
-        assert cn.at_band_frequencies(level, 120.0, rule=rule)[0] == pytest.approx(level[-1], abs=1e-9)
 
 
 def test_table_choices_follow_the_directive():
@@ -128,22 +99,3 @@ def test_directivity():
 def test_line_sound_power_of_a_flow():
     """eq. 2.3.1: 100 vehicles per hour at 100 km/h are one vehicle per km: -30 dB re one vehicle per metre."""
     assert cn.line_sound_power_db(100.0, 100.0, 100.0) == pytest.approx(70.0)
-
-
-def test_the_reference_rule_maps_each_table_before_combining():
-    # The European reference module maps each wavelength table to the band frequencies on its
-    # own (dB linear in wavelength, ends held) and combines per band. Independent method: np.interp
-    # of each table at lambda = v / f_i, then eq. 2.3.6 and 2.3.10 per band.
-    _, a3 = cn.contact_filter(50e3, 0.92)
-    rail, wheel, joints = cn.rail_roughness("E"), cn.wheel_roughness("cast_iron"), cn.impact_roughness(0.01)
-    for v in (10.0, 20.0, 33.3):
-        lam = v / T.band_hz
-        at = [np.interp(lam, T.wavelength_m, table) for table in (rail, wheel, a3, joints)]
-        filtered = 10 * np.log10(10 ** (at[0] / 10) + 10 ** (at[1] / 10)) + at[2]
-        want = 10 * np.log10(10 ** (filtered / 10) + 10 ** (at[3] / 10))
-        got = cn.band_roughness(rail, wheel, a3, v, impact_db=joints)
-        np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
-    # Combining on the wavelength grid first is not the same where the tables curve between
-    # grid points: a difference of order 0.1 dB in some band.
-    first = cn.at_band_frequencies(cn.total_roughness(rail, wheel, a3, joints), 20.0)
-    assert 0.01 < np.max(np.abs(first - cn.band_roughness(rail, wheel, a3, 20.0, impact_db=joints))) < 0.5

@@ -118,6 +118,7 @@ def speed_advisory_fields(advice: SpeedAdvice, stamp_ns: int, frame_id: str) -> 
 
 def rolling_noise_fields(p: NoisePrediction, i: int, header: Fields, train_id: str, receiver: Any) -> Fields:
     """Pass i of a NoisePrediction as RollingNoise fields (receiver: a models.passby.Receiver)."""
+    names, values = p.components(i)
     return {
         "header": header, "train_id": train_id, "model": p.model, "speed_mps": float(p.speed_mps[i]),
         "receiver_distance_m": float(receiver.distance_m), "receiver_height_m": float(receiver.height_m),
@@ -125,7 +126,7 @@ def rolling_noise_fields(p: NoisePrediction, i: int, header: Fields, train_id: s
         "roughness_db": p.roughness_db[i].tolist(), "pass_by_time_s": float(p.pass_by_time_s[i]),
         "lpaeq_tp_dba": float(p.lpaeq_tp_dba[i]), "lpafmax_dba": float(p.lpafmax_dba[i]),
         "tel_dba": float(p.tel_dba[i]), "roughness_growth_increase_db": float(p.roughness_growth_increase_db[i]),
-        "component_names": list(p.component_names), "component_lpaeq_dba": p.component_lpaeq_dba[i].tolist()}
+        "component_names": names, "component_lpaeq_dba": values}
 
 
 def wayside_alert_fields(alert: Alert, frame_id: str) -> Fields:

@@ -15,7 +15,8 @@ OVERRIDES = {"noise_model": "noise.model", "rail_roughness": "noise.rail_roughne
 
 
 def add_parser(models: argparse._SubParsersAction) -> None:
-    from rail_monitor.models.cnossos import INTERPOLATION_RULES, SLEEPER_TYPES
+    from rail_monitor.models.cnossos import SLEEPER_TYPES
+    from rail_monitor.models.cnossos_bands import INTERPOLATION_RULES
     from rail_monitor.noise.config import MODELS, ROUGHNESS_SOURCES
 
     r = models.add_parser("noise", help="rolling noise pass-by levels and spectra (CNOSSOS-EU and mechanics), "
@@ -65,8 +66,7 @@ def _print_table(r) -> None:
           "  components [dB(A)]")
     for (name, days), out in r.results.items():
         for i in range(len(r.speeds)):
-            comps = ", ".join(f"{c} {x:.1f}" for c, x in zip(out.component_names, out.component_lpaeq_dba[i],
-                                                             strict=True))
+            comps = ", ".join(f"{c} {x:.1f}" for c, x in zip(*out.components(i), strict=True))
             print(f"{name:>9} {days:6g} {r.speeds[i]:8.2f} {out.lpaeq_tp_dba[i]:9.1f} {out.lpafmax_dba[i]:8.1f} "
                   f"{out.tel_dba[i]:6.1f} {out.roughness_growth_increase_db[i]:14.1f}  {comps}")
 

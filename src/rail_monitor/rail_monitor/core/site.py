@@ -95,11 +95,15 @@ VEHICLE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("axles_per_vehicle", 4, "Axles per vehicle [-].", 1, 12),
     ParamSpec("wheel_diameter_m", 0.84, "Nominal wheel diameter [m].", 0.3, 1.5),
     ParamSpec("brake_type", "disc", "Brake type (sets wheel roughness).", choices=BRAKE_TYPES),
+    ParamSpec("freight", False, "Freight wagons: CNOSSOS-EU's superstructure term (eq. 2.3.9) is counted for "
+              "freight vehicles only."),
     ParamSpec("wheel_load_n", 60000.0, "Nominal static wheel load [N].", 1.0e3, 2.5e5),
     ParamSpec("unsprung_mass_kg", 600.0, "Unsprung mass per wheel (half a wheelset and what moves with it) "
               "[kg].", 50.0, 5000.0),
     ParamSpec("vehicle_length_m", 20.0, "Vehicle length over couplers [m].", 3.0, 40.0),
     ParamSpec("bogie_semi_wheelbase_m", 1.25, "Half the bogie wheelbase (axle to bogie centre) [m].", 0.3, 5.0),
+    ParamSpec("bogie_centre_distance_m", 14.0, "Distance between the vehicle's bogie centres [m]: where its axles "
+              "radiate in the pass-by (a moving point source per axle).", 0.0, 40.0),
     ParamSpec("traffic_share", 1.0, "Share of the site's trains of this class [-].", 0.0, 1.0),
     ParamSpec("vehicles_min", 3, "Fewest vehicles in a consist [-].", 1, 100),
     ParamSpec("vehicles_max", 6, "Most vehicles in a consist [-].", 1, 100),
@@ -125,10 +129,12 @@ class VehicleClass:
     axles_per_vehicle: int
     wheel_diameter_m: float
     brake_type: str
+    freight: bool
     wheel_load_n: float
     unsprung_mass_kg: float
     vehicle_length_m: float
     bogie_semi_wheelbase_m: float
+    bogie_centre_distance_m: float
     traffic_share: float
     vehicles_min: int
     vehicles_max: int
@@ -219,6 +225,9 @@ def site_from_values(values: Mapping[str, Any]) -> Site:
         v = VehicleClass(name=name, **resolve(VEHICLE_SPECS, section(values, prefix), where=prefix, strict=True))
         if v.vehicles_min > v.vehicles_max or v.speed_min_mps > v.speed_max_mps:
             raise ConfigError(f"vehicle class {name!r}: a minimum exceeds its maximum (vehicles or speed)")
+        if v.bogie_centre_distance_m + 2.0 * v.bogie_semi_wheelbase_m > v.vehicle_length_m:
+            raise ConfigError(f"vehicle class {name!r}: bogie_centre_distance_m + 2 bogie_semi_wheelbase_m exceeds "
+                              "vehicle_length_m (the axles must lie on the vehicle)")
         vehicles[name] = v
     if not vehicles:
         raise ConfigError("parameter 'vehicle_classes' names no vehicle class")

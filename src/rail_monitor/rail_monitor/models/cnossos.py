@@ -13,19 +13,9 @@ Per 1/3-octave band i (24 bands, nominal 50 Hz to 10 kHz), for one vehicle of N_
     L_W,0,VEH,i     = L_R,TOT,i + L_H,VEH,i + 10 lg N_ax                         (2.3.8)
     L_W,0,VEH,SUP,i = L_R,TOT,i + L_H,VEH,SUP,i + 10 lg N_ax                     (2.3.9)
 
-L_R,TOT,i is the wavelength spectrum read at lambda = v / f_i (v in m/s, f_i the nominal band
-centre). The Directive says only that the tables are "averaged energetically and
-proportionally"; two rules are offered (``INTERPOLATION_RULES``):
-
-* ``reference`` (default), the European reference module's: each table (rail roughness, wheel
-  roughness, contact filter, impact roughness) mapped to the band frequencies on its own, the
-  dB values interpolated linearly in wavelength, end values held outside the table, then
-  combined per band (:func:`band_roughness`);
-* ``energy_log_frequency``: the tables combined on the wavelength grid, then the energy
-  (10^(L/10)) interpolated linearly against lg(lambda), that is against lg(f), end values held.
-
-Mapping before or after combining differs where the tables curve between grid points: up to
-about 0.1 dB per band.
+L_R,TOT,i is the wavelength spectrum read at lambda = v / f_i (v in m/s). The Directive says only
+that the tables are "averaged energetically and proportionally"; the two rules that reproduce the
+two public implementations are in :mod:`rail_monitor.models.cnossos_bands`.
 
 Impact noise adds the joint roughness to L_R,TOT in energy: L_R,IMPACT = L_R,IMPACT-SINGLE +
 10 lg(n_l / 0.01), n_l joints per metre (2.3.10-2.3.11). A bridge adds L_R,TOT + L_H,BRIDGE +
@@ -62,7 +52,6 @@ from rail_monitor.models.levels import level, power
 FloatArray = NDArray[np.float64]
 
 EDITION = "2021"
-INTERPOLATION_RULES = ("reference", "energy_log_frequency")
 RAIL_ROUGHNESS_CLASSES = ("E", "M")
 BRAKE_TYPES = ("cast_iron", "composite", "disc")   # Table G-1a columns
 SLEEPER_TYPES = ("monoblock", "biblock", "wooden", "direct_fastening")
@@ -132,11 +121,25 @@ def rail_roughness(roughness_class: str) -> FloatArray:
     return tables().by_wavelength[names[roughness_class]]
 
 
-def wheel_roughness(brake_type: str) -> FloatArray:
-    """Wheel roughness [dB re 1 um] by brake type (cast_iron, composite, disc), Table G-1a."""
+def wheel_roughness(brake_type: str, rule: str = "reference") -> FloatArray:
+    """Wheel roughness [dB re 1 um] by brake type (cast_iron, composite, disc), Table G-1a, on the
+    tables' grid, as the interpolation rule's implementation holds it: the unrounded values to
+    0.01 dB (``reference``) or at the full precision of NoiseModelling's data (``noisemodelling``,
+    data/noisemodelling_wheel_roughness.csv; they differ by at most 0.005 dB)."""
     if brake_type not in BRAKE_TYPES:
         raise ValueError(f"brake type must be one of {BRAKE_TYPES}")
+    if rule == "noisemodelling":
+        return _noisemodelling_wheel_roughness()[brake_type]
     return tables().by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
+
+
+@lru_cache(maxsize=1)
+def _noisemodelling_wheel_roughness() -> dict[str, FloatArray]:
+    head, data = _read("noisemodelling_wheel_roughness.csv")
+    order = np.argsort(data[:, 0])
+    if not np.array_equal(data[order, 0] / 1e3, tables().wavelength_m):
+        raise ValueError("noisemodelling_wheel_roughness.csv: its wavelengths are not the tables' grid")
+    return {h: data[order, j] for j, h in enumerate(head) if j}
 
 
 def contact_filter(wheel_load_n: float, wheel_diameter_m: float) -> tuple[tuple[float, float], FloatArray]:
@@ -162,56 +165,6 @@ def total_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: 
     if impact_db is not None:
         total = level(power(total) + power(impact_db))
     return total
-
-
-def band_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike, speed_mps: ArrayLike,
-                   band_hz: ArrayLike | None = None, rule: str = "reference",
-                   impact_db: ArrayLike | None = None) -> FloatArray:
-    """L_R,TOT per band [dB re 1 um] (eqs. 2.3.6 and 2.3.10) at lambda = v / f_i: shape
-    speed.shape + (bands,). The wavelength tables are on the tables' grid (the rail roughness may
-    carry a leading axis per pass). ``reference`` maps each table to the bands and combines per
-    band; ``energy_log_frequency`` combines on the grid and maps the sum (module docstring)."""
-    if rule != "reference":
-        return at_band_frequencies(total_roughness(rail_db, wheel_db, contact_filter_db, impact_db), speed_mps,
-                                   band_hz, rule)
-    def at(table: ArrayLike) -> FloatArray:
-        return at_band_frequencies(table, speed_mps, band_hz, rule)
-
-    total = level(power(at(rail_db)) + power(at(wheel_db))) + at(contact_filter_db)
-    return total if impact_db is None else level(power(total) + power(at(impact_db)))
-
-
-def at_band_frequencies(level_db: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
-                        rule: str = "reference", wavelength_m: ArrayLike | None = None) -> FloatArray:
-    """A wavelength spectrum [dB] read at lambda = v / f_i: shape speed.shape + (bands,).
-
-    level_db: on ``wavelength_m`` (ascending; default the tables' grid), last axis; it may carry
-    leading axes matching speed (one spectrum per pass). band_hz: nominal band centres
-    (default the tables'). rule: one of INTERPOLATION_RULES (module docstring).
-    """
-    t = tables()
-    grid = t.wavelength_m if wavelength_m is None else np.asarray(wavelength_m, float)
-    f = t.band_hz if band_hz is None else np.asarray(band_hz, float)
-    speed = np.asarray(speed_mps, float)
-    lam = speed[..., None] / f                                        # [m]
-    lv = np.broadcast_to(np.asarray(level_db, float), speed.shape + grid.shape)
-    if rule == "reference":
-        x, xp, fp = lam, grid, lv
-    elif rule == "energy_log_frequency":
-        x, xp, fp = np.log(lam), np.log(grid), power(lv)
-    else:
-        raise ValueError(f"unknown interpolation rule {rule!r}; use one of {INTERPOLATION_RULES}")
-    out = _interp_rows(x, xp, fp)
-    return out if rule == "reference" else level(out)
-
-
-def _interp_rows(x: FloatArray, xp: FloatArray, fp: FloatArray) -> FloatArray:
-    """np.interp per row: x (..., m), fp (..., n) on one ascending xp (n,); ends held."""
-    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
-    w = np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
-    lo = np.take_along_axis(fp, j, axis=-1)
-    hi = np.take_along_axis(fp, j + 1, axis=-1)
-    return lo + w * (hi - lo)
 
 
 # -- transfer functions (frequency domain) ---------------------------------------------------------

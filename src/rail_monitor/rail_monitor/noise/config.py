@@ -11,6 +11,7 @@ import numpy as np
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.passby import Receiver
 
@@ -21,8 +22,9 @@ _CLASS_E = cn.rail_roughness("E")
 NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("model", "cnossos", "Source model of noise/rolling: CNOSSOS-EU (Directive 2015/996 as amended by "
               "2021/1226), the mechanics model, or both (one message per model).", choices=(*MODELS, "both")),
-    ParamSpec("interpolation", "reference", "Wavelength-to-frequency rule: the European reference module's (dB "
-              "linear in wavelength, ends held) or energy against lg frequency.", choices=cn.INTERPOLATION_RULES),
+    ParamSpec("interpolation", "reference", "Wavelength-to-frequency rule: the European reference module's (each "
+              "table mapped on its own, dB linear in wavelength, ends held) or NoiseModelling's (energy linear in lg f "
+              "on its grid, joints before the contact filter).", choices=cb.INTERPOLATION_RULES),
     ParamSpec("rail_roughness", "E", "Baseline rail roughness: class E (EN ISO 3095:2013), class M (CNOSSOS "
               "average network) or the measured spectrum below.", choices=ROUGHNESS_SOURCES),
     ParamSpec("rail_roughness_wavelength_m", cn.tables().wavelength_m.tolist(), "Wavelengths of the measured "
@@ -39,8 +41,11 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("receiver_distance_m", 7.5, "Horizontal distance of the receiver from the track centre [m].",
               0.5, 1000.0),
     ParamSpec("receiver_height_m", 1.2, "Receiver height above the rail head [m].", -10.0, 100.0),
-    ParamSpec("source_height_m", 0.05, "Height of the rolling-noise source line above the rail head [m] "
-              "(CNOSSOS source A).", 0.0, 5.0),
+    ParamSpec("source_height_m", 0.5, "Height of the rolling-noise source line above the rail head [m] "
+              "(CNOSSOS-EU source A, h = 1: 0.5 m, Directive 2015/996 Annex II 2.3.1).", 0.0, 5.0),
+    ParamSpec("pass_by_sources", "axles", "Sources of the pass-by levels: a moving point source per axle (ISO 3095's "
+              "moving train: LpAFmax sees the bogies) or a uniform line source of the train's length (about 1.2 dB "
+              "lower LpAFmax, the same TEL, and about 20x cheaper).", choices=("axles", "line")),
     ParamSpec("ground_reflection", 1.0, "Energy reflection coefficient of the ground [-] (1: hard, 0: free "
               "field).", 0.0, 1.0),
     ParamSpec("ground_depth_m", 0.0, "Depth of the reflecting ground plane below the rail head [m].", 0.0, 10.0),

@@ -34,9 +34,11 @@ from rail_monitor.core.contact import contact_state
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
+from rail_monitor.models.passby_axles import AxleLayout, axle_layout
 from rail_monitor.noise.config import MODELS, NoiseConfig, selected_models
 
 # What roughness_growth_increase_db is measured against, for every label that shows it.
@@ -84,6 +86,13 @@ class NoisePrediction:
 
     def __len__(self) -> int:
         return len(self.speed_mps)
+
+    def components(self, i: int) -> tuple[list[str], list[float]]:
+        """Pass i's source components and their LpAeq,Tp [dB(A)]: those its class has (the
+        superstructure term is for freight only), in component_names order."""
+        pairs = [(c, float(x)) for c, x in zip(self.component_names, self.component_lpaeq_dba[i], strict=True)
+                 if x > -np.inf]
+        return [c for c, _ in pairs], [x for _, x in pairs]
 
     def per_pass(self) -> dict[str, np.ndarray]:
         """The arrays over passes, by field name."""
@@ -136,13 +145,21 @@ class RollingNoiseModel:
             contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
             _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m)
             _, veh = cn.vehicle_transfer(v.wheel_diameter_m)
-            cnossos = {"track": track_db + self.squeal_db, "vehicle": veh + self.squeal_db,
-                       "superstructure": np.full(len(self.band), self.squeal_db)}
+            cnossos = {"track": track_db + self.squeal_db, "vehicle": veh + self.squeal_db}
+            if v.freight:  # L_H,VEH,SUP of Table G-3c: 0 dB, for freight vehicles only (eq. 2.3.9)
+                cnossos["superstructure"] = np.full(len(self.band), self.squeal_db)
             if self.bridge_db is not None:
                 cnossos["bridge"] = self.bridge_db
             mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
                                      v.wheel_diameter_m, cfg.radiators, cfg.band_points)
-            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type), a3, cnossos, mech)
+            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation), a3, cnossos, mech)
+
+    def component_names(self, model: str) -> list[str]:
+        """The model's source components over the site's classes, in a fixed order."""
+        names: dict[str, None] = {}
+        for terms in self.classes.values():
+            names.update(dict.fromkeys(terms.cnossos if model == "cnossos" else terms.mechanics))
+        return list(names)
 
     @property
     def models(self) -> tuple[str, ...]:
@@ -182,10 +199,10 @@ class RollingNoiseModel:
         out = np.empty((len(passes), len(self.band)))
         for name, rows in _class_rows(passes):
             speed = passes.speed_mps[rows]
-            on_rail = power(cn.at_band_frequencies(rail if rail.ndim == 1 else rail[rows], speed, self.band_hz))
+            on_rail = power(cb.at_band_frequencies(rail if rail.ndim == 1 else rail[rows], speed, self.band_hz))
             if self.impact_db is not None:
-                on_rail = on_rail + power(cn.at_band_frequencies(self.impact_db, speed, self.band_hz))
-            wheel = power(cn.at_band_frequencies(self.classes[name].wheel_db, speed, self.band_hz))
+                on_rail = on_rail + power(cb.at_band_frequencies(self.impact_db, speed, self.band_hz))
+            wheel = power(cb.at_band_frequencies(self.classes[name].wheel_db, speed, self.band_hz))
             out[rows] = on_rail / (on_rail + wheel)
         return out
 
@@ -199,12 +216,10 @@ class RollingNoiseModel:
         model = model or self.models[0]
         if model not in MODELS:
             raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
-        # The mechanics model's contact filter per pass (its own patch, from its wheel load): the same
-        # on both rails. CNOSSOS's is in its tables.
-        filter_db = None if model == "cnossos" else level(wrn.contact_filter_power(
-            passes.speed_mps, self.band, contact_state(self.site, passes).patch.a, self.cfg.band_points))
+        filter_db = self._filter_db(passes, model)
         roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filter_db)
-        geometry = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver)
+        geometry = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver,
+                                 self._axles(passes) if self.cfg.pass_by_sources == "axles" else None)
         pb = self._pass_by(components, geometry)
         names = list(components)
         growth = np.zeros(len(passes))
@@ -219,6 +234,32 @@ class RollingNoiseModel:
                                           for c in names], axis=-1),
             roughness_growth_increase_db=growth)
 
+    def vehicle_sound_power(self, passes: PassTable, model: str,
+                            corrugation: Corrugation | None = None) -> dict[str, np.ndarray]:
+        """L_W,0 per vehicle [dB re 1 pW] per source component (passes x bands): the power per
+        metre of train times the vehicle length (train length / vehicles); for CNOSSOS-EU the
+        Directive's L_W,0 of eqs. 2.3.7-2.3.9 and 2.3.14, to compare with another implementation."""
+        _, components = self._sources(self.rail_roughness_db(corrugation), passes, model,
+                                      self._filter_db(passes, model))
+        per_vehicle = 10.0 * np.log10(passes.train_length_m / passes.vehicle_count)[:, None]
+        return {c: lw + per_vehicle for c, lw in components.items()}
+
+    def _axles(self, passes: PassTable) -> AxleLayout:
+        """The axles of each pass's train (a point source each): its counts and length, the class's
+        bogies scaled to the pass's vehicle pitch."""
+        per = self.site.per_pass
+        ratio = per(passes.vehicle_class, "bogie_centre_distance_m") / per(passes.vehicle_class, "vehicle_length_m")
+        return axle_layout(passes.train_length_m, passes.vehicle_count, passes.axle_count, ratio,
+                           per(passes.vehicle_class, "bogie_semi_wheelbase_m"))
+
+    def _filter_db(self, passes: PassTable, model: str) -> np.ndarray | None:
+        """The mechanics model's contact filter level per pass (passes x bands; its own patch, from
+        its wheel load, the same on both rails); None for CNOSSOS, whose filter is in its tables."""
+        if model == "cnossos":
+            return None
+        return level(wrn.contact_filter_power(passes.speed_mps, self.band, contact_state(self.site, passes).patch.a,
+                                              self.cfg.band_points))
+
     def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str,
                  filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness [dB re 1 um] and sound power per metre of train per component
@@ -227,9 +268,9 @@ class RollingNoiseModel:
         n, nb = len(passes), len(self.band)
         per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
         roughness = np.empty((n, nb))
-        # Every component of the model, even with no passes (an empty history gives empty arrays).
-        terms = next(iter(self.classes.values()))
-        components = {c: np.full((n, nb), -np.inf) for c in (terms.cnossos if model == "cnossos" else terms.mechanics)}
+        # Every component of the model, even with no passes (an empty history gives empty arrays);
+        # one a class lacks stays -inf on its passes (NoisePrediction.components).
+        components = {c: np.full((n, nb), -np.inf) for c in self.component_names(model)}
         for name, rows in _class_rows(passes):
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
             lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
@@ -249,10 +290,10 @@ class RollingNoiseModel:
         """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
         rule = self.cfg.interpolation
         if model == "cnossos":
-            return cn.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
+            return cb.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
                                      self.impact_db), terms.cnossos
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
-        lr = cn.at_band_frequencies(combined, speed, self.band_hz, rule) + filter_db
+        lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule) + filter_db
         return lr, terms.mechanics
 
 

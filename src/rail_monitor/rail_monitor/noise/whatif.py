@@ -12,9 +12,20 @@ import numpy as np
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.passes import FRICTION_BY_NAME, MAX_SPEED_MPS, PassTable, with_class_defaults
 from rail_monitor.core.site import Site, VehicleClass, site_from_values
+from rail_monitor.models.passby import METRIC_DEFINITIONS
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import INCREASE_REFERENCE, Corrugation, NoisePrediction, RollingNoiseModel
 
+# What each spectrum of the JSON holds (bands: band_centre_hz).
+SPECTRUM_DEFINITIONS = {
+    "components_lpaeq_dba": "LpAeq,Tp of each source component alone [dB(A)] (CNOSSOS-EU's superstructure term "
+                            "for freight classes only)",
+    "lw0_per_vehicle_db": "sound power per vehicle per component and band [dB re 1 pW]: for CNOSSOS-EU L_W,0 of "
+                          "Directive 2015/996 Annex II eqs. 2.3.7-2.3.9 (2.3.14 for a bridge), no directivity",
+    "lw_db_per_m": "sound power per metre of train, all components [dB re 1 pW/m]",
+    "lp_db": "LpZeq,Tp per band at the receiver [dB re 20 uPa]",
+    "roughness_db": "combined effective roughness at the band frequencies [dB re 1 um]",
+}
 SINGLE_NUMBERS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "pass_by_time_s", "roughness_growth_increase_db")
 
 
@@ -29,6 +40,7 @@ class NoiseWhatIf:
     speeds: np.ndarray                  # [m/s]
     passes_per_day: float               # trains per day of the growth [1/day]
     results: dict[tuple[str, float], NoisePrediction]
+    sound_power: dict[tuple[str, float], dict[str, np.ndarray]]  # L_W,0 per vehicle by component [dB re 1 pW]
 
 
 def synthetic_passes(site: Site, cls: VehicleClass, speeds: np.ndarray, vehicles: int) -> PassTable:
@@ -79,22 +91,28 @@ def predict_noise(values: Mapping[str, Any], vehicle_class: str | None = None, s
     states = growth_states(values, site, cls, float(v[0]), growth_days, passes_per_day)
     results = {(name, days): model.predict(table, name, state) for name in model.models
                for days, state in states.items()}
+    sound_power = {(name, days): model.vehicle_sound_power(table, name, state) for name in model.models
+                   for days, state in states.items()}
     where = (f"site {site.site_id}, {cls.name} ({cls.brake_type} brakes, {n_vehicles} vehicles), rail "
              f"{model.cfg.rail_roughness}, {model.track_name}, receiver {model.receiver.distance_m:g} m / "
              f"{model.receiver.height_m:g} m")
-    return NoiseWhatIf(where, model, cls, n_vehicles, v, passes_per_day, results)
+    return NoiseWhatIf(where, model, cls, n_vehicles, v, passes_per_day, results, sound_power)
 
 
 def summary(r: NoiseWhatIf) -> dict[str, Any]:
     """The what-if as plain data (JSON): per model and growth, per pass its single numbers and spectra."""
-    def row(out: NoisePrediction, i: int) -> dict[str, Any]:
+    def row(key: tuple[str, float], i: int) -> dict[str, Any]:
+        out = r.results[key]
+        names, lpaeq = out.components(i)
         return {"speed_mps": float(r.speeds[i]), **{k: float(getattr(out, k)[i]) for k in SINGLE_NUMBERS},
-                "components_lpaeq_dba": dict(zip(out.component_names, out.component_lpaeq_dba[i].tolist(),
-                                                 strict=True)),
+                "components_lpaeq_dba": dict(zip(names, lpaeq, strict=True)),
+                "lw0_per_vehicle_db": {c: r.sound_power[key][c][i].tolist() for c in names},
                 "lp_db": out.lp_db[i].tolist(), "lw_db_per_m": out.lw_db[i].tolist(),
                 "roughness_db": out.roughness_db[i].tolist()}
 
     return {"where": r.where, "band_centre_hz": r.model.band_hz.tolist(),
+            "definitions": {**METRIC_DEFINITIONS, **SPECTRUM_DEFINITIONS,
+                            "roughness_growth_increase_db": f"LpAeq,Tp minus {INCREASE_REFERENCE}"},
             "roughness_growth_increase_reference": f"LpAeq,Tp minus {INCREASE_REFERENCE}", "results": [
-        {"model": name, "growth_days": days, "passes": [row(out, i) for i in range(len(r.speeds))]}
-        for (name, days), out in r.results.items()]}
+        {"model": name, "growth_days": days, "passes": [row((name, days), i) for i in range(len(r.speeds))]}
+        for (name, days) in r.results]}

@@ -1,0 +1,115 @@
+"""CNOSSOS-EU wavelength tables read at the band frequencies: the two interpolation rules.
+
+The Directive (2015/996, Annex II 2.3.2, with the corrigendum of OJ L 5, 10.1.2018) reads the
+wavelength spectra at lambda = v / f_i and says only that they are "averaged energetically and
+proportionally". Two public implementations read it differently, and each rule here reproduces
+one of them (tests/models/test_cnossos_bands.py):
+
+* ``reference`` (default), the European Commission's reference module: each table (rail
+  roughness, wheel roughness, contact filter A_3, impact roughness) is mapped to the nominal band
+  centres on its own, its dB values interpolated linearly in wavelength with the end values held
+  outside the table, and the mapped tables are combined per band (eqs. 2.3.6 and 2.3.10);
+* ``noisemodelling``, NoiseModelling's (Universite Gustave Eiffel, the open CNOSSOS-EU
+  implementation, class RailwayCnossos): rail, wheel and impact roughness are added in energy on
+  the wavelength grid, the contact filter added, and the energy 10^(L/10) interpolated linearly
+  in lg f. Its grid puts the table's row m (m = 33 for the 2000 mm row down to -1 for 0.8 mm) at
+  exactly 10^(m/10) mm, and it reads the bands at the exact base-ten centres 10^(x/10) kHz of
+  IEC 61260-1 (50.12 Hz, not 50 Hz). Bands below the grid's lowest frequency v / 1.995 m (above
+  100 m/s at 50 Hz) take the value of the second band that has one, as NoiseModelling fills them.
+  Bands above the grid's highest frequency v / 0.794 mm (below 7.94 m/s at 10 kHz), where
+  NoiseModelling has no value (NaN), hold the highest band that has one (our choice).
+
+The rules differ by up to about 1.6 dB per band where the contact filter falls steeply between
+grid points (1.25 kHz at 80 km/h), and up to 1.9 dB where the joints' roughness meets the filter,
+which NoiseModelling applies to the joints and the reference module does not (docs/models.md has
+the figure).
+
+References
+----------
+.. [1] Commission Directive (EU) 2015/996 of 19 May 2015 establishing common noise assessment methods
+   according to Directive 2002/49/EC, *Official Journal of the European Union* L 168, 1.7.2015,
+   Annex II section 2.3; corrigendum, OJ L 5, 10.1.2018.
+.. [2] NoiseModelling, Universite Gustave Eiffel and CNRS, https://github.com/Universite-Gustave-Eiffel/
+   NoiseModelling (module noisemodelling-emission, railway/cnossos).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rail_monitor.models.cnossos import tables
+from rail_monitor.models.iec61260 import band_index, exact_centre
+from rail_monitor.models.levels import level, power
+
+FloatArray = NDArray[np.float64]
+
+INTERPOLATION_RULES = ("reference", "noisemodelling")
+
+# NoiseModelling's wavelengths of the tables' rows, ascending as the tables are: 10^(m/10) mm, m = -1 ... 33.
+NOISEMODELLING_WAVELENGTH_M = 10.0 ** (np.arange(-1, 34) / 10.0) / 1e3
+
+
+def check_rule(rule: str) -> str:
+    if rule not in INTERPOLATION_RULES:
+        raise ValueError(f"unknown interpolation rule {rule!r}; use one of {INTERPOLATION_RULES}")
+    return rule
+
+
+def band_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike, speed_mps: ArrayLike,
+                   band_hz: ArrayLike | None = None, rule: str = "reference",
+                   impact_db: ArrayLike | None = None) -> FloatArray:
+    """L_R,TOT per band [dB re 1 um] (eqs. 2.3.6 and 2.3.10) at lambda = v / f_i: shape
+    speed.shape + (bands,). The tables are on the tables' grid (the rail roughness may carry a
+    leading axis per pass); band_hz: nominal band centres (default the tables'). The order of
+    operations is the rule's (module docstring)."""
+    if check_rule(rule) == "noisemodelling":
+        rough = power(rail_db) + power(wheel_db)
+        if impact_db is not None:
+            rough = rough + power(impact_db)
+        return at_band_frequencies(level(rough) + np.asarray(contact_filter_db, float), speed_mps, band_hz, rule)
+
+    def at(table: ArrayLike) -> FloatArray:
+        return at_band_frequencies(table, speed_mps, band_hz, rule)
+
+    total = level(power(at(rail_db)) + power(at(wheel_db))) + at(contact_filter_db)
+    return total if impact_db is None else level(power(total) + power(at(impact_db)))
+
+
+def at_band_frequencies(level_db: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
+                        rule: str = "reference") -> FloatArray:
+    """A spectrum on the tables' wavelength grid [dB], last axis (it may carry leading axes
+    matching speed, one spectrum per pass), read at lambda = v / f_i by the rule: shape
+    speed.shape + (bands,). band_hz: nominal band centres [Hz] (default the tables')."""
+    t = tables()
+    f = t.band_hz if band_hz is None else np.asarray(band_hz, float)
+    speed = np.asarray(speed_mps, float)
+    lv = np.broadcast_to(np.asarray(level_db, float), speed.shape + t.wavelength_m.shape)
+    if check_rule(rule) == "reference":
+        return _interp_rows(speed[..., None] / f, t.wavelength_m, lv)
+    # In u = lg f - lg v = -lg(lambda) the grid is one for every pass, ascending in frequency.
+    u_grid = -np.log10(NOISEMODELLING_WAVELENGTH_M[::-1])
+    u = np.log10(exact_centre(band_index(f))) - np.log10(speed)[..., None]
+    out = _interp_rows(u, u_grid, power(lv[..., ::-1]))
+    return level(_noisemodelling_fill(out, (u >= u_grid[0]) & (u <= u_grid[-1])))
+
+
+def _noisemodelling_fill(out: FloatArray, inside: NDArray[np.bool_]) -> FloatArray:
+    """Bands outside the grid: below it, the value of the second band inside (as NoiseModelling
+    fills them); above it, the highest band inside. ``inside`` is contiguous along the bands."""
+    if not inside.any(axis=-1).all():
+        raise ValueError("no 1/3-octave band falls within the CNOSSOS wavelength grid at this speed")
+    k = np.arange(out.shape[-1])
+    low = np.argmax(inside, axis=-1)[..., None]
+    high = out.shape[-1] - 1 - np.argmax(inside[..., ::-1], axis=-1)[..., None]
+    idx = np.where(k < low, np.minimum(low + 1, high), np.minimum(k, high))
+    return np.take_along_axis(out, idx, axis=-1)
+
+
+def _interp_rows(x: FloatArray, xp: FloatArray, fp: FloatArray) -> FloatArray:
+    """np.interp per row: x (..., m), fp (..., n) on one ascending xp (n,); ends held."""
+    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
+    w = np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
+    lo = np.take_along_axis(fp, j, axis=-1)
+    hi = np.take_along_axis(fp, j + 1, axis=-1)
+    return lo + w * (hi - lo)
