@@ -12,7 +12,7 @@ from bench.corrugation import passes
 from bench.timing import best_of, header, parser
 from rail_monitor.core.site import site_from_values
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
-from rail_monitor.noise.config import MODELS, noise_config
+from rail_monitor.noise.config import MODELS, PASS_BY_SOURCES, noise_config
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 from rail_monitor.site_file import load_parameter_file
 
@@ -51,10 +51,13 @@ def main() -> None:
         print(f"{name:>9}: per pass {1e3 * bare:6.2f} ms; with a corrugation state (two roughness cases) "
               f"{1e3 * grown:6.2f} ms")
     table = passes(site, ns.passes)
-    for name in MODELS:
-        t = best_of(lambda name=name: model.predict(table, name, state), 1)
-        print(f"{name:>9}: batch of {ns.passes} passes with a corrugation state {t:6.2f} s = "
-              f"{ns.passes / t:9.0f} passes/s")
+    # The pass-by sources in one run: the moving point sources per axle against the line source.
+    for sources in PASS_BY_SOURCES:
+        by = RollingNoiseModel(site, noise_config({**values, "noise.pass_by_sources": sources}))
+        for name in MODELS:
+            t = best_of(lambda name=name, by=by: by.predict(table, name, state), 1)
+            print(f"{name:>9}, {sources:>5} sources: batch of {ns.passes} passes with a corrugation state "
+                  f"{t:6.2f} s = {ns.passes / t:9.0f} passes/s")
 
 
 if __name__ == "__main__":

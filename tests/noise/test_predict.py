@@ -36,7 +36,7 @@ def model():
 def test_doubling_the_speed_adds_about_9_db(model, name, vehicle_class):
     """docs/models.md, "Rolling noise": rolling noise rises about 30 lg v, 9 dB per doubling (the UQ paper:
     up to 10 dB(A));
-    tolerance 1.5 dB, from 20 to 40 m/s (72 to 144 km/h). Measured: CNOSSOS 8.7 (EMU) and 9.3 (freight),
+    tolerance 1.5 dB, from 20 to 40 m/s (72 to 144 km/h). Measured: CNOSSOS 8.6 (EMU) and 9.3 (freight),
     mechanics 8.0 and 10.3. (Outside this range the mechanics model departs: its wheel has no modes, so
     for the cast-iron freight it saturates above 30 m/s; see the README.)"""
     out = model.predict(_passes(model.site, vehicle_class, [20.0, 40.0]), name)

@@ -92,39 +92,52 @@ def axle_layout(length_m: ArrayLike, vehicle_count: ArrayLike, axle_count: Array
     return AxleLayout(vehicles, pitch, offsets)
 
 
-def _sum_over_axles(layout: AxleLayout, first: NDArray[np.int64], count: NDArray[np.int64], term) -> FloatArray:
-    """sum over vehicles first ... first + count - 1 and their axles of term(offset behind the
-    front [m], shape (passes, 1)) -> (passes, ...), accumulated one axle at a time in a fixed
-    order, so that a pass's sum is the same bits whatever other passes share the call."""
-    total = None
+def _axle_offsets(layout: AxleLayout, first: NDArray[np.int64], count: NDArray[np.int64], width: int):
+    """The offsets behind the front [m] of the axles of vehicles first ... first + count - 1, in a
+    fixed order (vehicle, then axle), as blocks (passes, <= width), NaN where a pass has no axle."""
     k = layout.offsets_m.shape[1]
-    for j in range(int(count.max(initial=0))):
-        live = j < count
-        for i in range(k):
-            offset = (first + j) * layout.pitch_m + layout.offsets_m[:, i]
-            on = live & np.isfinite(offset)
-            value = term(np.where(on, offset, 0.0)[:, None])
-            if not on.all():
-                value = np.where(on[:, None], value, 0.0)
+    total = int(count.max(initial=0)) * k
+    for lo in range(0, total, width):
+        column = np.arange(lo, min(lo + width, total))
+        j, i = column // k, column % k
+        offset = (first[:, None] + j[None, :]) * layout.pitch_m[:, None] + layout.offsets_m[:, i]
+        offset[j[None, :] >= count[:, None]] = np.nan
+        yield offset
+
+
+def _sum_over_axles(layout: AxleLayout, first: NDArray[np.int64], count: NDArray[np.int64], term,
+                    width: int) -> FloatArray:
+    """sum over vehicles first ... first + count - 1 and their axles of term(offsets behind the
+    front [m], (passes, w)) -> (passes, w, ...), the term evaluated on up to width axles at once
+    and summed one axle at a time in a fixed order, so that a pass's sum is the same bits whatever
+    other passes share the call (the terms are elementwise)."""
+    total = None
+    for offset in _axle_offsets(layout, first, count, width):
+        on = np.isfinite(offset)
+        value = term(np.where(on, offset, 0.0))
+        if not on.all():
+            value = np.where(on.reshape(on.shape + (1,) * (value.ndim - 2)), value, 0.0)
+        for axle in range(value.shape[1]):
             if total is None:
-                total = value.copy()
+                total = value[:, axle].copy()
             else:
-                total += value
-    return np.zeros((len(count), 1)) if total is None else total
+                total += value[:, axle]
+    return np.zeros(len(count)) if total is None else total
 
 
 def window_kernel(layout: AxleLayout, length_m: ArrayLike, d: float, r: float) -> FloatArray:
     """Mean over the pass-by time of the kernel of the axles [1/m] (passes,): exact, every axle."""
     length = np.atleast_1d(np.asarray(length_m, float))
     out = np.empty(len(length))
-    order = np.argsort(layout.vehicles, kind="stable")   # blocks alike in vehicles: few idle iterations
+    order = np.argsort(layout.vehicles, kind="stable")   # blocks alike in vehicles: few idle columns
     for lo in range(0, len(length), PASS_CHUNK):
         part = order[lo:lo + PASS_CHUNK]
         sub = _take(layout, part)
         ell = length[part, None]
         both = _sum_over_axles(sub, np.zeros(len(part), np.int64), sub.vehicles,
-                               lambda s, ell=ell: kernel_antiderivative(ell - s, d, r) + kernel_antiderivative(s, d, r))
-        out[part] = (sub.pitch_m / sub.axles_per_vehicle) * np.asarray(both)[:, 0] / length[part]
+                               lambda s, ell=ell: kernel_antiderivative(ell - s, d, r) + kernel_antiderivative(s, d, r),
+                               max(1, HISTORY_ELEMENTS // len(part)))
+        out[part] = (sub.pitch_m / sub.axles_per_vehicle) * both / length[part]
     return out
 
 
@@ -183,12 +196,13 @@ def _history(c1: FloatArray, c2: FloatArray, layout: AxleLayout, length: FloatAr
     """The squared pressure (passes, samples) at the times t [s] after the train's middle passes
     (per pass, from 6 tau before): vehicles lo ... hi axle by axle, the rest as line segments."""
     front = 0.5 * length[:, None] + speed[:, None] * t                             # (passes, T) [m]
-    c1c, c2c, broad = c1[:, None], c2[:, None], _BROADSIDE * d * d
-    x2, g1, g2 = (np.empty_like(front) for _ in range(3))
+    c1c, c2c, broad = c1[:, None, None], c2[:, None, None], _BROADSIDE * d * d
 
     def pressure(s: FloatArray) -> FloatArray:
-        """c1 g1 + c2 g2 [1/m^2 x 4 pi] of an axle s behind the front, in place (the arrays are the cost)."""
-        np.subtract(front, s, out=x2)
+        """c1 g1 + c2 g2 [1/m^2 x 4 pi] (passes, w, T) of the axles s (passes, w) behind the front,
+        in place (the arrays are the cost)."""
+        x2 = np.subtract(front[:, None, :], s[:, :, None])
+        g1, g2 = np.empty_like(x2), np.empty_like(x2)
         np.square(x2, out=x2)
         np.divide(c1c, np.add(x2, r1 * r1, out=g1), out=g1)
         np.divide(c2c, np.add(x2, r2 * r2, out=g2), out=g2)
@@ -198,7 +212,7 @@ def _history(c1: FloatArray, c2: FloatArray, layout: AxleLayout, length: FloatAr
         return np.multiply(g1, x2, out=g1)
 
     weight = (layout.pitch_m / layout.axles_per_vehicle)[:, None] / (4.0 * np.pi)
-    total = weight * _sum_over_axles(layout, lo, hi - lo + 1, pressure)
+    total = weight * _sum_over_axles(layout, lo, hi - lo + 1, pressure, max(1, HISTORY_ELEMENTS // front.size))
     # The vehicles before lo and after hi, as the line segments they occupy.
     head_start = front - (lo * layout.pitch_m)[:, None]
     tail_start = front - ((hi + 1) * layout.pitch_m)[:, None]
