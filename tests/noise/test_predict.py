@@ -37,8 +37,7 @@ def test_doubling_the_speed_adds_about_9_db(model, name, vehicle_class):
     """docs/models.md, "Rolling noise": rolling noise rises about 30 lg v, 9 dB per doubling (the UQ paper:
     up to 10 dB(A));
     tolerance 1.5 dB, from 20 to 40 m/s (72 to 144 km/h). Measured: CNOSSOS 8.6 (EMU) and 9.3 (freight),
-    mechanics 8.0 and 10.3. (Outside this range the mechanics model departs: its wheel has no modes, so
-    for the cast-iron freight it saturates above 30 m/s; see the README.)"""
+    mechanics 8.3 and 9.4 (with the modal wheel).)"""
     out = model.predict(_passes(model.site, vehicle_class, [20.0, 40.0]), name)
     assert np.diff(out.lpaeq_tp_dba)[0] == pytest.approx(9.0, abs=1.5)
 
@@ -71,13 +70,15 @@ def test_rail_roughness_at_31_to_80_mm_raises_the_level_by_8_to_14_db(model, nam
     assert rise_ci[0] < rise[0] - 3.0
 
 
-def test_mechanics_and_cnossos_agree_within_a_few_dba(model):
-    """Same vehicle, track and roughness: the mechanics model is within 4 dB(A) of CNOSSOS-EU for the
-    disc-braked EMU on the site's track at 15-30 m/s (measured: about +2 to +3 dB(A); the rail transfer
-    agrees with Table G-3a within 3 dB from 630 Hz to 2.5 kHz, see the closing note)."""
-    passes = _passes(model.site, "emu", [15.0, 20.0, 30.0])
+@pytest.mark.parametrize("vehicle_class", ["emu", "dmu"])
+def test_mechanics_and_cnossos_agree_within_3_dba(model, vehicle_class):
+    """Same vehicle, track and roughness: the mechanics model (modal wheel) is within 3 dB(A) of
+    CNOSSOS-EU for the 840 mm-wheeled EMU and DMU on the site's track at 15-30 m/s (measured +2.1 to
+    +2.6 and +0.3 to +2.4 dB(A)). The cast-iron-braked freight wagon is +2.5 to +4.5 dB(A) (its rail
+    component; issue 18 open)."""
+    passes = _passes(model.site, vehicle_class, [15.0, 20.0, 30.0])
     gap = model.predict(passes, "mechanics").lpaeq_tp_dba - model.predict(passes, "cnossos").lpaeq_tp_dba
-    assert np.all(np.abs(gap) <= 4.0), gap
+    assert np.all(np.abs(gap) <= 3.0), gap
 
 
 def test_post_grinding_state_gives_no_increase_and_growth_raises_it(model):
@@ -221,3 +222,40 @@ def test_the_superstructure_term_is_for_freight_classes_only(model):
     assert names == ["track", "vehicle", "superstructure"] and np.all(np.isfinite(values))
     total = 10 * np.log10(np.sum(10 ** (np.asarray(out.components(0)[1]) / 10)))
     assert total == pytest.approx(out.lpaeq_tp_dba[0], abs=1e-9)
+
+
+def _class_components(model, vehicle_class, speeds):
+    lw = model.vehicle_sound_power(_passes(model.site, vehicle_class, speeds), "mechanics")
+    return {c: lw[c] for c in ("rail", "sleeper", "wheel")}
+
+
+@pytest.mark.parametrize("speed_kmh", [80.0, 120.0])
+def test_the_modal_wheel_gives_twins_shaped_component_spectra(model, speed_kmh):
+    """Thompson (2009), chapters 5-6 (TWINS results for a 920 mm wheel on ballasted track): the
+    sleepers dominate at low frequency, the rail from about 500 to 1600 Hz, the wheel above about
+    2 kHz. The site's freight wagon (920 mm wheels, the site's UIC60 track), per band: sleepers the
+    largest at 200-315 Hz, the rail at 500-1600 Hz, the wheel at 2-10 kHz. (At 400 Hz the wheel's
+    n = 2 axial mode, 369 Hz, stands out: a peak TWINS also shows, there from lateral excitation.)"""
+    lw = _class_components(model, "freight", [speed_kmh / 3.6])
+    band = model.band_hz
+    top = np.array(list(lw))[np.argmax(np.stack([v[0] for v in lw.values()]), axis=0)]
+    assert np.all(top[(band >= 200) & (band <= 315)] == "sleeper"), top
+    assert np.all(top[(band >= 500) & (band <= 1600)] == "rail"), top
+    assert np.all(top[band >= 2000] == "wheel"), top
+
+
+SPEED_LAW_CLASSES = ["dmu", pytest.param("emu", marks=pytest.mark.xfail(
+    strict=True, reason="emu: 30.3 lg v but 10.5 dB per doubling at 10-15 m/s (issue 18, open)")),
+    pytest.param("freight", marks=pytest.mark.xfail(
+        strict=True, reason="freight: 32.6 lg v and 10.8 dB per doubling at 15-20 m/s (issue 18, open)"))]
+
+
+@pytest.mark.parametrize("vehicle_class", SPEED_LAW_CLASSES)
+def test_the_mechanics_speed_law_is_25_to_32_lg_v(model, vehicle_class):
+    """Rolling noise grows 25-32 lg v (Thompson 2009, section 1.6: about 30 lg v) and at most 10 dB(A)
+    per doubling (the UQ paper) over 10-40 m/s: the least-squares slope in lg v, and each step."""
+    speeds = np.array([10.0, 15.0, 20.0, 30.0, 40.0])
+    out = model.predict(_passes(model.site, vehicle_class, speeds), "mechanics").lpaeq_tp_dba
+    slope = np.polyfit(np.log10(speeds), out, 1)[0]
+    assert 25.0 <= slope <= 32.0, slope
+    assert np.all(np.diff(out) / np.log2(speeds[1:] / speeds[:-1]) <= 10.0)

@@ -100,6 +100,9 @@ VEHICLE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("wheel_load_n", 60000.0, "Nominal static wheel load [N].", 1.0e3, 2.5e5),
     ParamSpec("unsprung_mass_kg", 600.0, "Unsprung mass per wheel (half a wheelset and what moves with it) "
               "[kg].", 50.0, 5000.0),
+    ParamSpec("wheel_damping_ratio", 1.0e-4, "Damping ratio of the wheel's modes with two or more nodal "
+              "diameters in the mechanics rolling-noise model [-] (1e-4: an untreated solid wheel; a wheel damper: "
+              "1e-3 to 1e-2).", 1.0e-6, 0.5),
     ParamSpec("vehicle_length_m", 20.0, "Vehicle length over couplers [m].", 3.0, 40.0),
     ParamSpec("bogie_semi_wheelbase_m", 1.25, "Half the bogie wheelbase (axle to bogie centre) [m].", 0.3, 5.0),
     ParamSpec("bogie_centre_distance_m", 14.0, "Distance between the vehicle's bogie centres [m]: where its axles "
@@ -132,6 +135,7 @@ class VehicleClass:
     freight: bool
     wheel_load_n: float
     unsprung_mass_kg: float
+    wheel_damping_ratio: float
     vehicle_length_m: float
     bogie_semi_wheelbase_m: float
     bogie_centre_distance_m: float

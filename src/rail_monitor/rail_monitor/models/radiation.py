@@ -39,8 +39,16 @@ def oscillating_cylinder(ka: ArrayLike) -> FloatArray:
     power normalised by the surface-averaged normal velocity, <v_n^2> = v^2 / 2. Limits:
     (pi / 2) (ka)^3 for ka << 1 (a line dipole), 1 for ka >> 1.
     """
+    return cylinder_mode(1, ka)
+
+
+def cylinder_mode(order: ArrayLike, ka: ArrayLike) -> FloatArray:
+    """sigma [-] of an infinitely long cylinder of radius a whose normal velocity varies as cos(n theta):
+    2 / (pi ka |H_n'(ka)|^2) (Junger & Feit 1986, section 4.7), normalised by the surface-averaged
+    mean square normal velocity (the theta average of cos^2 enters power and normalisation alike).
+    Tends to 1 above ka of about n, and falls as (ka)^(2n+1) below (n >= 1)."""
     x = np.asarray(ka, float)
-    return 2.0 / (np.pi * x * np.abs(h1vp(1, x)) ** 2)
+    return 2.0 / (np.pi * x * np.abs(h1vp(np.asarray(order), x)) ** 2)
 
 
 def baffled_piston(ka: ArrayLike) -> FloatArray:

@@ -5,11 +5,14 @@ J. Sound Vib. 161 (1993) 387-482; Thompson, Railway Noise and Vibration, Elsevie
 
 1. Combined roughness r (rail + wheel, mean square per band) through the contact filter |F|^2
    (models.contact_filter, band-averaged over the band's wavelengths lambda = v / f).
-2. Vertical velocities at the contact for a unit roughness between wheel and rail, with the
+2. Contact force and vertical velocities for a unit roughness between wheel and rail, with the
    wheel, rail and contact-spring receptances alpha_W, alpha_R, alpha_C = 1 / k_H:
 
-       v_R = i w alpha_R r / (alpha_W + alpha_R + alpha_C),
-       v_W = -i w alpha_W r / (alpha_W + alpha_R + alpha_C).
+       F = r / (alpha_W + alpha_R + alpha_C),  v_R = i w alpha_R F,  v_W = -i w alpha_W F,
+
+   alpha_W = -1 / (M w^2) + sum_n phi_n^2 / (w_n^2 - w^2 + 2 i zeta_n w_n w): the unsprung mass M
+   plus the wheel's flexible modes at the contact (models.wheel_modes, unit generalised mass,
+   phi_n the radial displacement at the contact).
 
 3. Radiated power per wheel-rail contact, W = rho0 c0 sigma S <v^2> (models.radiation):
    * rail: the vibration decays along the rail at the track decay rate Delta [dB/m]
@@ -19,17 +22,21 @@ J. Sound Vib. 161 (1993) 387-482; Thompson, Railway Noise and Vibration, Elsevie
    * sleepers: each rail seat moves with the rail times the seat's transmissibility
      (models.track.sleeper_transmissibility), summed over the seats under the decaying field,
      |v_R|^2 x 2 x 4.343 / (Delta d); radiation of a baffled piston of the half-sleeper's top area;
-   * wheel: rigid-body vertical motion of the wheel (the unsprung mass), radiated by its rim as
-     an oscillating cylinder of the wheel's radius and the rim's width.
+   * wheel: its rigid-body vertical motion (the unsprung mass), radiated by its rim as an
+     oscillating cylinder of the wheel's radius and the rim's width, plus each flexible mode's
+     axial and radial surface motion with the radiation efficiency of its far field's order
+     (modal_wheel_power).
 
 The result per axle (two contacts) is a transfer L_H,mech = 10 lg(W / r^2) [dB re 1 pW per
 (1 um)^2 of roughness], so that L_W = L_R,TOT + L_H,mech, the form of CNOSSOS-EU's eqs.
 2.3.7-2.3.8 and directly comparable to its tables. Transfers are band averages of the squared
-transfer over ``points`` log-spaced frequencies per band (resonances narrower than a band).
+transfer over ``points`` log-spaced frequencies per band (enough to resolve the wheel's
+resonances as the rail damps them: 400 per band converge to 0.3 dB).
 
-Not modelled (and why the wheel component is a lower bound): the wheel's own modes (for
-0.84-0.92 m wheels, the axial and radial modes above about 1.5 kHz that dominate TWINS's wheel
-noise), lateral rail and wheel motion, and shielding by the vehicle body.
+Not modelled: lateral rail and wheel motion and the lateral contact force (which excite the
+axial modes more than the vertical force's offset does: TWINS's wheel is louder, above all
+below 2 kHz), the wheel's rotation (which splits each mode in two), and shielding by the
+vehicle body.
 
 References
 ----------
@@ -51,10 +58,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rail_monitor.models import radiation, track
+from rail_monitor.models import wheel_modes as wm
 from rail_monitor.models.contact_filter import hertzian_line_filter
 from rail_monitor.models.iec61260 import G, exact_centre
 
 FloatArray = NDArray[np.float64]
+ComplexArray = NDArray[np.complex128]
 COMPONENTS = ("rail", "sleeper", "wheel")
 NEPER_DB = 20.0 * np.log10(np.e)   # 8.686 dB per neper: decay rate [dB/m] = 8.686 Im(k)
 
@@ -124,23 +133,71 @@ def wheel_power(v2: ArrayLike, frequency: ArrayLike, diameter_m: float, rim_widt
     return radiation.radiated_power(np.asarray(v2) / 2.0, 2.0 * np.pi * radius * rim_width_m, sigma)
 
 
+def modal_damping(nodal_diameters: ArrayLike, ratio_n2: float = 1.0e-4) -> FloatArray:
+    """Damping ratio per wheel mode [-]: 1e-2 for n = 0 and 1e-3 for n = 1 (modes coupled to the
+    axle), ratio_n2 for n >= 2 (1e-4 for an untreated solid wheel; a wheel damper raises it) - the
+    values used with TWINS (Thompson 2009, section 5.2)."""
+    n = np.asarray(nodal_diameters)
+    return np.select([n == 0, n == 1], [max(1.0e-2, ratio_n2), max(1.0e-3, ratio_n2)], ratio_n2)
+
+
+def modal_terms(frequency: ArrayLike, modes: wm.WheelModes, damping: ArrayLike) -> ComplexArray:
+    """phi_c / (w_n^2 - w^2 + 2 i zeta_n w_n w) per mode [1/(kg^1/2 s^-2)]: shape frequency.shape + (modes,).
+    The modal coordinate per unit contact force; times phi_c and summed, the receptance."""
+    w = 2.0 * np.pi * np.asarray(frequency, float)[..., None]
+    wn = 2.0 * np.pi * modes.frequency_hz
+    return modes.contact_radial / (wn**2 - w**2 + 2j * np.asarray(damping) * wn * w)
+
+
+def modal_wheel_power(force2: ArrayLike, frequency: ArrayLike, modes: wm.WheelModes, terms: ComplexArray
+                      ) -> FloatArray:
+    """Power [W] radiated by the wheel's flexible modes under a contact force of squared amplitude
+    force2 [N2]: per mode rho0 c0 w^2 |q_n|^2 / 2 (sigma_ax A_ax + sigma_rad A_rad), with the modal
+    coordinate q_n = terms F, A the mode's squared axial and radial displacements integrated over
+    the wheel's exterior (models.wheel_modes), and sigma the radiation efficiency of a cylinder of
+    the wheel's radius with the far field's order: n + 1 for axial motion (a disc moving axially is
+    a dipole at n = 0) and n for radial motion (n = 1 is the rigid wheel's cross motion). Modes
+    add in power (cross terms between modes of one n neglected: resonances 1e-4 wide)."""
+    f = np.asarray(frequency, float)[..., None]
+    n = modes.nodal_diameters
+    sigma = radiation.cylinder_mode(np.arange(n.max() + 2), radiation.wavenumber(f) * modes.rolling_radius_m)
+    surface = sigma[..., n + 1] * modes.axial_surface + sigma[..., n] * modes.radial_surface
+    w2 = (2.0 * np.pi * f) ** 2
+    return radiation.RHO_C * np.asarray(force2) * np.sum(w2 * np.abs(terms) ** 2 * surface, axis=-1) / 2.0
+
+
 def axle_transfer(band: ArrayLike, trk: track.Track, unsprung_mass_kg: float, contact_stiffness_npm: float,
                   wheel_diameter_m: float, radiators: Radiators = Radiators(), points: int = 5,
-                  beam: str = "timoshenko") -> dict[str, FloatArray]:
+                  beam: str = "timoshenko", modes: wm.WheelModes | None = None,
+                  wheel_damping_ratio: float = 1.0e-4) -> dict[str, FloatArray]:
     """L_H,mech per component [dB re 1 pW per (1 um)^2 of roughness] for one axle (two contacts).
 
     Speed-independent: with L_R,TOT [dB re 1 um] (filtered), L_W = L_R,TOT + L_H,mech per axle.
+    modes: the wheel's flexible modes (models.wheel_modes; None: a rigid wheel), with
+    wheel_damping_ratio for those with two or more nodal diameters (modal_damping). ``points``
+    per band must resolve the wheel's resonances as the rail couples them (about 400).
     """
     f = band_frequencies(band, points)
     alpha_r = track.continuous_receptance(f, trk, beam)
-    alpha_w = track.wheel_receptance(f, unsprung_mass_kg)
-    vr2, vw2 = contact_velocity_ratios(f, alpha_r, alpha_w, contact_stiffness_npm)
+    alpha_rigid = track.wheel_receptance(f, unsprung_mass_kg)
+    if modes is None:
+        terms = None
+        alpha_w = alpha_rigid
+    else:
+        terms = modal_terms(f, modes, modal_damping(modes.nodal_diameters, wheel_damping_ratio))
+        alpha_w = alpha_rigid + np.sum(terms * modes.contact_radial, axis=-1)
+    vr2, _ = contact_velocity_ratios(f, alpha_r, alpha_w, contact_stiffness_npm)
+    force2 = np.abs(1.0 / (alpha_r + alpha_w + 1.0 / contact_stiffness_npm)) ** 2   # |F / r|^2 [N2/m2]
+    wheel = wheel_power(force2 * np.abs(2.0 * np.pi * f * alpha_rigid) ** 2, f, wheel_diameter_m,
+                        radiators.wheel_rim_width_m)
+    if terms is not None:
+        wheel = wheel + modal_wheel_power(force2, f, modes, terms)
     decay = np.maximum(track.decay_rate(f, trk, beam), 1e-3)
     per_contact = {
         "rail": rail_power(vr2, f, decay, radiators.rail_radius_m),
         "sleeper": sleeper_power(vr2, f, decay, track.sleeper_transmissibility(f, trk), trk.sleeper_spacing_m,
                                  radiators.sleeper_area_m2),
-        "wheel": wheel_power(vw2, f, wheel_diameter_m, radiators.wheel_rim_width_m),
+        "wheel": wheel,
     }
     # W per unit r^2 [W/m2] -> dB: r^2 re (1 um)^2 and W re 1 pW cancel (1e-12 both).
     return {name: 10.0 * np.log10(2.0 * np.mean(w, axis=-1)) for name, w in per_contact.items()}

@@ -55,7 +55,12 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("sleeper_area_m2", wrn.Radiators.sleeper_area_m2, "Mechanics: radiating top area of a half sleeper "
               "[m2].", 0.0, 5.0),
     ParamSpec("wheel_rim_width_m", wrn.Radiators.wheel_rim_width_m, "Mechanics: wheel rim width [m].", 0.01, 0.5),
-    ParamSpec("band_points", 5, "Mechanics: frequencies per 1/3-octave band for band averages [-].", 1, 50),
+    ParamSpec("band_points", 5, "Mechanics: frequencies per 1/3-octave band for the contact filter's band "
+              "average per pass [-].", 1, 50),
+    ParamSpec("transfer_points", 400, "Mechanics: frequencies per 1/3-octave band for the speed-independent "
+              "transfers, resolving the wheel's resonances (400 converge to 0.3 dB) [-].", 5, 5000),
+    ParamSpec("wheel", "modal", "Mechanics: the wheel as its unsprung mass plus its flexible modes (axisymmetric "
+              "finite elements of the class's wheel diameter) or as a rigid mass.", choices=("modal", "rigid")),
 )
 
 

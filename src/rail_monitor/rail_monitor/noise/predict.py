@@ -25,16 +25,19 @@ per band.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.contact import contact_state
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import wheel_modes as wm
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
@@ -150,8 +153,10 @@ class RollingNoiseModel:
                 cnossos["superstructure"] = np.full(len(self.band), self.squeal_db)
             if self.bridge_db is not None:
                 cnossos["bridge"] = self.bridge_db
+            modes = wheel_modes(v.wheel_diameter_m) if cfg.wheel == "modal" else None
             mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
-                                     v.wheel_diameter_m, cfg.radiators, cfg.band_points)
+                                     v.wheel_diameter_m, cfg.radiators, cfg.transfer_points, modes=modes,
+                                     wheel_damping_ratio=v.wheel_damping_ratio)
             self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation), a3, cnossos, mech)
 
     def component_names(self, model: str) -> list[str]:
@@ -295,6 +300,14 @@ class RollingNoiseModel:
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule) + filter_db
         return lr, terms.mechanics
+
+
+def wheel_modes(diameter_m: float) -> wm.WheelModes:
+    """The flexible modes of the representative wheel of this diameter (models.wheel_modes), kept in
+    the on-disk cache: their finite-element solution takes about 0.6 s per wheel."""
+    section = wm.WheelSection.scaled(diameter_m)
+    arrays = cached_arrays("wheel_modes", dataclasses.asdict(section), lambda: wm.wheel_modes(section).arrays())
+    return wm.WheelModes(*(np.array(arrays[k]) for k in wm.MODE_ARRAYS), section.rolling_radius_m)
 
 
 def _class_rows(passes: PassTable) -> Iterator[tuple[str, np.ndarray]]:
