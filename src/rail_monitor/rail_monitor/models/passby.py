@@ -6,7 +6,8 @@ track centre line, of uniform directional sound power W' per metre (dB re 1 pW/m
 h_s above the rail head, moving at speed v. Each element radiates as a point source in free
 field over a flat reflecting ground: the direct path and an image in the ground plane (at
 ground_depth below the rail head), added in energy with the ground's energy reflection
-coefficient Q (1: hard; 0: free field). Spherical spreading uses CNOSSOS-EU's convention
+coefficient Q (1: hard; 0: free field; or per band |Q|^2 of a porous ground's spherical-wave
+reflection, models.ground). Spherical spreading uses CNOSSOS-EU's convention
 Lp = L_W - 10 lg(4 pi r^2) (Directive 2015/996 Annex II 2.5.6, A_div = 20 lg d + 11; it takes
 rho c = 400 rayl). The horizontal directivity is CNOSSOS-EU's for rolling noise,
 D(phi) = 0.01 + 0.99 sin^2 phi (Annex II eq. 2.3.15), phi the angle in plan between the track
@@ -43,6 +44,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rail_monitor.models.ground import spherical_reflection
+from rail_monitor.models.iec61260 import exact_centre
 from rail_monitor.models.levels import a_weighted, level, power
 
 if TYPE_CHECKING:
@@ -76,6 +79,16 @@ class Receiver:
     source_height_m: float = 0.5
     ground_depth_m: float = 0.0
     ground_reflection: float = 1.0
+    ground_flow_resistivity_pa_s_m2: float = 0.0   # > 0: a porous ground (models.ground) instead
+
+    def image_weight(self, band: ArrayLike) -> float | FloatArray:
+        """Energy weight of the image path: ground_reflection, or for a porous ground |Q|^2 per
+        band (models.ground.spherical_reflection at the band's exact centre)."""
+        if self.ground_flow_resistivity_pa_s_m2 <= 0.0:
+            return self.ground_reflection
+        _, (r2, psi) = self.paths()
+        q = spherical_reflection(exact_centre(band), self.ground_flow_resistivity_pa_s_m2, r2, -psi)
+        return np.abs(q) ** 2
 
     def paths(self) -> tuple[tuple[float, float], tuple[float, float]]:
         """(perpendicular distance R [m], elevation angle psi [rad]) of the direct and image paths."""
@@ -171,7 +184,7 @@ class PassGeometry:
     total1: float        # kernel total of the direct path [1/m]
     total2: float        # of the image path [1/m]
     a_weight: FloatArray  # A-weighting of each band as a power ratio [-]
-    ground_reflection: float
+    ground_reflection: float | FloatArray   # energy weight of the image path, scalar or per band
     axles: AxleLayout | None = None  # point sources per axle (models.passby_axles); None: a line source
 
 
@@ -190,7 +203,7 @@ def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, re
         k1, k2 = passby_axles.window_kernel(axles, length, d, r1), passby_axles.window_kernel(axles, length, d, r2)
     return PassGeometry(length, np.atleast_1d(np.asarray(speed_mps, float)), d, r1, r2, k1[:, None], k2[:, None],
                         kernel_total(d, r1), kernel_total(d, r2), power(a_weighted(0.0, band)),
-                        receiver.ground_reflection, axles)
+                        receiver.image_weight(band), axles)
 
 
 def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike,

@@ -49,6 +49,10 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
               "lower LpAFmax, the same TEL; a batch about 1.5x faster).", choices=PASS_BY_SOURCES),
     ParamSpec("ground_reflection", 1.0, "Energy reflection coefficient of the ground [-] (1: hard, 0: free "
               "field).", 0.0, 1.0),
+    ParamSpec("ground_flow_resistivity_kpa_s_m2", 0.0, "Flow resistivity of a porous ground [kPa s/m2]: the image "
+              "path then weighs |Q|^2 per band, Q the spherical-wave reflection coefficient with Delany-Bazley's "
+              "impedance (about 200: grass-covered soil; 20-80: loose ballast); 0: ground_reflection instead.",
+              0.0, 1.0e6),
     ParamSpec("ground_depth_m", 0.0, "Depth of the reflecting ground plane below the rail head [m].", 0.0, 10.0),
     ParamSpec("rail_radius_m", float(wrn.Radiators.rail_radius_m), "Mechanics: radius of the cylinder radiating "
               "like the rail's vertical motion [m].", 0.01, 1.0),
@@ -80,7 +84,7 @@ def band_centres_hz() -> np.ndarray:
 
 def _receiver(self) -> Receiver:
     return Receiver(self.receiver_distance_m, self.receiver_height_m, self.source_height_m, self.ground_depth_m,
-                    self.ground_reflection)
+                    self.ground_reflection, 1.0e3 * self.ground_flow_resistivity_kpa_s_m2)
 
 
 def _radiators(self) -> wrn.Radiators:
