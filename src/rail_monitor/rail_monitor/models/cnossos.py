@@ -1,10 +1,19 @@
-"""CNOSSOS-EU railway source model: rolling, impact, bridge and curve-squeal sound power.
+"""CNOSSOS-EU railway source model: rolling, impact, bridge, curve-squeal, traction and
+aerodynamic sound power, directivity and line source power.
 
 Commission Directive (EU) 2015/996, Annex II section 2.3 (the source model for railway
 traffic), corrected by the corrigendum of OJ L 5, 10.1.2018 (f = v / lambda with v in m/s), as
 amended by Commission Delegated Directive (EU) 2021/1226 (new Tables G-1b, G-2, G-3a, G-4 and
-G-7). The tables of Appendix G are the package's data files ``data/cnossos_eu_2021_*.csv``
-(edition 2021, with their citation). Equation numbers are the Directive's.
+G-7). Two editions of Appendix G are data files of the package, each with its citation:
+
+* ``2021`` (default), ``data/cnossos_eu_2021_*.csv``: the tables in force;
+* ``2015``, ``data/cnossos_eu_2015_*.csv``: the tables of Directive 2015/996 at the precision of
+  the database they were printed from, the European Commission's CNOSSOS-EU reference source
+  module (its catalogues; traction at constant speed and idling apart), with the 2015 text's
+  scalar bridge constant, the absolute value of the vertical directivity of source A, and only
+  the 920 mm / 50 kN contact filter.
+
+Equation numbers are the Directive's.
 
 Per 1/3-octave band i (24 bands, nominal 50 Hz to 10 kHz), for one vehicle of N_ax axles:
 
@@ -22,8 +31,17 @@ Impact noise adds the joint roughness to L_R,TOT in energy: L_R,IMPACT = L_R,IMP
 10 lg N_ax (2.3.14). Curve squeal adds 8 dB to the rolling-noise power for R <= 300 m and 5 dB
 for 300 m < R <= 500 m (2.3.2, "squeal"). Directivity: horizontal 10 lg(0.01 + 0.99 sin^2 phi)
 (2.3.15); vertical, for source A (h = 1) above the source, 40/3 [2/3 sin(2 psi) - sin psi]
-lg((f + 600) / 200) (2.3.16). Sound power per metre of line for a flow of Q
-vehicles per hour at v km/h: L_W',eq,line = L_W,0,dir + 10 lg(Q / (1000 v)) (2.3.1).
+lg((f + 600) / 200) (2.3.16), in the 2015 text its absolute value at every psi; none for
+source B. Traction (Table G-5) and aerodynamic noise (Table G-6, above 200 km/h: L_W,0,1 +
+alpha lg(v / v0)) are given per vehicle at the source heights A (0.5 m) and B (4 m). Sound power
+per metre of line for a flow of Q vehicles per hour at v km/h: L_W',eq,line = L_W,0,dir +
+10 lg(Q / (1000 v)) (2.3.1); a vehicle idling T_idle per T_ref, spread over a line of length l:
+L_W,0,dir + 10 lg(T_idle / T_ref) - 10 lg(l / 1 m).
+
+The European Commission's emission test workbook for the reference module (CNOSSOS_RAIL_EMISSION_
+TEST.xlsx, Stapelfeldt Ingenieurgesellschaft for the JRC, 2014) is reproduced by edition 2015 with
+the ``reference`` rule to its printed 0.01 dB (tests/models/test_cnossos_workbook.py); its idling
+rows imply l = 1200 m for T_idle = T_ref.
 
 References
 ----------
@@ -51,7 +69,8 @@ from rail_monitor.models.levels import level, power
 
 FloatArray = NDArray[np.float64]
 
-EDITION = "2021"
+EDITIONS = ("2015", "2021")
+DEFAULT_EDITION = "2021"
 RAIL_ROUGHNESS_CLASSES = ("E", "M")
 BRAKE_TYPES = ("cast_iron", "composite", "disc")   # Table G-1a columns
 SLEEPER_TYPES = ("monoblock", "biblock", "wooden", "direct_fastening")
@@ -59,6 +78,9 @@ PAD_CLASSES = ("soft", "medium", "hard")
 BRIDGE_TYPES = ("none", "concrete", "steel")
 # Table G-3a pad classes by dynamic stiffness [N/m]: soft 150-250, medium 250-800, hard 800-1000 MN/m.
 PAD_CLASS_UPPER_NPM = (250e6, 800e6)
+SOURCE_HEIGHTS = {"A": 0.5, "B": 4.0}   # above the rail head [m], Annex II 2.3.1 (h = 1 and h = 2)
+RUNNING_CONDITIONS = ("constant", "idling")
+AERODYNAMIC_ONSET_KMH = 200.0           # aerodynamic noise is taken into account above this speed (2.3.2)
 
 
 def _read(name: str) -> tuple[list[str], FloatArray]:
@@ -69,9 +91,10 @@ def _read(name: str) -> tuple[list[str], FloatArray]:
 
 @dataclass(frozen=True)
 class Tables:
-    """Appendix G of the 2021 edition. Wavelength tables on an ascending wavelength grid [m];
+    """Appendix G of one edition. Wavelength tables on an ascending wavelength grid [m];
     frequency tables on the 24 nominal band centres (band numbers x of IEC 61260-1)."""
 
+    edition: str
     wavelength_m: FloatArray
     by_wavelength: dict[str, FloatArray]
     band: NDArray[np.int64]
@@ -94,16 +117,44 @@ class Tables:
         return {float(n.removeprefix("vehicle_wheel_").removesuffix("mm")) / 1e3: c
                 for n, c in self.by_frequency.items() if n.startswith("vehicle_wheel_")}
 
+    @property
+    def traction_types(self) -> tuple[str, ...]:
+        """The vehicle types of Table G-5 in this edition."""
+        names = (n.removeprefix("traction_").rsplit("_", 2)[0] for n in self.by_frequency if n.startswith("traction_"))
+        return tuple(dict.fromkeys(names))
 
-@lru_cache(maxsize=1)
-def tables() -> Tables:
-    """The Appendix G tables (read once)."""
-    head, data = _read("cnossos_eu_2021_wavelength.csv")
+    def column(self, name: str, what: str) -> FloatArray:
+        """A table column by name; a one-line error naming the edition where it has none."""
+        found = self.by_frequency.get(name, self.by_wavelength.get(name))
+        if found is None:
+            raise ValueError(f"CNOSSOS-EU edition {self.edition} has no {what}")
+        return found
+
+
+def check_edition(edition: str) -> str:
+    if edition not in EDITIONS:
+        raise ValueError(f"unknown CNOSSOS-EU edition {edition!r}; use one of {EDITIONS}")
+    return edition
+
+
+def check_rule_edition(rule: str, edition: str) -> str:
+    """The interpolation rule, refused where its implementation has no tables of the edition."""
+    if rule == "noisemodelling" and check_edition(edition) != "2021":
+        raise ValueError("the noisemodelling interpolation rule reads the 2021 edition's tables only")
+    return rule
+
+
+@lru_cache(maxsize=len(EDITIONS))
+def tables(edition: str = DEFAULT_EDITION) -> Tables:
+    """The Appendix G tables of an edition (read once)."""
+    check_edition(edition)
+    head, data = _read(f"cnossos_eu_{edition}_wavelength.csv")
     order = np.argsort(data[:, 0])
     by_wl = {h: data[order, j] for j, h in enumerate(head) if j}
-    fhead, fdata = _read("cnossos_eu_2021_frequency.csv")
-    return Tables(wavelength_m=data[order, 0] / 1e3, by_wavelength=by_wl, band=band_index(fdata[:, 0]),
-                  band_hz=fdata[:, 0], by_frequency={h: fdata[:, j] for j, h in enumerate(fhead) if j})
+    fhead, fdata = _read(f"cnossos_eu_{edition}_frequency.csv")
+    return Tables(edition=edition, wavelength_m=data[order, 0] / 1e3, by_wavelength=by_wl,
+                  band=band_index(fdata[:, 0]), band_hz=fdata[:, 0],
+                  by_frequency={h: fdata[:, j] for j, h in enumerate(fhead) if j})
 
 
 def printed_wheel_roughness() -> tuple[FloatArray, dict[str, FloatArray]]:
@@ -113,24 +164,25 @@ def printed_wheel_roughness() -> tuple[FloatArray, dict[str, FloatArray]]:
 
 
 # -- roughness and contact filter (wavelength domain) --------------------------------------------
-def rail_roughness(roughness_class: str) -> FloatArray:
-    """Rail roughness [dB re 1 um] of class E (EN ISO 3095:2013) or M (average network), Table G-1b."""
+def rail_roughness(roughness_class: str, edition: str = DEFAULT_EDITION) -> FloatArray:
+    """Rail roughness [dB re 1 um] of class E (EN ISO 3095:2013) or M (average network), Table G-1b
+    (G-1 in 2015)."""
     names = {"E": "rail_roughness_E_iso3095", "M": "rail_roughness_M_average_network"}
     if roughness_class not in names:
         raise ValueError(f"rail roughness class must be one of {RAIL_ROUGHNESS_CLASSES}")
-    return tables().by_wavelength[names[roughness_class]]
+    return tables(edition).by_wavelength[names[roughness_class]]
 
 
-def wheel_roughness(brake_type: str, rule: str = "reference") -> FloatArray:
+def wheel_roughness(brake_type: str, rule: str = "reference", edition: str = DEFAULT_EDITION) -> FloatArray:
     """Wheel roughness [dB re 1 um] by brake type (cast_iron, composite, disc), Table G-1a, on the
     tables' grid, as the interpolation rule's implementation holds it: the unrounded values to
     0.01 dB (``reference``) or at the full precision of NoiseModelling's data (``noisemodelling``,
     data/noisemodelling_wheel_roughness.csv; they differ by at most 0.005 dB)."""
     if brake_type not in BRAKE_TYPES:
         raise ValueError(f"brake type must be one of {BRAKE_TYPES}")
-    if rule == "noisemodelling":
+    if check_rule_edition(rule, edition) == "noisemodelling":
         return _noisemodelling_wheel_roughness()[brake_type]
-    return tables().by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
+    return tables(edition).by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
 
 
 @lru_cache(maxsize=1)
@@ -142,20 +194,22 @@ def _noisemodelling_wheel_roughness() -> dict[str, FloatArray]:
     return {h: data[order, j] for j, h in enumerate(head) if j}
 
 
-def contact_filter(wheel_load_n: float, wheel_diameter_m: float) -> tuple[tuple[float, float], FloatArray]:
+def contact_filter(wheel_load_n: float, wheel_diameter_m: float,
+                   edition: str = DEFAULT_EDITION) -> tuple[tuple[float, float], FloatArray]:
     """A_3 [dB] of Table G-2 for the nearest (load, diameter) entry in lg(load) and lg(diameter).
 
-    The table gives five cases; the nearest is taken, diameter first (the filter scales with the
-    contact length, which grows with both). Returns the entry and its column.
+    The 2021 table gives five cases; the nearest is taken, diameter first (the filter scales with
+    the contact length, which grows with both). Edition 2015 here holds the 920 mm / 50 kN entry
+    only. Returns the entry and its column.
     """
-    entries = tables().contact_filters
+    entries = tables(edition).contact_filters
     key = min(entries, key=lambda k: (abs(np.log(k[1] / wheel_diameter_m)), abs(np.log(k[0] / wheel_load_n))))
     return key, entries[key]
 
 
-def impact_roughness(joints_per_m: float) -> FloatArray:
+def impact_roughness(joints_per_m: float, edition: str = DEFAULT_EDITION) -> FloatArray:
     """L_R,IMPACT [dB re 1 um] for a joint density n_l [1/m] (eq. 2.3.11; table for 1 per 100 m)."""
-    return tables().by_wavelength["impact_single_joint_per_100m"] + 10.0 * np.log10(joints_per_m / 0.01)
+    return tables(edition).by_wavelength["impact_single_joint_per_100m"] + 10.0 * np.log10(joints_per_m / 0.01)
 
 
 def total_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike,
@@ -174,9 +228,10 @@ def pad_class(pad_stiffness_npm: float) -> str:
     return "soft" if pad_stiffness_npm < soft else "medium" if pad_stiffness_npm <= medium else "hard"
 
 
-def track_transfer(sleeper_type: str, pad_stiffness_npm: float) -> tuple[str, FloatArray]:
+def track_transfer(sleeper_type: str, pad_stiffness_npm: float,
+                   edition: str = DEFAULT_EDITION) -> tuple[str, FloatArray]:
     """L_H,TR [dB per axle] (Table G-3a) for a sleeper type and pad stiffness: (column, values)."""
-    by_f = tables().by_frequency
+    t = tables(edition)
     if sleeper_type == "wooden":
         name = "track_wooden_sleepers"
     elif sleeper_type == "direct_fastening":
@@ -185,24 +240,25 @@ def track_transfer(sleeper_type: str, pad_stiffness_npm: float) -> tuple[str, Fl
         name = f"track_{sleeper_type}_{pad_class(pad_stiffness_npm)}_pad"
     else:
         raise ValueError(f"sleeper type must be one of {SLEEPER_TYPES}")
-    return name, by_f[name]
+    return name, t.column(name, f"track transfer for sleeper type {sleeper_type}")
 
 
-def vehicle_transfer(wheel_diameter_m: float) -> tuple[float, FloatArray]:
+def vehicle_transfer(wheel_diameter_m: float, edition: str = DEFAULT_EDITION) -> tuple[float, FloatArray]:
     """L_H,VEH [dB per axle] (Table G-3b) of the nearest tabulated wheel diameter: (diameter [m], values)."""
-    entries = tables().vehicle_transfers
+    entries = tables(edition).vehicle_transfers
     key = min(entries, key=lambda dia: abs(np.log(dia / wheel_diameter_m)))
     return key, entries[key]
 
 
-def bridge_transfer(bridge_type: str) -> FloatArray | None:
-    """L_H,BRIDGE [dB per axle] (Table G-7), or None without a bridge."""
+def bridge_transfer(bridge_type: str, edition: str = DEFAULT_EDITION) -> FloatArray | None:
+    """L_H,BRIDGE [dB per axle] (Table G-7 of 2021), or None without a bridge. The 2015 text has a
+    scalar bridge constant instead (rolling_sound_power's bridge_constant_db)."""
     columns = {"concrete": "bridge_concrete_plus10dBA", "steel": "bridge_steel_ballasted_plus15dBA"}
     if bridge_type == "none":
         return None
     if bridge_type not in columns:
         raise ValueError(f"bridge type must be one of {BRIDGE_TYPES}")
-    return tables().by_frequency[columns[bridge_type]]
+    return tables(edition).column(columns[bridge_type], "bridge transfer table (the 2015 text adds a constant)")
 
 
 # -- sound power ---------------------------------------------------------------------------------
@@ -232,22 +288,46 @@ def curve_squeal_db(curve_radius_m: float) -> float:
 
 def rolling_sound_power(total_roughness_f_db: ArrayLike, axles_per_vehicle: ArrayLike, track_db: ArrayLike,
                         vehicle_db: ArrayLike, superstructure_db: ArrayLike = 0.0, bridge_db: ArrayLike | None = None,
-                        squeal_db: float = 0.0) -> SourcePower:
+                        squeal_db: float = 0.0, bridge_constant_db: float = 0.0) -> SourcePower:
     """L_W,0 per vehicle [dB re 1 pW] of track, vehicle and superstructure (eqs. 2.3.7-2.3.9), and
     the bridge (2.3.14), from L_R,TOT at the band frequencies [dB re 1 um] (passes x bands).
 
-    squeal_db (curve_squeal_db) is added to the rolling components, not to the bridge.
+    squeal_db (curve_squeal_db) is added to the rolling components, not to the bridge; so is the
+    2015 text's scalar bridge constant C_bridge (bridge_constant_db), as the reference module adds it.
     """
     lr = np.asarray(total_roughness_f_db, float)
     axles = 10.0 * np.log10(np.asarray(axles_per_vehicle, float))[..., None] if np.ndim(axles_per_vehicle) \
         else 10.0 * np.log10(float(axles_per_vehicle))
     base = lr + axles
+    excess = squeal_db + bridge_constant_db
     return SourcePower(
-        track=base + np.asarray(track_db, float) + squeal_db,
-        vehicle=base + np.asarray(vehicle_db, float) + squeal_db,
-        superstructure=base + np.asarray(superstructure_db, float) + squeal_db,
+        track=base + np.asarray(track_db, float) + excess,
+        vehicle=base + np.asarray(vehicle_db, float) + excess,
+        superstructure=base + np.asarray(superstructure_db, float) + excess,
         bridge=None if bridge_db is None else base + np.asarray(bridge_db, float),
     )
+
+
+def vehicle_sound_power(rolling: SourcePower, traction_type: str | None, speed_kmh: ArrayLike,
+                        condition: str = "constant",
+                        edition: str = DEFAULT_EDITION) -> dict[str, dict[str, FloatArray]]:
+    """L_W,0 per vehicle [dB re 1 pW] by source height and component (2.3.1-2.3.2): at A (h = 1)
+    the rolling components (superstructure included, as the reference module places it), the
+    bridge, traction and aerodynamic noise; at B (h = 2) traction and aerodynamic noise. An idling
+    vehicle has traction noise only; no traction type, no traction noise. Arrays passes x bands."""
+    if condition not in RUNNING_CONDITIONS:
+        raise ValueError(f"running condition must be one of {RUNNING_CONDITIONS}")
+    out: dict[str, dict[str, FloatArray]] = {"A": {}, "B": {}}
+    if condition == "constant":
+        out["A"].update(rolling.components())
+    for source, comps in out.items():
+        if traction_type is not None:
+            comps["traction"] = np.broadcast_to(traction_sound_power(traction_type, source, condition, edition),
+                                                np.shape(rolling.track))
+        if condition == "constant":
+            comps["aerodynamic"] = np.broadcast_to(aerodynamic_sound_power(speed_kmh, source, edition),
+                                                   np.shape(rolling.track))
+    return out
 
 
 def horizontal_directivity_db(phi_rad: ArrayLike) -> FloatArray:
@@ -255,19 +335,73 @@ def horizontal_directivity_db(phi_rad: ArrayLike) -> FloatArray:
     return 10.0 * np.log10(0.01 + 0.99 * np.sin(np.asarray(phi_rad, float)) ** 2)
 
 
-def vertical_directivity_a_db(psi_rad: ArrayLike, frequency_hz: ArrayLike) -> FloatArray:
-    """Delta L_W,dir,ver of source A (h = 1) [dB] (eq. 2.3.16): 0 at or below the source's height,
-    40/3 [2/3 sin(2 psi) - sin psi] lg((f + 600) / 200) above it (psi > 0).
+def vertical_directivity_a_db(psi_rad: ArrayLike, frequency_hz: ArrayLike,
+                              edition: str = DEFAULT_EDITION) -> FloatArray:
+    """Delta L_W,dir,ver of source A (h = 1) [dB] (eq. 2.3.16), 40/3 [2/3 sin(2 psi) - sin psi]
+    lg((f + 600) / 200):
 
-    Signed as printed: slightly positive up to psi = acos(3/4) = 41 degrees, negative above (the
-    vehicle body shields steep paths). The open implementation NoiseModelling reads it the same way.
+    * 2021: as printed above the source (psi > 0), 0 at or below it: slightly positive up to
+      psi = acos(3/4) = 41 degrees, negative above (the vehicle body shields steep paths). The open
+      implementation NoiseModelling reads it the same way.
+    * 2015: its absolute value at every psi, as the reference module computes it (the emission test
+      workbook's rows at psi = +-45 degrees differ from the signed form by up to 1.7 dB).
     """
     psi = np.asarray(psi_rad, float)
     f = np.asarray(frequency_hz, float)
     shape = 40.0 / 3.0 * (2.0 / 3.0 * np.sin(2.0 * psi) - np.sin(psi)) * np.log10((f + 600.0) / 200.0)
+    if check_edition(edition) == "2015":
+        return np.abs(shape)
     return np.where(psi > 0.0, shape, 0.0)
+
+
+def directivity_db(source: str, phi_rad: ArrayLike, psi_rad: ArrayLike, frequency_hz: ArrayLike,
+                   edition: str = DEFAULT_EDITION) -> FloatArray:
+    """Delta L_W,dir,hor + Delta L_W,dir,ver [dB] of source A or B (eqs. 2.3.15-2.3.16); source B
+    has no vertical term (the workbook's rows at psi = 45 degrees carry none)."""
+    hor = horizontal_directivity_db(phi_rad)[..., None]
+    if _check_source(source) == "B":
+        return hor + np.zeros_like(np.asarray(frequency_hz, float))
+    return hor + vertical_directivity_a_db(np.asarray(psi_rad, float)[..., None], frequency_hz, edition)
+
+
+def _check_source(source: str) -> str:
+    if source not in SOURCE_HEIGHTS:
+        raise ValueError(f"source height must be one of {tuple(SOURCE_HEIGHTS)}")
+    return source
+
+
+def traction_sound_power(traction_type: str, source: str, condition: str = "constant",
+                         edition: str = DEFAULT_EDITION) -> FloatArray:
+    """L_W,0 per vehicle [dB re 1 pW] of traction noise (Table G-5), 24 bands, at source A or B,
+    at constant speed or idling. The 2021 table gives one spectrum for both conditions."""
+    t = tables(edition)
+    if traction_type not in t.traction_types:
+        raise ValueError(f"traction type must be one of {t.traction_types} (edition {edition})")
+    if condition not in RUNNING_CONDITIONS:
+        raise ValueError(f"running condition must be one of {RUNNING_CONDITIONS}")
+    name = f"traction_{traction_type}_{condition}_{_check_source(source)}"
+    if name not in t.by_frequency:
+        name = f"traction_{traction_type}_constant_{source}"
+    return t.by_frequency[name]
+
+
+def aerodynamic_sound_power(speed_kmh: ArrayLike, source: str, edition: str = DEFAULT_EDITION,
+                            v0_kmh: float = 300.0, alpha: float = 50.0) -> FloatArray:
+    """L_W,0 per vehicle [dB re 1 pW] of aerodynamic noise (Table G-6): L_W,0,1 + alpha lg(v / v0)
+    above 200 km/h, -inf (no power) at or below it: shape speed.shape + (24,)."""
+    v = np.asarray(speed_kmh, float)[..., None]
+    spectrum = tables(edition).by_frequency[f"aerodynamic_{_check_source(source)}_300kmh"]
+    with np.errstate(divide="ignore"):
+        return np.where(v > AERODYNAMIC_ONSET_KMH, spectrum + alpha * np.log10(v / v0_kmh), -np.inf)
 
 
 def line_sound_power_db(lw0_dir_db: ArrayLike, vehicles_per_hour: float, speed_kmh: float) -> FloatArray:
     """L_W',eq,line [dB re 1 pW/m] of a steady flow (eq. 2.3.1): L_W,0,dir + 10 lg(Q / (1000 v))."""
     return np.asarray(lw0_dir_db, float) + 10.0 * np.log10(vehicles_per_hour / (1000.0 * speed_kmh))
+
+
+def idling_line_sound_power_db(lw0_dir_db: ArrayLike, idle_fraction: float, line_length_m: float) -> FloatArray:
+    """L_W',eq,line [dB re 1 pW/m] of a vehicle idling a fraction T_idle / T_ref of the reference time,
+    its power spread over a line of line_length_m (2.3.1): L_W,0,dir + 10 lg(T_idle / T_ref) -
+    10 lg(l / 1 m). The reference module's workbook spreads it over 1200 m."""
+    return np.asarray(lw0_dir_db, float) + 10.0 * np.log10(idle_fraction / line_length_m)

@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rail_monitor.models.cnossos import tables
+from rail_monitor.models.cnossos import DEFAULT_EDITION, check_rule_edition, tables
 from rail_monitor.models.iec61260 import band_index, exact_centre
 from rail_monitor.models.levels import level, power
 
@@ -50,42 +50,42 @@ INTERPOLATION_RULES = ("reference", "noisemodelling")
 NOISEMODELLING_WAVELENGTH_M = 10.0 ** (np.arange(-1, 34) / 10.0) / 1e3
 
 
-def check_rule(rule: str) -> str:
+def check_rule(rule: str, edition: str = DEFAULT_EDITION) -> str:
     if rule not in INTERPOLATION_RULES:
         raise ValueError(f"unknown interpolation rule {rule!r}; use one of {INTERPOLATION_RULES}")
-    return rule
+    return check_rule_edition(rule, edition)
 
 
 def band_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike, speed_mps: ArrayLike,
                    band_hz: ArrayLike | None = None, rule: str = "reference",
-                   impact_db: ArrayLike | None = None) -> FloatArray:
+                   impact_db: ArrayLike | None = None, edition: str = DEFAULT_EDITION) -> FloatArray:
     """L_R,TOT per band [dB re 1 um] (eqs. 2.3.6 and 2.3.10) at lambda = v / f_i: shape
     speed.shape + (bands,). The tables are on the tables' grid (the rail roughness may carry a
     leading axis per pass); band_hz: nominal band centres (default the tables'). The order of
-    operations is the rule's (module docstring)."""
-    if check_rule(rule) == "noisemodelling":
+    operations is the rule's (module docstring); the grid is the edition's."""
+    if check_rule(rule, edition) == "noisemodelling":
         rough = power(rail_db) + power(wheel_db)
         if impact_db is not None:
             rough = rough + power(impact_db)
         return at_band_frequencies(level(rough) + np.asarray(contact_filter_db, float), speed_mps, band_hz, rule)
 
     def at(table: ArrayLike) -> FloatArray:
-        return at_band_frequencies(table, speed_mps, band_hz, rule)
+        return at_band_frequencies(table, speed_mps, band_hz, rule, edition)
 
     total = level(power(at(rail_db)) + power(at(wheel_db))) + at(contact_filter_db)
     return total if impact_db is None else level(power(total) + power(at(impact_db)))
 
 
 def at_band_frequencies(level_db: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
-                        rule: str = "reference") -> FloatArray:
+                        rule: str = "reference", edition: str = DEFAULT_EDITION) -> FloatArray:
     """A spectrum on the tables' wavelength grid [dB], last axis (it may carry leading axes
     matching speed, one spectrum per pass), read at lambda = v / f_i by the rule: shape
     speed.shape + (bands,). band_hz: nominal band centres [Hz] (default the tables')."""
-    t = tables()
+    t = tables(edition)
     f = t.band_hz if band_hz is None else np.asarray(band_hz, float)
     speed = np.asarray(speed_mps, float)
     lv = np.broadcast_to(np.asarray(level_db, float), speed.shape + t.wavelength_m.shape)
-    if check_rule(rule) == "reference":
+    if check_rule(rule, edition) == "reference":
         return _interp_rows(speed[..., None] / f, t.wavelength_m, lv)
     # In u = lg f - lg v = -lg(lambda) the grid is one for every pass, ascending in frequency.
     u_grid = -np.log10(NOISEMODELLING_WAVELENGTH_M[::-1])
