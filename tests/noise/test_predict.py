@@ -211,6 +211,42 @@ def test_the_sites_cnossos_power_per_vehicle_is_the_directives_l_w0(site_values,
             assert np.all(got["superstructure"][0] == -np.inf)
 
 
+def test_a_site_on_the_2015_edition_takes_that_editions_terms(site_values):
+    # The site's L_W,0 under edition 2015 is the 2015 models' (tables, bridge constant on every rolling
+    # component, absolute vertical directivity); the reference module's arithmetic itself is checked
+    # against its workbook in tests/models/test_cnossos_workbook.py.
+    from rail_monitor.models import cnossos_bands as cb
+
+    values = {**site_values, "noise.cnossos_edition": "2015", "noise.bridge_constant_db": 4.0,
+              "noise.rail_roughness": "M"}
+    model = RollingNoiseModel(load_site(SITE_FILE), noise_config(values))
+    cls = model.site.vehicle("freight")
+    got = model.vehicle_sound_power(_passes(model.site, "freight", [14.0]), "cnossos")
+    _, a3 = cn.contact_filter(cls.wheel_load_n, cls.wheel_diameter_m, "2015")
+    lr = cb.band_roughness(cn.rail_roughness("M", "2015"), cn.wheel_roughness(cls.brake_type, edition="2015"), a3,
+                           14.0, edition="2015")
+    want = cn.rolling_sound_power(lr, cls.axles_per_vehicle, cn.track_transfer("monoblock", 3.5e8, "2015")[1],
+                                  cn.vehicle_transfer(cls.wheel_diameter_m, "2015")[1], bridge_constant_db=4.0)
+    for component in ("track", "vehicle", "superstructure"):
+        np.testing.assert_allclose(got[component][0], getattr(want, component), rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(model.vertical_db, np.abs(model.vertical_db))
+    # Class M at 1 m is 25 dB re 1 um in 2021 and 11 dB in 2015: the edition is not a no-op.
+    m2021 = RollingNoiseModel(load_site(SITE_FILE), noise_config({**site_values, "noise.rail_roughness": "M"}))
+    at_1m = [m.baseline_db[np.argmin(np.abs(m.grid - 1.0))] for m in (m2021, model)]
+    assert at_1m == pytest.approx([25.0, 11.0], abs=1e-12)
+
+
+@pytest.mark.parametrize(("edition", "key", "value", "why"), [
+    ("2015", "noise.bridge", "concrete", "bridge constant"),
+    ("2015", "noise.sleeper_type", "direct_fastening", "direct-fastening"),
+    ("2015", "noise.interpolation", "noisemodelling", "NoiseModelling"),
+    ("2021", "noise.bridge_constant_db", 3.0, "Table G-7"),
+])
+def test_terms_an_edition_lacks_are_refused(site_values, edition, key, value, why):
+    with pytest.raises(ConfigError, match=why):
+        noise_config({**site_values, "noise.cnossos_edition": edition, key: value})
+
+
 def test_the_superstructure_term_is_for_freight_classes_only(model):
     # Directive 2015/996 Annex II eq. 2.3.9: the vehicle superstructure transfer is for freight
     # vehicles. A batch of an EMU and a freight pass lists it for the freight pass alone.

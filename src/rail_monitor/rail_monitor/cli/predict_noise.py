@@ -11,11 +11,12 @@ from rail_monitor.cli.common import add_site_option, print_json, site_values
 # option dest -> the site parameter it overrides
 OVERRIDES = {"noise_model": "noise.model", "rail_roughness": "noise.rail_roughness",
              "sleeper_type": "noise.sleeper_type", "interpolation": "noise.interpolation",
+             "edition": "noise.cnossos_edition",
              "distance": "noise.receiver_distance_m", "pad_stiffness": "track.pad_stiffness_npm"}
 
 
 def add_parser(models: argparse._SubParsersAction) -> None:
-    from rail_monitor.models.cnossos import SLEEPER_TYPES
+    from rail_monitor.models.cnossos import EDITIONS, SLEEPER_TYPES
     from rail_monitor.models.cnossos_bands import INTERPOLATION_RULES
     from rail_monitor.noise.config import MODELS, ROUGHNESS_SOURCES
 
@@ -33,6 +34,7 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     r.add_argument("--pad-stiffness", type=float, help="rail pad stiffness [N/m] (track.pad_stiffness_npm)")
     r.add_argument("--interpolation", choices=INTERPOLATION_RULES,
                    help="wavelength-to-band interpolation rule (default: the site's)")
+    r.add_argument("--edition", choices=EDITIONS, help="CNOSSOS-EU edition of Appendix G (default: the site's)")
     r.add_argument("--distance", type=float, help="receiver distance from the track centre [m]")
     r.add_argument("--growth-days", type=float, nargs="+",
                    help="also predict after this many days of corrugation growth from grinding (at the first speed)")

@@ -23,6 +23,10 @@ _CLASS_E = cn.rail_roughness("E")
 NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("model", "cnossos", "Source model of noise/rolling: CNOSSOS-EU (Directive 2015/996 as amended by "
               "2021/1226), the mechanics model, or both (one message per model).", choices=(*MODELS, "both")),
+    ParamSpec("cnossos_edition", cn.DEFAULT_EDITION, "Edition of CNOSSOS-EU's Appendix G: 2021 (Directive 2015/996 "
+              "as amended by 2021/1226, in force) or 2015 (the 2015 text at the precision of the European Commission's "
+              "reference module: its scalar bridge constant, absolute vertical directivity, 920 mm contact filter).",
+              choices=cn.EDITIONS),
     ParamSpec("interpolation", "reference", "Wavelength-to-frequency rule: the European reference module's (each "
               "table mapped on its own, dB linear in wavelength, ends held) or NoiseModelling's (energy linear in lg f "
               "on its grid, joints before the contact filter).", choices=cb.INTERPOLATION_RULES),
@@ -34,7 +38,9 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
               "[dB re 1 um] (default: class E).", -60.0, 80.0),
     ParamSpec("sleeper_type", "monoblock", "Sleeper type for CNOSSOS's track transfer (Table G-3a); the pad class "
               "follows track.pad_stiffness_npm.", choices=cn.SLEEPER_TYPES),
-    ParamSpec("bridge", "none", "Bridge at the site (CNOSSOS Table G-7).", choices=cn.BRIDGE_TYPES),
+    ParamSpec("bridge", "none", "Bridge at the site (CNOSSOS Table G-7; edition 2021).", choices=cn.BRIDGE_TYPES),
+    ParamSpec("bridge_constant_db", 0.0, "Edition 2015's bridge constant C_bridge, added to the rolling noise [dB]; "
+              "0: no bridge.", 0.0, 30.0),
     ParamSpec("joints_per_100m", 0.0, "Rail joints (impact noise, CNOSSOS Table G-4) per 100 m [-]; 0: none.",
               0.0, 100.0),
     ParamSpec("curve_squeal", False, "Add CNOSSOS's curve-squeal term (+8 dB R <= 300 m, +5 dB to 500 m) to the "
@@ -104,4 +110,23 @@ def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConf
     if len(wl) != len(db) or len(wl) < 2 or np.any(np.diff(wl) <= 0):
         raise ConfigError(f"parameters '{prefix}rail_roughness_wavelength_m' and '{prefix}rail_roughness_db' must "
                           "have the same length (at least 2), wavelengths strictly ascending")
+    _check_edition_terms(values, prefix)
     return values_of(NoiseConfig, values)
+
+
+def _check_edition_terms(values: Mapping[str, Any], prefix: str) -> None:
+    """Terms the chosen CNOSSOS-EU edition does not have are refused, not silently replaced."""
+    edition = values["cnossos_edition"]
+    refusals = {
+        "2015": [("bridge", values["bridge"] != "none", "has a bridge constant instead of Table G-7: set "
+                  f"'{prefix}bridge_constant_db'"),
+                 ("sleeper_type", values["sleeper_type"] == "direct_fastening", "has no direct-fastening track "
+                  "transfer"),
+                 ("interpolation", values["interpolation"] == "noisemodelling", "is not read by NoiseModelling's "
+                  "rule (its grid is the 2021 tables')")],
+        "2021": [("bridge_constant_db", values["bridge_constant_db"] != 0.0, "has Table G-7 instead of a bridge "
+                  f"constant: set '{prefix}bridge'")],
+    }
+    for name, refused, why in refusals[edition]:
+        if refused:
+            raise ConfigError(f"parameter '{prefix}{name}': CNOSSOS-EU edition {edition} {why}")

@@ -132,22 +132,25 @@ class RollingNoiseModel:
 
     def __init__(self, site: Site, cfg: NoiseConfig) -> None:
         self.site, self.cfg = site, cfg
-        t = cn.tables()
+        self.edition = ed = cfg.cnossos_edition
+        t = cn.tables(ed)
         self.grid = t.wavelength_m
         self.band, self.band_hz = t.band, t.band_hz
         self.receiver = cfg.receiver
         (_, psi), _ = self.receiver.paths()
-        self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz)
+        self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz, ed)
         self.baseline_db = self._baseline()
-        self.impact_db = cn.impact_roughness(cfg.joints_per_100m / 100.0) if cfg.joints_per_100m > 0 else None
-        self.track_name, track_db = cn.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm)
-        self.bridge_db = cn.bridge_transfer(cfg.bridge)
-        self.squeal_db = cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0
+        self.impact_db = cn.impact_roughness(cfg.joints_per_100m / 100.0, ed) if cfg.joints_per_100m > 0 else None
+        self.track_name, track_db = cn.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm, ed)
+        self.bridge_db = cn.bridge_transfer(cfg.bridge, ed)
+        # The 2015 bridge constant raises the rolling components as the curve-squeal term does.
+        self.squeal_db = (cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0) \
+            + cfg.bridge_constant_db
         self.classes: dict[str, _ClassTerms] = {}
         for name, v in site.vehicles.items():
             contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
-            _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m)
-            _, veh = cn.vehicle_transfer(v.wheel_diameter_m)
+            _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, ed)
+            _, veh = cn.vehicle_transfer(v.wheel_diameter_m, ed)
             cnossos = {"track": track_db + self.squeal_db, "vehicle": veh + self.squeal_db}
             if v.freight:  # L_H,VEH,SUP of Table G-3c: 0 dB, for freight vehicles only (eq. 2.3.9)
                 cnossos["superstructure"] = np.full(len(self.band), self.squeal_db)
@@ -157,7 +160,8 @@ class RollingNoiseModel:
             mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
                                      v.wheel_diameter_m, cfg.radiators, cfg.transfer_points, modes=modes,
                                      wheel_damping_ratio=v.wheel_damping_ratio)
-            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation), a3, cnossos, mech)
+            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, ed), a3, cnossos,
+                                             mech)
 
     def component_names(self, model: str) -> list[str]:
         """The model's source components over the site's classes, in a fixed order."""
@@ -174,7 +178,7 @@ class RollingNoiseModel:
     def _baseline(self) -> np.ndarray:
         source = self.cfg.rail_roughness
         if source != "measured":
-            return cn.rail_roughness(source)
+            return cn.rail_roughness(source, self.edition)
         wl = np.asarray(self.cfg.rail_roughness_wavelength_m, float)
         return np.interp(self.grid, wl, np.asarray(self.cfg.rail_roughness_db, float))
 
@@ -204,10 +208,13 @@ class RollingNoiseModel:
         out = np.empty((len(passes), len(self.band)))
         for name, rows in _class_rows(passes):
             speed = passes.speed_mps[rows]
-            on_rail = power(cb.at_band_frequencies(rail if rail.ndim == 1 else rail[rows], speed, self.band_hz))
+            def at(table: np.ndarray, speed: np.ndarray = speed) -> np.ndarray:
+                return power(cb.at_band_frequencies(table, speed, self.band_hz, edition=self.edition))
+
+            on_rail = at(rail if rail.ndim == 1 else rail[rows])
             if self.impact_db is not None:
-                on_rail = on_rail + power(cb.at_band_frequencies(self.impact_db, speed, self.band_hz))
-            wheel = power(cb.at_band_frequencies(self.classes[name].wheel_db, speed, self.band_hz))
+                on_rail = on_rail + at(self.impact_db)
+            wheel = at(self.classes[name].wheel_db)
             out[rows] = on_rail / (on_rail + wheel)
         return out
 
@@ -296,9 +303,9 @@ class RollingNoiseModel:
         rule = self.cfg.interpolation
         if model == "cnossos":
             return cb.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
-                                     self.impact_db), terms.cnossos
+                                     self.impact_db, self.edition), terms.cnossos
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
-        lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule) + filter_db
+        lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
         return lr, terms.mechanics
 
 

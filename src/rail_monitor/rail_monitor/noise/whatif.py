@@ -95,7 +95,7 @@ def predict_noise(values: Mapping[str, Any], vehicle_class: str | None = None, s
                    for days, state in states.items()}
     where = (f"site {site.site_id}, {cls.name} ({cls.brake_type} brakes, {n_vehicles} vehicles), rail "
              f"{model.cfg.rail_roughness}, {model.track_name}, receiver {model.receiver.distance_m:g} m / "
-             f"{model.receiver.height_m:g} m")
+             f"{model.receiver.height_m:g} m; CNOSSOS-EU edition {model.edition}, {model.cfg.interpolation} rule")
     return NoiseWhatIf(where, model, cls, n_vehicles, v, passes_per_day, results, sound_power)
 
 
