@@ -57,7 +57,7 @@ def test_f_weighted_peak_matches_a_time_integration_over_every_axle(vehicles, sp
     span = (-(0.5 * length + 200.0) / speed, (0.5 * length + 200.0) / speed)
     sol = solve_ivp(lambda t, y: (_all_axle_history(layout, length, speed, t) - y) / tau, span, [0.0],
                     max_step=0.002, rtol=1e-9, atol=1e-16)
-    got = passby_axles.f_weighted_peak(np.ones(1), np.ones(1), layout, [length], [speed], D, R1, R2)
+    got = passby_axles.f_weighted_peak([(np.ones(1), R1), (np.ones(1), R2)], layout, [length], [speed], D)
     assert 10 * np.log10(got[0]) == pytest.approx(10 * np.log10(sol.y[0].max()), abs=0.02)
 
 
@@ -65,7 +65,7 @@ def test_a_slow_single_axle_peaks_at_its_closest_approach():
     """One axle passing slowly (v tau << d): the F-weighted peak is the squared pressure at x = 0,
     W (g_direct(0) + g_image(0)), within 0.01 dB."""
     layout = passby_axles.axle_layout([4.0], [1], [1], 0.0, 0.0)
-    got = passby_axles.f_weighted_peak(np.ones(1), np.ones(1), layout, [4.0], [0.5], D, R1, R2)
+    got = passby_axles.f_weighted_peak([(np.ones(1), R1), (np.ones(1), R2)], layout, [4.0], [0.5], D)
     want = 4.0 * (passby.point_kernel(0.0, D, R1) + passby.point_kernel(0.0, D, R2))
     assert 10 * np.log10(got[0]) == pytest.approx(10 * np.log10(want), abs=0.01)
 
@@ -94,9 +94,49 @@ def test_extreme_but_valid_trains_cost_bounded_memory_and_give_finite_levels():
     layout = passby_axles.axle_layout(length, vehicles, axles, 0.7, 1.0)
     assert layout.offsets_m.shape[1] == passby_axles.MAX_AXLES_PER_VEHICLE
     tracemalloc.start()
-    peak = passby_axles.f_weighted_peak(np.ones(3), np.ones(3), layout, length, speed, D, R1, R2)
+    peak = passby_axles.f_weighted_peak([(np.ones(3), R1), (np.ones(3), R2)], layout, length, speed, D)
     mean = passby_axles.window_kernel(layout, length, D, R1)
     _, most = tracemalloc.get_traced_memory()
     tracemalloc.stop()
     assert np.all(np.isfinite(peak)) and np.all(peak > 0) and np.all(np.isfinite(mean))
     assert most < 400e6
+
+
+@pytest.mark.parametrize("axles", [True, False])
+def test_a_second_source_line_adds_its_energy_and_shares_the_time_history(axles):
+    """CNOSSOS-EU's source B (4 m) beside source A: LpAeq,Tp and TEL are the energy sums of the two lines
+    computed apart (exact: both are exposures over the same Tp), LpAFmax lies between the louder line's and
+    the energy sum of the two (the F weighting follows their summed history). Two lines at one height are one
+    line of their summed power (the history is linear in the paths' powers), 1e-9 dB."""
+    band = np.arange(-6, 9)
+    length, vehicles, speed = 92.0, 4, [22.2]
+    layout = _layout(length, vehicles, 16) if axles else None
+    high = passby.Receiver(7.5, 1.2, 4.0, 0.0, 1.0)
+
+    def geometry(receiver):
+        return passby.pass_geometry(band, [length], speed, receiver, layout)
+
+    ga, gb = geometry(RECEIVER), geometry(high)
+    rng = np.random.default_rng(5)
+    lw_a, lw_b = 80.0 + 10.0 * rng.random((1, len(band))), 75.0 + 10.0 * rng.random((1, len(band)))
+    a_alone = passby.pass_by(lw_a, band, [length], speed, RECEIVER, geometry=ga)
+    b_alone = passby.pass_by(lw_b, band, [length], speed, high, geometry=gb)
+    both = passby.pass_by(lw_a, band, [length], speed, RECEIVER, geometry=ga, elevated=(lw_b, gb))
+
+    def energy(x, y):
+        return levels.level(levels.power(x) + levels.power(y))
+
+    np.testing.assert_allclose(both.lp_db, energy(a_alone.lp_db, b_alone.lp_db), rtol=0, atol=1e-9)
+    assert both.lpaeq_tp_dba[0] == pytest.approx(energy(a_alone.lpaeq_tp_dba, b_alone.lpaeq_tp_dba)[0], abs=1e-9)
+    assert both.tel_dba[0] == pytest.approx(energy(a_alone.tel_dba, b_alone.tel_dba)[0], abs=1e-9)
+    peak = both.lpafmax_dba[0]
+    assert max(a_alone.lpafmax_dba[0], b_alone.lpafmax_dba[0]) < peak
+    assert peak < energy(a_alone.lpafmax_dba, b_alone.lpafmax_dba)[0] + 1e-9
+    summed = passby.pass_by(energy(lw_a, lw_b), band, [length], speed, RECEIVER, geometry=ga)
+    same_height = passby.pass_by(lw_a, band, [length], speed, RECEIVER, geometry=ga, elevated=(lw_b, ga))
+    assert same_height.lpafmax_dba[0] == pytest.approx(summed.lpafmax_dba[0], abs=1e-9)
+    np.testing.assert_allclose(same_height.lp_db, summed.lp_db, rtol=0, atol=1e-9)
+    # No power on the second line: the first line's levels, bit for bit.
+    silent = passby.pass_by(lw_a, band, [length], speed, RECEIVER, geometry=ga,
+                            elevated=(np.full_like(lw_b, -np.inf), gb))
+    np.testing.assert_array_equal(silent.lp_db, a_alone.lp_db)

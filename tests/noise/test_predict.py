@@ -8,6 +8,7 @@ import pytest
 
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
+from rail_monitor.core.site import site_from_values
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.noise.config import MODELS, noise_config
@@ -234,6 +235,45 @@ def test_a_site_on_the_2015_edition_takes_that_editions_terms(site_values):
     m2021 = RollingNoiseModel(load_site(SITE_FILE), noise_config({**site_values, "noise.rail_roughness": "M"}))
     at_1m = [m.baseline_db[np.argmin(np.abs(m.grid - 1.0))] for m in (m2021, model)]
     assert at_1m == pytest.approx([25.0, 11.0], abs=1e-12)
+
+
+def test_traction_and_aerodynamic_noise_from_sources_a_and_b(site_values):
+    # CNOSSOS-EU's traction (Table G-5) per vehicle of a class that has it, aerodynamic noise (G-6) above
+    # 200 km/h when the site asks for it: the L_W,0 per vehicle is the table's, and source B's pass-by is
+    # the pass-by of a line 4 m above the rail head with no vertical directivity (an independent call).
+    from rail_monitor.models.passby import pass_by, pass_geometry
+
+    values = {**site_values, "vehicle.dmu.traction": "dmu", "noise.aerodynamic": True}
+    model = RollingNoiseModel(site_from_values(values), noise_config(values))
+    passes = _passes(model.site, "dmu", [20.0, 250.0 / 3.6])
+    lw0 = model.vehicle_sound_power(passes, "cnossos")
+    for src in "AB":
+        np.testing.assert_allclose(lw0[f"traction_{src.lower()}"], np.tile(cn.traction_sound_power("dmu", src), (2, 1)),
+                                   rtol=0, atol=1e-9)
+        assert np.all(np.isneginf(lw0[f"aerodynamic_{src.lower()}"][0]))          # 72 km/h: none
+        np.testing.assert_allclose(lw0[f"aerodynamic_{src.lower()}"][1], cn.aerodynamic_sound_power(250.0, src),
+                                   rtol=0, atol=1e-9)
+    out = model.predict(passes, "cnossos")
+    names, _ = out.components(0)
+    assert names == ["track", "vehicle", "traction_a", "traction_b"]
+    assert out.components(1)[0][-2:] == ["aerodynamic_a", "aerodynamic_b"]
+    per_metre = lw0["traction_b"] + 10.0 * np.log10(passes.vehicle_count / passes.train_length_m)[:, None]
+    high = model.receiver_b
+    want = pass_by(per_metre, model.band, passes.train_length_m, passes.speed_mps, high, 0.0, False,
+                   pass_geometry(model.band, passes.train_length_m, passes.speed_mps, high, model._axles(passes)))
+    got = out.component_lpaeq_dba[:, out.component_names.index("traction_b")]
+    np.testing.assert_allclose(got, want.lpaeq_tp_dba, rtol=0, atol=1e-9)
+    assert high.source_height_m == 4.0
+    # The same passes without traction or aerodynamic noise are quieter, and keep their components.
+    plain = RollingNoiseModel(load_site(SITE_FILE), noise_config(site_values)).predict(passes, "cnossos")
+    assert plain.component_names == ["track", "vehicle", "superstructure"]
+    assert np.all(out.lpaeq_tp_dba > plain.lpaeq_tp_dba)
+
+
+def test_a_traction_type_the_edition_lacks_is_refused(site_values):
+    values = {**site_values, "vehicle.dmu.traction": "diesel_loco_1180kw"}
+    with pytest.raises(ConfigError, match=r"vehicle\.dmu\.traction.*edition 2021 has no traction type"):
+        RollingNoiseModel(site_from_values(values), noise_config(values))
 
 
 @pytest.mark.parametrize(("edition", "key", "value", "why"), [

@@ -18,7 +18,7 @@ from rail_monitor.core.friction import FRICTION_NAMES
 from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
 from rail_monitor.core.timeutil import time_zone
 from rail_monitor.models import hertz
-from rail_monitor.models.cnossos import BRAKE_TYPES
+from rail_monitor.models.cnossos import BRAKE_TYPES, TRACTION_TYPES
 from rail_monitor.models.squeal import K3_CONVENTIONS, RIG_PEAK_FRICTION
 from rail_monitor.models.track import Track
 
@@ -97,6 +97,9 @@ VEHICLE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("brake_type", "disc", "Brake type (sets wheel roughness).", choices=BRAKE_TYPES),
     ParamSpec("freight", False, "Freight wagons: CNOSSOS-EU's superstructure term (eq. 2.3.9) is counted for "
               "freight vehicles only."),
+    ParamSpec("traction", "none", "CNOSSOS-EU traction noise (Table G-5) of each vehicle of the class's trains, by "
+              "vehicle type (at constant speed; sources A and B); none: no traction noise (wagons, coaches).",
+              choices=("none", *TRACTION_TYPES)),
     ParamSpec("wheel_load_n", 60000.0, "Nominal static wheel load [N].", 1.0e3, 2.5e5),
     ParamSpec("unsprung_mass_kg", 600.0, "Unsprung mass per wheel (half a wheelset and what moves with it) "
               "[kg].", 50.0, 5000.0),
@@ -133,6 +136,7 @@ class VehicleClass:
     wheel_diameter_m: float
     brake_type: str
     freight: bool
+    traction: str
     wheel_load_n: float
     unsprung_mass_kg: float
     wheel_damping_ratio: float

@@ -80,6 +80,9 @@ BRIDGE_TYPES = ("none", "concrete", "steel")
 PAD_CLASS_UPPER_NPM = (250e6, 800e6)
 SOURCE_HEIGHTS = {"A": 0.5, "B": 4.0}   # above the rail head [m], Annex II 2.3.1 (h = 1 and h = 2)
 RUNNING_CONDITIONS = ("constant", "idling")
+# Table G-5's vehicle types over the editions (each edition's own: Tables.traction_types).
+TRACTION_TYPES = ("diesel_loco_800kw", "diesel_loco_2200kw", "diesel_loco_1180kw", "diesel_loco_2200kw_class66",
+                  "dmu", "electric_loco", "emu")
 AERODYNAMIC_ONSET_KMH = 200.0           # aerodynamic noise is taken into account above this speed (2.3.2)
 
 

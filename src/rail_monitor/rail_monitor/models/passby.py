@@ -208,22 +208,35 @@ def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, re
 
 def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike,
             receiver: Receiver, direct_correction_db: ArrayLike = 0.0, time_weighted: bool = True,
-            geometry: PassGeometry | None = None) -> PassBy:
+            geometry: PassGeometry | None = None,
+            elevated: tuple[ArrayLike, PassGeometry] | None = None) -> PassBy:
     """Pass-by levels of trains with band sound power per metre [dB re 1 pW/m] (passes x bands).
 
     length_m, speed_mps: per pass [m], [m/s]. band: IEC 61260-1 band numbers. direct_correction_db:
     per band, added to the direct path only (CNOSSOS-EU's vertical directivity of source A).
     time_weighted: compute LpAFmax (the costly part; NaN without it). geometry: pass_geometry of
-    the same bands, passes and receiver, when it is already at hand.
+    the same bands, passes and receiver, when it is already at hand. elevated: a second source
+    line of the same trains at another height (CNOSSOS-EU's source B, 4 m): its power per metre
+    and its pass_geometry (the same passes, bands and axles), without directivity correction; its
+    paths join the time history, so LpAFmax is that of both lines together.
     """
     g = geometry or pass_geometry(band, length_m, speed_mps, receiver)
     lw = np.atleast_2d(np.asarray(lw_per_metre_db, float))
     w_direct = power(lw + np.asarray(direct_correction_db, float))     # per band, direct path
     w_image = g.ground_reflection * power(lw)
-    lp = level(w_direct * g.k1 + w_image * g.k2)
-    tel_band = level(w_direct * g.total1 + w_image * g.total2)
+    mean = w_direct * g.k1 + w_image * g.k2
+    exposure = w_direct * g.total1 + w_image * g.total2
     a = g.a_weight
-    fmax = level(_peak(g, np.sum(w_direct * a, axis=-1), np.sum(w_image * a, axis=-1))) if time_weighted \
+    paths = [(w_direct, g.r1), (w_image, g.r2)]
+    if elevated is not None:
+        lw_b, gb = np.atleast_2d(np.asarray(elevated[0], float)), elevated[1]
+        wb_direct, wb_image = power(lw_b), gb.ground_reflection * power(lw_b)
+        mean = mean + (wb_direct * gb.k1 + wb_image * gb.k2)
+        exposure = exposure + (wb_direct * gb.total1 + wb_image * gb.total2)
+        paths += [(wb_direct, gb.r1), (wb_image, gb.r2)]
+    lp = level(mean)
+    tel_band = level(exposure)
+    fmax = level(_peak(g, [(np.sum(w * a, axis=-1), r) for w, r in paths])) if time_weighted \
         else np.full(len(g.length), np.nan)
     return PassBy(
         lp_db=lp,
@@ -234,18 +247,23 @@ def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, sp
     )
 
 
-def _peak(g: PassGeometry, c1: FloatArray, c2: FloatArray) -> FloatArray:
-    """The F-time-weighted peak of the pass's sources (line or axles) of A-weighted powers c1, c2."""
+# The paths of a pass-by: (A-weighted power per metre per pass [any unit], perpendicular distance [m]).
+Paths = list[tuple[FloatArray, float]]
+
+
+def _peak(g: PassGeometry, paths: Paths) -> FloatArray:
+    """The F-time-weighted peak of the pass's sources (line or axles) along these paths."""
     if g.axles is None:
-        return _f_weighted_peak(c1, c2, g.length, g.speed, g.d, g.r1, g.r2)
+        return _f_weighted_peak(paths, g.length, g.speed, g.d)
     from rail_monitor.models import passby_axles
 
-    return passby_axles.f_weighted_peak(c1, c2, g.axles, g.length, g.speed, g.d, g.r1, g.r2)
+    return passby_axles.f_weighted_peak(paths, g.axles, g.length, g.speed, g.d)
 
 
-def _f_weighted_peak(c1: FloatArray, c2: FloatArray, length: FloatArray, speed: FloatArray, d: float,
-                     r1: float, r2: float, steps_per_tau: int = 8) -> FloatArray:
-    """Peak of the F-time-weighted squared pressure c1 x1(t) + c2 x2(t), x_i(t) = G_i(vt) - G_i(vt - L).
+def _f_weighted_peak(paths: Paths, length: FloatArray, speed: FloatArray, d: float,
+                     steps_per_tau: int = 8) -> FloatArray:
+    """Peak of the F-time-weighted squared pressure sum_i c_i x_i(t), x_i(t) = G_i(vt) - G_i(vt - L),
+    over the paths (c_i, R_i).
 
     Exponential averaging (IEC 61672-1 eq. 7, tau = 0.125 s) from 6 tau before to 3 tau after the
     unweighted peak (the train's middle at the perpendicular), started in steady state: the
@@ -256,9 +274,11 @@ def _f_weighted_peak(c1: FloatArray, c2: FloatArray, length: FloatArray, speed: 
     s = 0.5 * length[:, None] + speed[:, None] * t[None, :]     # front position along the track [m]
     g = _antiderivative_with
     rear = s - length[:, None]
-    front_d, rear_d = _atan_over(s, d), _atan_over(rear, d)  # shared by the direct and image paths
-    x = c1[:, None] * (g(s, d, r1, front_d) - g(rear, d, r1, rear_d)) \
-        + c2[:, None] * (g(s, d, r2, front_d) - g(rear, d, r2, rear_d))
+    front_d, rear_d = _atan_over(s, d), _atan_over(rear, d)  # shared by every path
+    x = None
+    for c, r in paths:
+        term = c[:, None] * (g(s, d, r, front_d) - g(rear, d, r, rear_d))
+        x = term if x is None else x + term
     return exponential_average(x, np.exp(-1.0 / steps_per_tau)).max(axis=1)
 
 

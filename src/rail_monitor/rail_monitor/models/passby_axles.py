@@ -40,7 +40,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rail_monitor.models.passby import _BROADSIDE, _OMNI, F_TIME_CONSTANT_S, exponential_average, kernel_antiderivative
+from rail_monitor.models.passby import (
+    _BROADSIDE,
+    _OMNI,
+    F_TIME_CONSTANT_S,
+    Paths,
+    exponential_average,
+    kernel_antiderivative,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -145,15 +152,16 @@ def _take(layout: AxleLayout, rows: NDArray[np.int64]) -> AxleLayout:
     return AxleLayout(layout.vehicles[rows], layout.pitch_m[rows], layout.offsets_m[rows])
 
 
-def f_weighted_peak(c1: FloatArray, c2: FloatArray, layout: AxleLayout, length_m: ArrayLike, speed_mps: ArrayLike,
-                    d: float, r1: float, r2: float) -> FloatArray:
-    """Peak of the F-time-weighted squared pressure of the axles (passes,), c1 and c2 the A-weighted
-    power per metre [W/m-like, any unit] of the direct and image paths (module docstring). Each
-    pass's time step, window and near vehicles are its own, so the result is the same bits in a
-    batch as alone."""
+def f_weighted_peak(paths: Paths, layout: AxleLayout, length_m: ArrayLike, speed_mps: ArrayLike,
+                    d: float) -> FloatArray:
+    """Peak of the F-time-weighted squared pressure of the axles (passes,) along the paths (c, R): c
+    the A-weighted power per metre [W/m-like, any unit] of a path (per pass), R its perpendicular
+    distance [m]: the direct and image paths of each source line (module docstring). Each pass's
+    time step, window and near vehicles are its own, so the result is the same bits in a batch as
+    alone."""
     length = np.atleast_1d(np.asarray(length_m, float))
     speed = np.atleast_1d(np.asarray(speed_mps, float))
-    tau, r = F_TIME_CONSTANT_S, max(r1, r2)
+    tau, r = F_TIME_CONSTANT_S, max(r for _, r in paths)
     dt = np.maximum(tau / STEPS_PER_TAU, d / (SAMPLES_PER_DISTANCE * speed))
     before = np.ceil(6.0 * tau / dt).astype(np.int64)
     samples = before + np.ceil((_travel(layout, r) / speed + 3.0 * tau) / dt).astype(np.int64) + 1
@@ -171,8 +179,8 @@ def f_weighted_peak(c1: FloatArray, c2: FloatArray, layout: AxleLayout, length_m
             stop += 1
         part = order[start:stop]
         t = (np.arange(int(samples[part].max()))[None, :] - before[part, None]) * dt[part, None]
-        x = _history(c1[part], c2[part], _take(layout, part), length[part], speed[part], lo[part], hi[part], t,
-                     d, r1, r2)
+        x = _history([(c[part], r_path) for c, r_path in paths], _take(layout, part), length[part], speed[part],
+                     lo[part], hi[part], t, d)
         y = exponential_average(x, np.exp(-dt[part] / tau))
         own = np.arange(y.shape[1])[None, :] < samples[part, None]
         out[part] = np.where(own, y, -np.inf).max(axis=1)
@@ -191,22 +199,26 @@ def _reach(layout: AxleLayout, r: float, speed: FloatArray, duration: FloatArray
     return NEAR_PATH_DISTANCES * r + speed * duration + layout.pitch_m
 
 
-def _history(c1: FloatArray, c2: FloatArray, layout: AxleLayout, length: FloatArray, speed: FloatArray,
-             lo: NDArray[np.int64], hi: NDArray[np.int64], t: FloatArray, d: float, r1: float, r2: float) -> FloatArray:
+def _history(paths: Paths, layout: AxleLayout, length: FloatArray, speed: FloatArray, lo: NDArray[np.int64],
+             hi: NDArray[np.int64], t: FloatArray, d: float) -> FloatArray:
     """The squared pressure (passes, samples) at the times t [s] after the train's middle passes
     (per pass, from 6 tau before): vehicles lo ... hi axle by axle, the rest as line segments."""
     front = 0.5 * length[:, None] + speed[:, None] * t                             # (passes, T) [m]
-    c1c, c2c, broad = c1[:, None, None], c2[:, None, None], _BROADSIDE * d * d
+    broad = _BROADSIDE * d * d
+    weights = [(c[:, None, None], r * r) for c, r in paths]
 
     def pressure(s: FloatArray) -> FloatArray:
-        """c1 g1 + c2 g2 [1/m^2 x 4 pi] (passes, w, T) of the axles s (passes, w) behind the front,
-        in place (the arrays are the cost)."""
+        """sum over paths of c / (x^2 + R^2), times the horizontal directivity [1/m^2 x 4 pi]
+        (passes, w, T), of the axles s (passes, w) behind the front, in place (the arrays are the
+        cost)."""
         x2 = np.subtract(front[:, None, :], s[:, :, None])
         g1, g2 = np.empty_like(x2), np.empty_like(x2)
         np.square(x2, out=x2)
-        np.divide(c1c, np.add(x2, r1 * r1, out=g1), out=g1)
-        np.divide(c2c, np.add(x2, r2 * r2, out=g2), out=g2)
-        np.add(g1, g2, out=g1)
+        (c_first, r2_first), *rest = weights
+        np.divide(c_first, np.add(x2, r2_first, out=g1), out=g1)
+        for c_path, r2_path in rest:
+            np.divide(c_path, np.add(x2, r2_path, out=g2), out=g2)
+            np.add(g1, g2, out=g1)
         np.divide(broad, np.add(x2, d * d, out=x2), out=x2)
         np.add(x2, _OMNI, out=x2)
         return np.multiply(g1, x2, out=g1)
@@ -217,7 +229,7 @@ def _history(c1: FloatArray, c2: FloatArray, layout: AxleLayout, length: FloatAr
     head_start = front - (lo * layout.pitch_m)[:, None]
     tail_start = front - ((hi + 1) * layout.pitch_m)[:, None]
     rear = front - length[:, None]
-    for c, r in ((c1, r1), (c2, r2)):
+    for c, r in paths:
         g = kernel_antiderivative
         total = total + c[:, None] * (g(front, d, r) - g(head_start, d, r) + g(tail_start, d, r) - g(rear, d, r))
     return total

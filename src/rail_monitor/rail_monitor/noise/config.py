@@ -45,6 +45,8 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
               0.0, 100.0),
     ParamSpec("curve_squeal", False, "Add CNOSSOS's curve-squeal term (+8 dB R <= 300 m, +5 dB to 500 m) to the "
               "CNOSSOS rolling noise. Off: squeal is squeal_risk_model's, noise/squeal."),
+    ParamSpec("aerodynamic", False, "Add CNOSSOS-EU's aerodynamic noise (Table G-6, sources A and B) to the CNOSSOS "
+              "prediction of passes above 200 km/h."),
     ParamSpec("receiver_distance_m", 7.5, "Horizontal distance of the receiver from the track centre [m].",
               0.5, 1000.0),
     ParamSpec("receiver_height_m", 1.2, "Receiver height above the rail head [m].", -10.0, 100.0),

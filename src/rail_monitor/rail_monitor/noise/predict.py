@@ -33,7 +33,8 @@ import numpy as np
 
 from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.contact import contact_state
-from rail_monitor.core.passes import PassTable
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.passes import KMH_PER_MPS, PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
@@ -125,6 +126,11 @@ class _ClassTerms:
     a3_db: np.ndarray                    # CNOSSOS contact filter on the grid [dB]
     cnossos: dict[str, np.ndarray]       # L_H per component [dB per axle], 24 bands
     mechanics: dict[str, np.ndarray]     # L_H,mech per component [dB per axle]
+    traction: dict[str, np.ndarray]      # CNOSSOS L_W,0 per vehicle by source [dB re 1 pW], 24 bands
+
+
+# CNOSSOS-EU's components radiated from source B (4 m above the rail head); the others from A.
+SOURCE_B_COMPONENTS = ("traction_b", "aerodynamic_b")
 
 
 class RollingNoiseModel:
@@ -146,8 +152,14 @@ class RollingNoiseModel:
         # The 2015 bridge constant raises the rolling components as the curve-squeal term does.
         self.squeal_db = (cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0) \
             + cfg.bridge_constant_db
+        self.receiver_b = dataclasses.replace(self.receiver, source_height_m=cn.SOURCE_HEIGHTS["B"])
         self.classes: dict[str, _ClassTerms] = {}
         for name, v in site.vehicles.items():
+            if v.traction != "none" and v.traction not in t.traction_types:
+                raise ConfigError(f"parameter 'vehicle.{name}.traction': CNOSSOS-EU edition {ed} has no traction "
+                                  f"type {v.traction!r} (it has {', '.join(t.traction_types)})")
+            traction = {} if v.traction == "none" else {
+                f"traction_{src.lower()}": cn.traction_sound_power(v.traction, src, "constant", ed) for src in "AB"}
             contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
             _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, ed)
             _, veh = cn.vehicle_transfer(v.wheel_diameter_m, ed)
@@ -161,13 +173,18 @@ class RollingNoiseModel:
                                      v.wheel_diameter_m, cfg.radiators, cfg.transfer_points, modes=modes,
                                      wheel_damping_ratio=v.wheel_damping_ratio)
             self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, ed), a3, cnossos,
-                                             mech)
+                                             mech, traction)
 
     def component_names(self, model: str) -> list[str]:
         """The model's source components over the site's classes, in a fixed order."""
         names: dict[str, None] = {}
         for terms in self.classes.values():
             names.update(dict.fromkeys(terms.cnossos if model == "cnossos" else terms.mechanics))
+        if model == "cnossos":
+            for terms in self.classes.values():
+                names.update(dict.fromkeys(terms.traction))
+            if self.cfg.aerodynamic:
+                names.update(dict.fromkeys(("aerodynamic_a", "aerodynamic_b")))
         return list(names)
 
     @property
@@ -230,8 +247,7 @@ class RollingNoiseModel:
             raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
         filter_db = self._filter_db(passes, model)
         roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filter_db)
-        geometry = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver,
-                                 self._axles(passes) if self.cfg.pass_by_sources == "axles" else None)
+        geometry = self._geometries(passes, model)
         pb = self._pass_by(components, geometry)
         names = list(components)
         growth = np.zeros(len(passes))
@@ -290,12 +306,42 @@ class RollingNoiseModel:
             roughness[rows] = lr
             for comp, lh in transfers.items():
                 components[comp][rows] = lr + lh + per_metre[rows]
+            if model == "cnossos":
+                self._vehicle_sources(components, rows, self.classes[name], passes)
         return roughness, components
 
-    def _pass_by(self, components: dict[str, np.ndarray], geometry: PassGeometry, time_weighted: bool = True
-                 ) -> PassBy:
-        return pass_by(_total(components), self.band, geometry.length, geometry.speed, self.receiver,
-                       self.vertical_db, time_weighted, geometry)
+    def _vehicle_sources(self, components: dict[str, np.ndarray], rows: np.ndarray, terms: _ClassTerms,
+                         passes: PassTable) -> None:
+        """CNOSSOS-EU's traction and aerodynamic power per metre of train [dB re 1 pW/m] on the rows
+        of one class: L_W,0 per vehicle + 10 lg(vehicles / train length)."""
+        per_metre = 10.0 * np.log10(passes.vehicle_count[rows] / passes.train_length_m[rows])[:, None]
+        for comp, lw0 in terms.traction.items():
+            components[comp][rows] = lw0 + per_metre
+        if self.cfg.aerodynamic:
+            speed_kmh = passes.speed_mps[rows] * KMH_PER_MPS
+            for src in "AB":
+                components[f"aerodynamic_{src.lower()}"][rows] = \
+                    cn.aerodynamic_sound_power(speed_kmh, src, self.edition) + per_metre
+
+    def _geometries(self, passes: PassTable, model: str) -> tuple[PassGeometry, PassGeometry | None]:
+        """The pass geometry of source A, and of source B (4 m) where the model has components there."""
+        axles = self._axles(passes) if self.cfg.pass_by_sources == "axles" else None
+        low = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver, axles)
+        if not set(self.component_names(model)) & set(SOURCE_B_COMPONENTS):
+            return low, None
+        return low, pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver_b, axles)
+
+    def _pass_by(self, components: dict[str, np.ndarray], geometries: tuple[PassGeometry, PassGeometry | None],
+                 time_weighted: bool = True) -> PassBy:
+        """Pass-by of the components: those of source B as a second source line of the same trains
+        (CNOSSOS-EU's horizontal directivity alone), the others at source A."""
+        geometry, geometry_b = geometries
+        low = {c: lw for c, lw in components.items() if c not in SOURCE_B_COMPONENTS}
+        high = {c: lw for c, lw in components.items() if c in SOURCE_B_COMPONENTS}
+        elevated = (_total(high), geometry_b) if high else None
+        total = _total(low) if low else np.full_like(next(iter(high.values())), -np.inf)
+        return pass_by(total, self.band, geometry.length, geometry.speed, self.receiver, self.vertical_db,
+                       time_weighted, geometry, elevated)
 
     def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray, model: str,
                    filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
