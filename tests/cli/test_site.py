@@ -36,3 +36,21 @@ def test_a_mistake_is_one_line_and_writes_nothing(tmp_path, capsys):
     keep = tmp_path / "mine.yaml"
     keep.write_text("mine")
     assert main(["site", str(keep)]) == 2 and keep.read_text() == "mine"  # never replaced
+
+
+def test_a_catalogue_file_goes_into_the_site_file_line_for_line(tmp_path, capsys):
+    mine = tmp_path / "mine.csv"
+    bands = [50, 63, 80, 100, 125, 160, 200, 250, 315, 400, 500, 630, 800, 1000, 1250, 1600, 2000, 2500, 3150, 4000,
+             5000, 6300, 8000, 10000]
+    rows = "".join(f"{f},{70 + i}.5\n" for i, f in enumerate(bands))
+    mine.write_text("# a slab track\nfrequency_hz,track_slab\n" + rows)
+    out = tmp_path / "slab.yaml"
+    assert main(["site", str(out), "--cnossos-catalogue", str(mine), "--set", "noise.track_transfer=track_slab"]) == 0
+    assert load_parameter_file(out)["noise.cnossos_catalogue"] == mine.read_text()
+    assert "noise.cnossos_catalogue: 26 lines set" in capsys.readouterr().out
+    bad = tmp_path / "bad.csv"
+    bad.write_text(mine.read_text().replace("70.5", "seventy"))
+    assert main(["site", str(tmp_path / "no.yaml"), "--cnossos-catalogue", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "noise.cnossos_catalogue" in err and "not a number" in err and err.count("\n") == 1, err
+    assert not (tmp_path / "no.yaml").exists()

@@ -3,6 +3,8 @@ noise"), for both source models."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -268,6 +270,30 @@ def test_traction_and_aerodynamic_noise_from_sources_a_and_b(site_values):
     plain = RollingNoiseModel(load_site(SITE_FILE), noise_config(site_values)).predict(passes, "cnossos")
     assert plain.component_names == ["track", "vehicle", "superstructure"]
     assert np.all(out.lpaeq_tp_dba > plain.lpaeq_tp_dba)
+
+
+def test_a_sites_own_catalogue_supplies_track_wheel_filter_and_traction(site_values):
+    # The site's catalogue (noise.cnossos_catalogue) is read like the edition's tables: the chosen track
+    # transfer, the wheel transfer and contact filter nearest the class's wheel, a traction type of its own.
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).parents[1] / "models"))
+    from test_cnossos_catalogue import FILTER, LOCO_A, TRACK, WHEEL, catalogue
+
+    values = {**site_values, "noise.cnossos_catalogue": catalogue(), "noise.track_transfer": "track_slab",
+              "vehicle.dmu.traction": "shunter", "vehicle.dmu.wheel_diameter_m": 0.76, "vehicle.dmu.wheel_load_n": 80e3}
+    model = RollingNoiseModel(site_from_values(values), noise_config(values))
+    terms = model.classes["dmu"]
+    np.testing.assert_array_equal(terms.cnossos["track"], TRACK)
+    np.testing.assert_array_equal(terms.cnossos["vehicle"], WHEEL)
+    np.testing.assert_array_equal(terms.a3_db, FILTER)
+    np.testing.assert_array_equal(terms.traction["traction_a"], LOCO_A)
+    assert model.track_name == "track_slab"
+    for key, value, why in (("noise.track_transfer", "track_none", "none of the edition's and the catalogue's"),
+                            ("noise.track_transfer", "vehicle_wheel_760mm", "none of the edition's"),
+                            ("noise.cnossos_catalogue", "frequency_hz,track_x\n50,1\n", "cnossos_catalogue.*grid")):
+        with pytest.raises(ConfigError, match=why):
+            noise_config({**values, key: value})
 
 
 def test_a_traction_type_the_edition_lacks_is_refused(site_values):

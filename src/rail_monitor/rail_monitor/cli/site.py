@@ -20,21 +20,32 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--set", dest="changes", action="append", default=[], metavar="NAME=VALUE",
                    help="a parameter and its value as YAML (e.g. curve_radius_m=400.0, "
                         "vehicle.freight.traffic_share=0.5); repeat for more")
+    s.add_argument("--cnossos-catalogue", metavar="CSV", help="a file of your own CNOSSOS-EU tables in the package's "
+                   "format (track, vehicle and traction spectra, contact filters), stored in the site file as "
+                   "noise.cnossos_catalogue")
     s.set_defaults(func=run)
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.site_file import check_parameter_file, load_site
+    from rail_monitor.noise.config import noise_config
+    from rail_monitor.site_file import check_parameter_file, load_parameter_file, load_site
 
     out = Path(ns.output)
     if out.exists() or out.is_symlink():
         raise RailMonitorError(f"{out} exists: give a new file name (a site file is never replaced)")
-    text, changed = edited_site_text(site_file(ns.site).read_text(encoding="utf-8"), ns.changes)
+    literal = {}
+    if ns.cnossos_catalogue:
+        try:
+            literal["noise.cnossos_catalogue"] = Path(ns.cnossos_catalogue).read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise RailMonitorError(f"{ns.cnossos_catalogue}: cannot read the catalogue: {exc}") from None
+    text, changed = edited_site_text(site_file(ns.site).read_text(encoding="utf-8"), ns.changes, literal)
     tmp = out.with_name(f".{out.name}.tmp")
     try:
         tmp.write_text(text, encoding="utf-8")
         check_parameter_file(tmp)
         site = load_site(tmp)
+        noise_config(load_parameter_file(tmp))   # the terms that depend on each other (edition, catalogue)
         tmp.replace(out)
     except OSError as exc:
         raise RailMonitorError(f"{out}: cannot write: {exc.strerror or exc}") from None
@@ -48,12 +59,13 @@ def run(ns: argparse.Namespace) -> int:
     return 0
 
 
-def edited_site_text(text: str, changes: list[str]) -> tuple[str, list[str]]:
+def edited_site_text(text: str, changes: list[str], literal: dict[str, str] | None = None) -> tuple[str, list[str]]:
     """The site file's text with each NAME=VALUE set where the file sets NAME (in whichever
-    section), else under ``/**``; comments and layout kept (ruamel.yaml round trip). Returns the
-    text and a line per change."""
+    section), else under ``/**``; comments and layout kept (ruamel.yaml round trip). literal: names
+    set to a text kept line for line (a YAML block scalar). Returns the text and a line per change."""
     import yaml
     from ruamel.yaml import YAML
+    from ruamel.yaml.scalarstring import LiteralScalarString
 
     rt = YAML()
     rt.preserve_quotes = True
@@ -70,6 +82,9 @@ def edited_site_text(text: str, changes: list[str]) -> tuple[str, list[str]]:
             raise RailMonitorError(f"--set {change!r}: the value is not YAML: {str(exc).splitlines()[0]}") from None
         old = _set(doc, name.strip(), value)
         lines.append(f"{name.strip()}: {old!r} -> {value!r}")
+    for name, block in (literal or {}).items():
+        _set(doc, name, LiteralScalarString(block))
+        lines.append(f"{name}: {len(block.splitlines())} lines set")
     buf = io.StringIO()
     rt.dump(doc, buf)
     return buf.getvalue(), lines

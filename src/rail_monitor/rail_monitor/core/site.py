@@ -98,8 +98,8 @@ VEHICLE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("freight", False, "Freight wagons: CNOSSOS-EU's superstructure term (eq. 2.3.9) is counted for "
               "freight vehicles only."),
     ParamSpec("traction", "none", "CNOSSOS-EU traction noise (Table G-5) of each vehicle of the class's trains, by "
-              "vehicle type (at constant speed; sources A and B); none: no traction noise (wagons, coaches).",
-              choices=("none", *TRACTION_TYPES)),
+              f"vehicle type (at constant speed; sources A and B): one of the edition's ({', '.join(TRACTION_TYPES)}) "
+              "or the site's noise.cnossos_catalogue; none: no traction noise (wagons, coaches)."),
     ParamSpec("wheel_load_n", 60000.0, "Nominal static wheel load [N].", 1.0e3, 2.5e5),
     ParamSpec("unsprung_mass_kg", 600.0, "Unsprung mass per wheel (half a wheelset and what moves with it) "
               "[kg].", 50.0, 5000.0),

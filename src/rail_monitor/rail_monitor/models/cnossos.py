@@ -57,7 +57,8 @@ from __future__ import annotations
 
 import csv
 import io
-from dataclasses import dataclass
+import re
+from dataclasses import dataclass, replace
 from functools import lru_cache
 from importlib import resources
 
@@ -86,9 +87,13 @@ TRACTION_TYPES = ("diesel_loco_800kw", "diesel_loco_2200kw", "diesel_loco_1180kw
 AERODYNAMIC_ONSET_KMH = 200.0           # aerodynamic noise is taken into account above this speed (2.3.2)
 
 
+def _rows(text: str) -> list[list[str]]:
+    """The rows of a table file's text: CSV, lines starting with # are comments."""
+    return [[cell.strip() for cell in r] for r in csv.reader(io.StringIO(text)) if r and not r[0].startswith("#")]
+
+
 def _read(name: str) -> tuple[list[str], FloatArray]:
-    text = resources.files("rail_monitor").joinpath("data", name).read_text(encoding="utf-8")
-    rows = [r for r in csv.reader(io.StringIO(text)) if r and not r[0].startswith("#")]
+    rows = _rows(resources.files("rail_monitor").joinpath("data", name).read_text(encoding="utf-8"))
     return rows[0], np.array(rows[1:], float)
 
 
@@ -134,6 +139,71 @@ class Tables:
         return found
 
 
+# A user's catalogue (with_catalogue): what its columns may add, by the table's first column.
+CATALOGUE_COLUMNS = {
+    "frequency_hz": (r"track_[a-z0-9_]+", r"vehicle_wheel_[0-9]+(\.[0-9]+)?mm",
+                     r"traction_[a-z0-9_]+_(constant|idling)_[AB]"),
+    "wavelength_mm": (r"contact_filter_[0-9]+(\.[0-9]+)?kN_[0-9]+(\.[0-9]+)?mm",),
+}
+CATALOGUE_LEVEL_RANGE_DB = (-100.0, 250.0)
+CATALOGUE_MAX_COLUMNS = 200
+
+
+def with_catalogue(base: Tables, text: str) -> Tables:
+    """The edition's tables with a user's own added: ``text`` holds one or more tables in the
+    package's format (lines starting with # are comments; each table starts with its header, a
+    first column ``frequency_hz`` on the 24 nominal bands 50 Hz - 10 kHz or ``wavelength_mm`` on
+    the edition's grid), whose columns are named as the package's are: track transfers
+    ``track_<name>`` [dB per axle], vehicle transfers ``vehicle_wheel_<d>mm`` [dB per axle],
+    traction ``traction_<type>_<constant|idling>_<A|B>`` [dB re 1 pW per vehicle; constant at both
+    heights required], contact filters ``contact_filter_<load>kN_<d>mm`` [dB]. A column may not
+    replace one the edition has. ValueError, one line, for the first fault."""
+    if not text.strip():
+        return base
+    by_f, by_wl = dict(base.by_frequency), dict(base.by_wavelength)
+    grids = {"frequency_hz": (base.band_hz, by_f), "wavelength_mm": (base.wavelength_m * 1e3, by_wl)}
+    tables_seen = 0
+    rows = _rows(text)
+    while rows:
+        head = rows.pop(0)
+        tables_seen += 1
+        where = f"catalogue table {tables_seen}"
+        if head[0] not in grids:
+            raise ValueError(f"{where}: the first column must be one of {tuple(grids)}, not {head[0]!r}")
+        end = next((i for i, r in enumerate(rows) if r[0] in grids), len(rows))
+        body, rows = rows[:end], rows[end:]
+        grid, into = grids[head[0]]
+        if len(head) < 2 or len(head) > CATALOGUE_MAX_COLUMNS or any(len(r) != len(head) for r in body):
+            raise ValueError(f"{where}: every row needs the header's {len(head)} cells, 2 to "
+                             f"{CATALOGUE_MAX_COLUMNS}")
+        try:
+            data = np.array(body, float).reshape(len(body), len(head))
+        except ValueError:
+            raise ValueError(f"{where}: a cell is not a number") from None
+        order = np.argsort(data[:, 0])
+        if len(data) != len(grid) or not np.array_equal(data[order, 0], grid):
+            raise ValueError(f"{where}: {head[0]} must be the edition {base.edition} grid's {len(grid)} values")
+        lo, hi = CATALOGUE_LEVEL_RANGE_DB
+        for j, name in enumerate(head[1:], start=1):
+            if not any(re.fullmatch(p, name) for p in CATALOGUE_COLUMNS[head[0]]):
+                raise ValueError(f"{where}: column {name!r} is none of {CATALOGUE_COLUMNS[head[0]]}")
+            if name in by_f or name in by_wl:
+                raise ValueError(f"{where}: column {name!r} is already a table of edition {base.edition} or of the "
+                                 "catalogue")
+            if not np.all(np.isfinite(data[:, j])) or np.any((data[:, j] < lo) | (data[:, j] > hi)):
+                raise ValueError(f"{where}: column {name!r} must be finite, within [{lo:g}, {hi:g}] dB")
+            into[name] = data[order, j]
+    out = replace(base, by_wavelength=by_wl, by_frequency=by_f)
+    for kind in out.traction_types:
+        if not all(f"traction_{kind}_constant_{h}" in by_f for h in SOURCE_HEIGHTS):
+            raise ValueError(f"catalogue: traction type {kind!r} needs its constant-speed spectrum at A and B")
+    return out
+
+
+def _as_tables(edition: str | Tables) -> Tables:
+    return edition if isinstance(edition, Tables) else tables(edition)
+
+
 def check_edition(edition: str) -> str:
     if edition not in EDITIONS:
         raise ValueError(f"unknown CNOSSOS-EU edition {edition!r}; use one of {EDITIONS}")
@@ -167,25 +237,25 @@ def printed_wheel_roughness() -> tuple[FloatArray, dict[str, FloatArray]]:
 
 
 # -- roughness and contact filter (wavelength domain) --------------------------------------------
-def rail_roughness(roughness_class: str, edition: str = DEFAULT_EDITION) -> FloatArray:
+def rail_roughness(roughness_class: str, edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
     """Rail roughness [dB re 1 um] of class E (EN ISO 3095:2013) or M (average network), Table G-1b
     (G-1 in 2015)."""
     names = {"E": "rail_roughness_E_iso3095", "M": "rail_roughness_M_average_network"}
     if roughness_class not in names:
         raise ValueError(f"rail roughness class must be one of {RAIL_ROUGHNESS_CLASSES}")
-    return tables(edition).by_wavelength[names[roughness_class]]
+    return _as_tables(edition).by_wavelength[names[roughness_class]]
 
 
-def wheel_roughness(brake_type: str, rule: str = "reference", edition: str = DEFAULT_EDITION) -> FloatArray:
+def wheel_roughness(brake_type: str, rule: str = "reference", edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
     """Wheel roughness [dB re 1 um] by brake type (cast_iron, composite, disc), Table G-1a, on the
     tables' grid, as the interpolation rule's implementation holds it: the unrounded values to
     0.01 dB (``reference``) or at the full precision of NoiseModelling's data (``noisemodelling``,
     data/noisemodelling_wheel_roughness.csv; they differ by at most 0.005 dB)."""
     if brake_type not in BRAKE_TYPES:
         raise ValueError(f"brake type must be one of {BRAKE_TYPES}")
-    if check_rule_edition(rule, edition) == "noisemodelling":
+    if check_rule_edition(rule, _as_tables(edition).edition) == "noisemodelling":
         return _noisemodelling_wheel_roughness()[brake_type]
-    return tables(edition).by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
+    return _as_tables(edition).by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
 
 
 @lru_cache(maxsize=1)
@@ -198,21 +268,21 @@ def _noisemodelling_wheel_roughness() -> dict[str, FloatArray]:
 
 
 def contact_filter(wheel_load_n: float, wheel_diameter_m: float,
-                   edition: str = DEFAULT_EDITION) -> tuple[tuple[float, float], FloatArray]:
+                   edition: str | Tables = DEFAULT_EDITION) -> tuple[tuple[float, float], FloatArray]:
     """A_3 [dB] of Table G-2 for the nearest (load, diameter) entry in lg(load) and lg(diameter).
 
     The 2021 table gives five cases; the nearest is taken, diameter first (the filter scales with
     the contact length, which grows with both). Edition 2015 here holds the 920 mm / 50 kN entry
     only. Returns the entry and its column.
     """
-    entries = tables(edition).contact_filters
+    entries = _as_tables(edition).contact_filters
     key = min(entries, key=lambda k: (abs(np.log(k[1] / wheel_diameter_m)), abs(np.log(k[0] / wheel_load_n))))
     return key, entries[key]
 
 
-def impact_roughness(joints_per_m: float, edition: str = DEFAULT_EDITION) -> FloatArray:
+def impact_roughness(joints_per_m: float, edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
     """L_R,IMPACT [dB re 1 um] for a joint density n_l [1/m] (eq. 2.3.11; table for 1 per 100 m)."""
-    return tables(edition).by_wavelength["impact_single_joint_per_100m"] + 10.0 * np.log10(joints_per_m / 0.01)
+    return _as_tables(edition).by_wavelength["impact_single_joint_per_100m"] + 10.0 * np.log10(joints_per_m / 0.01)
 
 
 def total_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike,
@@ -232,9 +302,9 @@ def pad_class(pad_stiffness_npm: float) -> str:
 
 
 def track_transfer(sleeper_type: str, pad_stiffness_npm: float,
-                   edition: str = DEFAULT_EDITION) -> tuple[str, FloatArray]:
+                   edition: str | Tables = DEFAULT_EDITION) -> tuple[str, FloatArray]:
     """L_H,TR [dB per axle] (Table G-3a) for a sleeper type and pad stiffness: (column, values)."""
-    t = tables(edition)
+    t = _as_tables(edition)
     if sleeper_type == "wooden":
         name = "track_wooden_sleepers"
     elif sleeper_type == "direct_fastening":
@@ -246,14 +316,14 @@ def track_transfer(sleeper_type: str, pad_stiffness_npm: float,
     return name, t.column(name, f"track transfer for sleeper type {sleeper_type}")
 
 
-def vehicle_transfer(wheel_diameter_m: float, edition: str = DEFAULT_EDITION) -> tuple[float, FloatArray]:
+def vehicle_transfer(wheel_diameter_m: float, edition: str | Tables = DEFAULT_EDITION) -> tuple[float, FloatArray]:
     """L_H,VEH [dB per axle] (Table G-3b) of the nearest tabulated wheel diameter: (diameter [m], values)."""
-    entries = tables(edition).vehicle_transfers
+    entries = _as_tables(edition).vehicle_transfers
     key = min(entries, key=lambda dia: abs(np.log(dia / wheel_diameter_m)))
     return key, entries[key]
 
 
-def bridge_transfer(bridge_type: str, edition: str = DEFAULT_EDITION) -> FloatArray | None:
+def bridge_transfer(bridge_type: str, edition: str | Tables = DEFAULT_EDITION) -> FloatArray | None:
     """L_H,BRIDGE [dB per axle] (Table G-7 of 2021), or None without a bridge. The 2015 text has a
     scalar bridge constant instead (rolling_sound_power's bridge_constant_db)."""
     columns = {"concrete": "bridge_concrete_plus10dBA", "steel": "bridge_steel_ballasted_plus15dBA"}
@@ -261,7 +331,7 @@ def bridge_transfer(bridge_type: str, edition: str = DEFAULT_EDITION) -> FloatAr
         return None
     if bridge_type not in columns:
         raise ValueError(f"bridge type must be one of {BRIDGE_TYPES}")
-    return tables(edition).column(columns[bridge_type], "bridge transfer table (the 2015 text adds a constant)")
+    return _as_tables(edition).column(columns[bridge_type], "bridge transfer table (the 2015 text adds a constant)")
 
 
 # -- sound power ---------------------------------------------------------------------------------
@@ -313,7 +383,7 @@ def rolling_sound_power(total_roughness_f_db: ArrayLike, axles_per_vehicle: Arra
 
 def vehicle_sound_power(rolling: SourcePower, traction_type: str | None, speed_kmh: ArrayLike,
                         condition: str = "constant",
-                        edition: str = DEFAULT_EDITION) -> dict[str, dict[str, FloatArray]]:
+                        edition: str | Tables = DEFAULT_EDITION) -> dict[str, dict[str, FloatArray]]:
     """L_W,0 per vehicle [dB re 1 pW] by source height and component (2.3.1-2.3.2): at A (h = 1)
     the rolling components (superstructure included, as the reference module places it), the
     bridge, traction and aerodynamic noise; at B (h = 2) traction and aerodynamic noise. An idling
@@ -374,10 +444,10 @@ def _check_source(source: str) -> str:
 
 
 def traction_sound_power(traction_type: str, source: str, condition: str = "constant",
-                         edition: str = DEFAULT_EDITION) -> FloatArray:
+                         edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
     """L_W,0 per vehicle [dB re 1 pW] of traction noise (Table G-5), 24 bands, at source A or B,
     at constant speed or idling. The 2021 table gives one spectrum for both conditions."""
-    t = tables(edition)
+    t = _as_tables(edition)
     if traction_type not in t.traction_types:
         raise ValueError(f"traction type must be one of {t.traction_types} (edition {edition})")
     if condition not in RUNNING_CONDITIONS:
@@ -388,12 +458,12 @@ def traction_sound_power(traction_type: str, source: str, condition: str = "cons
     return t.by_frequency[name]
 
 
-def aerodynamic_sound_power(speed_kmh: ArrayLike, source: str, edition: str = DEFAULT_EDITION,
+def aerodynamic_sound_power(speed_kmh: ArrayLike, source: str, edition: str | Tables = DEFAULT_EDITION,
                             v0_kmh: float = 300.0, alpha: float = 50.0) -> FloatArray:
     """L_W,0 per vehicle [dB re 1 pW] of aerodynamic noise (Table G-6): L_W,0,1 + alpha lg(v / v0)
     above 200 km/h, -inf (no power) at or below it: shape speed.shape + (24,)."""
     v = np.asarray(speed_kmh, float)[..., None]
-    spectrum = tables(edition).by_frequency[f"aerodynamic_{_check_source(source)}_300kmh"]
+    spectrum = _as_tables(edition).by_frequency[f"aerodynamic_{_check_source(source)}_300kmh"]
     with np.errstate(divide="ignore"):
         return np.where(v > AERODYNAMIC_ONSET_KMH, spectrum + alpha * np.log10(v / v0_kmh), -np.inf)
 

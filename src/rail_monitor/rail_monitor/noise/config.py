@@ -36,6 +36,13 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
               "rail roughness, ascending [m] (default: the CNOSSOS grid).", 1e-4, 10.0),
     ParamSpec("rail_roughness_db", _CLASS_E.tolist(), "Measured rail roughness per 1/3-octave wavelength band "
               "[dB re 1 um] (default: class E).", -60.0, 80.0),
+    ParamSpec("cnossos_catalogue", "", "A catalogue of your own added to the edition's CNOSSOS-EU tables: the text "
+              "of one or more tables in the package's CSV format (docs/models.md), first column frequency_hz "
+              "(track_<name>, vehicle_wheel_<d>mm, traction_<type>_<constant|idling>_<A|B>) or wavelength_mm on the "
+              "edition's grid (contact_filter_<load>kN_<d>mm); rail-monitor site --cnossos-catalogue FILE puts a "
+              "file here."),
+    ParamSpec("track_transfer", "", "Track transfer column to use (a track_<name> of the tables or the catalogue); "
+              "'': by sleeper_type and the pad class."),
     ParamSpec("sleeper_type", "monoblock", "Sleeper type for CNOSSOS's track transfer (Table G-3a); the pad class "
               "follows track.pad_stiffness_npm.", choices=cn.SLEEPER_TYPES),
     ParamSpec("bridge", "none", "Bridge at the site (CNOSSOS Table G-7; edition 2021).", choices=cn.BRIDGE_TYPES),
@@ -113,7 +120,21 @@ def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConf
         raise ConfigError(f"parameters '{prefix}rail_roughness_wavelength_m' and '{prefix}rail_roughness_db' must "
                           "have the same length (at least 2), wavelengths strictly ascending")
     _check_edition_terms(values, prefix)
+    _check_catalogue(values, prefix)
     return values_of(NoiseConfig, values)
+
+
+def _check_catalogue(values: Mapping[str, Any], prefix: str) -> None:
+    """The user's catalogue must read against its edition, and a chosen track transfer must exist."""
+    try:
+        tables = cn.with_catalogue(cn.tables(values["cnossos_edition"]), values["cnossos_catalogue"])
+    except ValueError as exc:
+        raise ConfigError(f"parameter '{prefix}cnossos_catalogue': {exc}") from None
+    name = values["track_transfer"]
+    if name and (not name.startswith("track_") or name not in tables.by_frequency):
+        known = ", ".join(n for n in tables.by_frequency if n.startswith("track_"))
+        raise ConfigError(f"parameter '{prefix}track_transfer' = {name!r} is none of the edition's and the "
+                          f"catalogue's track transfers ({known})")
 
 
 def _check_edition_terms(values: Mapping[str, Any], prefix: str) -> None:

@@ -139,16 +139,19 @@ class RollingNoiseModel:
     def __init__(self, site: Site, cfg: NoiseConfig) -> None:
         self.site, self.cfg = site, cfg
         self.edition = ed = cfg.cnossos_edition
-        t = cn.tables(ed)
+        self.tables = t = cn.with_catalogue(cn.tables(ed), cfg.cnossos_catalogue)   # checked by noise_config
         self.grid = t.wavelength_m
         self.band, self.band_hz = t.band, t.band_hz
         self.receiver = cfg.receiver
         (_, psi), _ = self.receiver.paths()
         self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz, ed)
         self.baseline_db = self._baseline()
-        self.impact_db = cn.impact_roughness(cfg.joints_per_100m / 100.0, ed) if cfg.joints_per_100m > 0 else None
-        self.track_name, track_db = cn.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm, ed)
-        self.bridge_db = cn.bridge_transfer(cfg.bridge, ed)
+        self.impact_db = cn.impact_roughness(cfg.joints_per_100m / 100.0, t) if cfg.joints_per_100m > 0 else None
+        if cfg.track_transfer:
+            self.track_name, track_db = cfg.track_transfer, t.by_frequency[cfg.track_transfer]
+        else:
+            self.track_name, track_db = cn.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm, t)
+        self.bridge_db = cn.bridge_transfer(cfg.bridge, t)
         # The 2015 bridge constant raises the rolling components as the curve-squeal term does.
         self.squeal_db = (cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0) \
             + cfg.bridge_constant_db
@@ -159,10 +162,10 @@ class RollingNoiseModel:
                 raise ConfigError(f"parameter 'vehicle.{name}.traction': CNOSSOS-EU edition {ed} has no traction "
                                   f"type {v.traction!r} (it has {', '.join(t.traction_types)})")
             traction = {} if v.traction == "none" else {
-                f"traction_{src.lower()}": cn.traction_sound_power(v.traction, src, "constant", ed) for src in "AB"}
+                f"traction_{src.lower()}": cn.traction_sound_power(v.traction, src, "constant", t) for src in "AB"}
             contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
-            _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, ed)
-            _, veh = cn.vehicle_transfer(v.wheel_diameter_m, ed)
+            _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, t)
+            _, veh = cn.vehicle_transfer(v.wheel_diameter_m, t)
             cnossos = {"track": track_db + self.squeal_db, "vehicle": veh + self.squeal_db}
             if v.freight:  # L_H,VEH,SUP of Table G-3c: 0 dB, for freight vehicles only (eq. 2.3.9)
                 cnossos["superstructure"] = np.full(len(self.band), self.squeal_db)
@@ -172,7 +175,7 @@ class RollingNoiseModel:
             mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
                                      v.wheel_diameter_m, cfg.radiators, cfg.transfer_points, modes=modes,
                                      wheel_damping_ratio=v.wheel_damping_ratio)
-            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, ed), a3, cnossos,
+            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, t), a3, cnossos,
                                              mech, traction)
 
     def component_names(self, model: str) -> list[str]:
@@ -195,7 +198,7 @@ class RollingNoiseModel:
     def _baseline(self) -> np.ndarray:
         source = self.cfg.rail_roughness
         if source != "measured":
-            return cn.rail_roughness(source, self.edition)
+            return cn.rail_roughness(source, self.tables)
         wl = np.asarray(self.cfg.rail_roughness_wavelength_m, float)
         return np.interp(self.grid, wl, np.asarray(self.cfg.rail_roughness_db, float))
 
@@ -321,7 +324,7 @@ class RollingNoiseModel:
             speed_kmh = passes.speed_mps[rows] * KMH_PER_MPS
             for src in "AB":
                 components[f"aerodynamic_{src.lower()}"][rows] = \
-                    cn.aerodynamic_sound_power(speed_kmh, src, self.edition) + per_metre
+                    cn.aerodynamic_sound_power(speed_kmh, src, self.tables) + per_metre
 
     def _geometries(self, passes: PassTable, model: str) -> tuple[PassGeometry, PassGeometry | None]:
         """The pass geometry of source A, and of source B (4 m) where the model has components there."""
