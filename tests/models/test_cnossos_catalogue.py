@@ -72,6 +72,7 @@ GRID = ",".join(f"{f:g}" for f in T.band_hz)
     (wavelength_table("contact_filter_80kN_760mm", FILTER[1:], T.wavelength_m[1:] * 1e3), "grid's 35 values"),
     (wavelength_table("vehicle_wheel_760mm", FILTER, T.wavelength_m * 1e3), "is none of"),
     ("frequency_hz," + ",".join(f"track_{i}" for i in range(300)) + "\n", "every row needs"),
+    ("#" * (cn.CATALOGUE_MAX_CHARS + 1), "more than"),
 ])
 def test_a_faulty_catalogue_is_refused_with_one_line(text, why):
     with pytest.raises(ValueError, match=why) as err:

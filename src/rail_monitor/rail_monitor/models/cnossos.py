@@ -147,6 +147,7 @@ CATALOGUE_COLUMNS = {
 }
 CATALOGUE_LEVEL_RANGE_DB = (-100.0, 250.0)
 CATALOGUE_MAX_COLUMNS = 200
+CATALOGUE_MAX_CHARS = 1_000_000   # far above any real catalogue; a larger text is refused before it is parsed
 
 
 def with_catalogue(base: Tables, text: str) -> Tables:
@@ -160,6 +161,8 @@ def with_catalogue(base: Tables, text: str) -> Tables:
     replace one the edition has. ValueError, one line, for the first fault."""
     if not text.strip():
         return base
+    if len(text) > CATALOGUE_MAX_CHARS:
+        raise ValueError(f"catalogue: {len(text)} characters, more than {CATALOGUE_MAX_CHARS}")
     by_f, by_wl = dict(base.by_frequency), dict(base.by_wavelength)
     grids = {"frequency_hz": (base.band_hz, by_f), "wavelength_mm": (base.wavelength_m * 1e3, by_wl)}
     tables_seen = 0
