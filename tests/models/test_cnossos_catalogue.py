@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rail_monitor.models import cnossos as cn
 
@@ -73,6 +75,8 @@ GRID = ",".join(f"{f:g}" for f in T.band_hz)
     (wavelength_table("vehicle_wheel_760mm", FILTER, T.wavelength_m * 1e3), "is none of"),
     ("frequency_hz," + ",".join(f"track_{i}" for i in range(300)) + "\n", "every row needs"),
     ("#" * (cn.CATALOGUE_MAX_CHARS + 1), "more than"),
+    ("frequency_hz,track_x\n\r0", "not CSV text"),
+    ("frequency_hz,track_x\n50,\x00\n", "not CSV text|every row|not a number"),
 ])
 def test_a_faulty_catalogue_is_refused_with_one_line(text, why):
     with pytest.raises(ValueError, match=why) as err:
@@ -86,3 +90,14 @@ def test_a_2015_catalogue_is_on_the_2015_grid():
     assert (80e3, 0.76) in cn.with_catalogue(t15, text).contact_filters
     with pytest.raises(ValueError, match="edition 2015 grid's 32 values"):
         cn.with_catalogue(t15, wavelength_table("contact_filter_80kN_760mm", FILTER, T.wavelength_m * 1e3))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(max_size=300), st.sampled_from(["", "frequency_hz,track_x\n", "wavelength_mm,contact_filter_1kN_1mm\n",
+                                                "frequency_hz,track_x\n" + "".join(f"{f:g},1\n" for f in T.band_hz)]))
+def test_any_text_is_a_catalogue_or_one_line_refusal(text, head):
+    # Hostile input: whatever the text, a ValueError of one line or tables; never another exception.
+    try:
+        cn.with_catalogue(T, head + text)
+    except ValueError as exc:
+        assert "\n" not in str(exc)

@@ -166,7 +166,10 @@ def with_catalogue(base: Tables, text: str) -> Tables:
     by_f, by_wl = dict(base.by_frequency), dict(base.by_wavelength)
     grids = {"frequency_hz": (base.band_hz, by_f), "wavelength_mm": (base.wavelength_m * 1e3, by_wl)}
     tables_seen = 0
-    rows = _rows(text)
+    try:
+        rows = _rows(text)
+    except csv.Error as exc:
+        raise ValueError(f"catalogue: not CSV text: {exc}") from None
     while rows:
         head = rows.pop(0)
         tables_seen += 1
