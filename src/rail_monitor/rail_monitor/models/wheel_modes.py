@@ -236,10 +236,13 @@ def harmonic_modes(blocks: tuple[tuple[float, float, float, float], ...], materi
     kk, mm = k[idx][:, idx].tocsc(), m[idx][:, idx].tocsc()
     # Shift below zero so that a free body's rigid-body modes do not make the shifted matrix singular;
     # ask for more modes until one lies above max_hz (or all are found).
+    # A fixed start vector: ARPACK's own draws from a generator it keeps between calls, so the modes'
+    # last bits would depend on what the process solved before.
+    start = np.random.default_rng(0).standard_normal(len(idx))
     count = 14
     while True:
         count = min(count, len(idx) - 2)
-        lam, vec = eigsh(kk, k=count, M=mm, sigma=-(2 * np.pi * 5.0) ** 2, which="LM")
+        lam, vec = eigsh(kk, k=count, M=mm, sigma=-(2 * np.pi * 5.0) ** 2, which="LM", v0=start)
         if np.sqrt(max(lam.max(), 0.0)) / (2 * np.pi) > max_hz or count == len(idx) - 2:
             break
         count *= 2

@@ -35,7 +35,7 @@ from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.contact import contact_state
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import KMH_PER_MPS, PassTable
-from rail_monitor.core.site import Site
+from rail_monitor.core.site import Site, VehicleClass
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_modes as wm
@@ -43,6 +43,7 @@ from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
 from rail_monitor.models.passby_axles import AxleLayout, axle_layout
+from rail_monitor.models.track import Track
 from rail_monitor.noise.config import MODELS, NoiseConfig, selected_models
 
 # What roughness_growth_increase_db is measured against, for every label that shows it.
@@ -171,10 +172,7 @@ class RollingNoiseModel:
                 cnossos["superstructure"] = np.full(len(self.band), self.squeal_db)
             if self.bridge_db is not None:
                 cnossos["bridge"] = self.bridge_db
-            modes = wheel_modes(v.wheel_diameter_m) if cfg.wheel == "modal" else None
-            mech = wrn.axle_transfer(self.band, site.track, v.unsprung_mass_kg, float(contact.stiffness),
-                                     v.wheel_diameter_m, cfg.radiators, cfg.transfer_points, modes=modes,
-                                     wheel_damping_ratio=v.wheel_damping_ratio)
+            mech = mechanics_transfer(self.band, site.track, v, float(contact.stiffness), cfg)
             self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, t), a3, cnossos,
                                              mech, traction)
 
@@ -356,6 +354,26 @@ class RollingNoiseModel:
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
         return lr, terms.mechanics
+
+
+def mechanics_transfer(band: np.ndarray, trk: Track, v: VehicleClass, contact_stiffness_npm: float,
+                       cfg: NoiseConfig) -> dict[str, np.ndarray]:
+    """The mechanics model's L_H,mech per component for an axle of the class (models.wheel_rail_noise.
+    axle_transfer), kept in the on-disk cache: 0.2 s a class at 400 frequencies per band, most of it
+    the wheel modes' radiation efficiencies, paid at every node start and command otherwise."""
+    inputs = {"band": np.asarray(band).tolist(), "track": dataclasses.asdict(trk),
+              "unsprung_mass_kg": v.unsprung_mass_kg, "contact_stiffness_npm": contact_stiffness_npm,
+              "wheel_diameter_m": v.wheel_diameter_m, "radiators": dataclasses.asdict(cfg.radiators),
+              "points": cfg.transfer_points, "wheel": cfg.wheel, "wheel_damping_ratio": v.wheel_damping_ratio}
+
+    def build() -> dict[str, np.ndarray]:
+        modes = wheel_modes(v.wheel_diameter_m) if cfg.wheel == "modal" else None
+        return wrn.axle_transfer(band, trk, v.unsprung_mass_kg, contact_stiffness_npm, v.wheel_diameter_m,
+                                 cfg.radiators, cfg.transfer_points, modes=modes,
+                                 wheel_damping_ratio=v.wheel_damping_ratio)
+
+    arrays = cached_arrays("axle_transfer", inputs, build)
+    return {name: arrays[name] for name in wrn.COMPONENTS}
 
 
 def wheel_modes(diameter_m: float) -> wm.WheelModes:
