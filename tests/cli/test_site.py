@@ -28,7 +28,9 @@ def test_a_mistake_is_one_line_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "bad.yaml"
     for change, why in (("curve_radius_m=400", "write 400 with a decimal point"),
                         ("vehicle.emu.wheel_diamter_m=0.9", "did you mean 'vehicle.emu.wheel_diameter_m'"),
-                        ("curve_radius_m", "expected NAME=VALUE")):
+                        ("curve_radius_m", "expected NAME=VALUE"),
+                        ("vehicle.dmu.traction=dmuu", "has no traction type 'dmuu'"),
+                        ("noise.bridge_constant_db=3.0", "has Table G-7 instead of a bridge constant")):
         assert main(["site", str(out), "--set", change]) == 2
         err = capsys.readouterr().err
         assert why in err and err.count("\n") == 1, err

@@ -27,7 +27,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.noise.config import noise_config
+    from rail_monitor.noise.config import check_traction, noise_config
     from rail_monitor.site_file import check_parameter_file, load_parameter_file, load_site
 
     out = Path(ns.output)
@@ -45,7 +45,7 @@ def run(ns: argparse.Namespace) -> int:
         tmp.write_text(text, encoding="utf-8")
         check_parameter_file(tmp)
         site = load_site(tmp)
-        noise_config(load_parameter_file(tmp))   # the terms that depend on each other (edition, catalogue)
+        check_traction(site, noise_config(load_parameter_file(tmp)))   # terms that depend on each other
         tmp.replace(out)
     except OSError as exc:
         raise RailMonitorError(f"{out}: cannot write: {exc.strerror or exc}") from None

@@ -4,7 +4,7 @@ CNOSSOS-EU track terms, receiver and ground, mechanics radiators."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -14,6 +14,9 @@ from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.passby import Receiver
+
+if TYPE_CHECKING:
+    from rail_monitor.core.site import Site
 
 MODELS = ("cnossos", "mechanics")
 PASS_BY_SOURCES = ("axles", "line")
@@ -124,10 +127,26 @@ def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConf
     return values_of(NoiseConfig, values)
 
 
+def site_tables(edition: str, catalogue: str) -> cn.Tables:
+    """The CNOSSOS-EU tables a site selects: its edition's, with its catalogue."""
+    return cn.with_catalogue(cn.tables(edition), catalogue)
+
+
+def check_traction(site: Site, cfg: NoiseConfig) -> cn.Tables:
+    """ConfigError for a vehicle class whose traction type the site's tables lack; the tables."""
+    tables = site_tables(cfg.cnossos_edition, cfg.cnossos_catalogue)
+    for name, v in site.vehicles.items():
+        if v.traction != "none" and v.traction not in tables.traction_types:
+            raise ConfigError(f"parameter 'vehicle.{name}.traction': CNOSSOS-EU edition {cfg.cnossos_edition} has no "
+                              f"traction type {v.traction!r} (it has {', '.join(tables.traction_types)}; a site's "
+                              "catalogue may add more)")
+    return tables
+
+
 def _check_catalogue(values: Mapping[str, Any], prefix: str) -> None:
     """The user's catalogue must read against its edition, and a chosen track transfer must exist."""
     try:
-        tables = cn.with_catalogue(cn.tables(values["cnossos_edition"]), values["cnossos_catalogue"])
+        tables = site_tables(values["cnossos_edition"], values["cnossos_catalogue"])
     except ValueError as exc:
         raise ConfigError(f"parameter '{prefix}cnossos_catalogue': {exc}") from None
     name = values["track_transfer"]

@@ -33,7 +33,6 @@ import numpy as np
 
 from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.contact import contact_state
-from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import KMH_PER_MPS, PassTable
 from rail_monitor.core.site import Site, VehicleClass
 from rail_monitor.models import cnossos as cn
@@ -44,7 +43,7 @@ from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
 from rail_monitor.models.passby_axles import AxleLayout, axle_layout
 from rail_monitor.models.track import Track
-from rail_monitor.noise.config import MODELS, NoiseConfig, selected_models
+from rail_monitor.noise.config import MODELS, NoiseConfig, check_traction, selected_models
 
 # What roughness_growth_increase_db is measured against, for every label that shows it.
 INCREASE_REFERENCE = ("the same pass on the site's baseline rail roughness (noise.rail_roughness: as ground, "
@@ -140,7 +139,7 @@ class RollingNoiseModel:
     def __init__(self, site: Site, cfg: NoiseConfig) -> None:
         self.site, self.cfg = site, cfg
         self.edition = ed = cfg.cnossos_edition
-        self.tables = t = cn.with_catalogue(cn.tables(ed), cfg.cnossos_catalogue)   # checked by noise_config
+        self.tables = t = check_traction(site, cfg)
         self.grid = t.wavelength_m
         self.band, self.band_hz = t.band, t.band_hz
         self.receiver = cfg.receiver
@@ -159,9 +158,6 @@ class RollingNoiseModel:
         self.receiver_b = dataclasses.replace(self.receiver, source_height_m=cn.SOURCE_HEIGHTS["B"])
         self.classes: dict[str, _ClassTerms] = {}
         for name, v in site.vehicles.items():
-            if v.traction != "none" and v.traction not in t.traction_types:
-                raise ConfigError(f"parameter 'vehicle.{name}.traction': CNOSSOS-EU edition {ed} has no traction "
-                                  f"type {v.traction!r} (it has {', '.join(t.traction_types)})")
             traction = {} if v.traction == "none" else {
                 f"traction_{src.lower()}": cn.traction_sound_power(v.traction, src, "constant", t) for src in "AB"}
             contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
