@@ -19,9 +19,11 @@ from rail_monitor.noise.predict import INCREASE_REFERENCE, Corrugation, NoisePre
 # What each spectrum of the JSON holds (bands: band_centre_hz).
 SPECTRUM_DEFINITIONS = {
     "components_lpaeq_dba": "LpAeq,Tp of each source component alone [dB(A)] (CNOSSOS-EU's superstructure term "
-                            "for freight classes only)",
+                            "for freight classes only; components ending _b radiate from source B, 4 m above the "
+                            "rail head, the others from source A)",
     "lw0_per_vehicle_db": "sound power per vehicle per component and band [dB re 1 pW]: for CNOSSOS-EU L_W,0 of "
-                          "Directive 2015/996 Annex II eqs. 2.3.7-2.3.9 (2.3.14 for a bridge), no directivity",
+                          "Directive 2015/996 Annex II eqs. 2.3.7-2.3.9 (2.3.14 for a bridge; Table G-5 for "
+                          "traction_a/_b, G-6 for aerodynamic_a/_b), no directivity",
     "lw_db_per_m": "sound power per metre of train, all components [dB re 1 pW/m]",
     "lp_db": "LpZeq,Tp per band at the receiver [dB re 20 uPa]",
     "roughness_db": "combined effective roughness at the band frequencies [dB re 1 um]",
