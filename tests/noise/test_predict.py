@@ -3,8 +3,6 @@ noise"), for both source models."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -275,10 +273,7 @@ def test_traction_and_aerodynamic_noise_from_sources_a_and_b(site_values):
 def test_a_sites_own_catalogue_supplies_track_wheel_filter_and_traction(site_values):
     # The site's catalogue (noise.cnossos_catalogue) is read like the edition's tables: the chosen track
     # transfer, the wheel transfer and contact filter nearest the class's wheel, a traction type of its own.
-    import sys
-
-    sys.path.insert(0, str(Path(__file__).parents[1] / "models"))
-    from test_cnossos_catalogue import FILTER, LOCO_A, TRACK, WHEEL, catalogue
+    from models.test_cnossos_catalogue import FILTER, LOCO_A, TRACK, WHEEL, catalogue
 
     values = {**site_values, "noise.cnossos_catalogue": catalogue(), "noise.track_transfer": "track_slab",
               "vehicle.dmu.traction": "shunter", "vehicle.dmu.wheel_diameter_m": 0.76, "vehicle.dmu.wheel_load_n": 80e3}

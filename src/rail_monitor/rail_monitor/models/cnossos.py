@@ -259,9 +259,10 @@ def wheel_roughness(brake_type: str, rule: str = "reference", edition: str | Tab
     data/noisemodelling_wheel_roughness.csv; they differ by at most 0.005 dB)."""
     if brake_type not in BRAKE_TYPES:
         raise ValueError(f"brake type must be one of {BRAKE_TYPES}")
-    if check_rule_edition(rule, _as_tables(edition).edition) == "noisemodelling":
+    t = _as_tables(edition)
+    if check_rule_edition(rule, t.edition) == "noisemodelling":
         return _noisemodelling_wheel_roughness()[brake_type]
-    return _as_tables(edition).by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
+    return t.by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
 
 
 @lru_cache(maxsize=1)

@@ -31,18 +31,22 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.contact import contact_state
 from rail_monitor.core.passes import KMH_PER_MPS, PassTable
-from rail_monitor.core.site import Site, VehicleClass
+from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
-from rail_monitor.models import wheel_modes as wm
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
 from rail_monitor.models.passby_axles import AxleLayout, axle_layout
-from rail_monitor.models.track import Track
+from rail_monitor.noise.class_terms import (
+    AERODYNAMIC_COMPONENTS,
+    SOURCE_B_COMPONENTS,
+    ClassTerms,
+    class_terms,
+    source_component,
+)
 from rail_monitor.noise.config import MODELS, NoiseConfig, check_traction, selected_models
 
 # What roughness_growth_increase_db is measured against, for every label that shows it.
@@ -118,21 +122,6 @@ class NoisePrediction:
         return replace(self, **out)
 
 
-@dataclass(frozen=True)
-class _ClassTerms:
-    """Per vehicle class, speed-independent: wheel roughness, filters and transfers."""
-
-    wheel_db: np.ndarray                 # on the CNOSSOS wavelength grid [dB re 1 um]
-    a3_db: np.ndarray                    # CNOSSOS contact filter on the grid [dB]
-    cnossos: dict[str, np.ndarray]       # L_H per component [dB per axle], 24 bands
-    mechanics: dict[str, np.ndarray]     # L_H,mech per component [dB per axle]
-    traction: dict[str, np.ndarray]      # CNOSSOS L_W,0 per vehicle by source [dB re 1 pW], 24 bands
-
-
-# CNOSSOS-EU's components radiated from source B (4 m above the rail head); the others from A.
-SOURCE_B_COMPONENTS = ("traction_b", "aerodynamic_b")
-
-
 class RollingNoiseModel:
     """Both source models for one site, with everything speed-independent computed once."""
 
@@ -152,25 +141,10 @@ class RollingNoiseModel:
         else:
             self.track_name, track_db = cn.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm, t)
         self.bridge_db = cn.bridge_transfer(cfg.bridge, t)
-        # The 2015 bridge constant raises the rolling components as the curve-squeal term does.
-        self.squeal_db = (cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0) \
-            + cfg.bridge_constant_db
+        # The curve-squeal term and the 2015 bridge constant raise every rolling component alike.
+        excess = (cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0) + cfg.bridge_constant_db
         self.receiver_b = dataclasses.replace(self.receiver, source_height_m=cn.SOURCE_HEIGHTS["B"])
-        self.classes: dict[str, _ClassTerms] = {}
-        for name, v in site.vehicles.items():
-            traction = {} if v.traction == "none" else {
-                f"traction_{src.lower()}": cn.traction_sound_power(v.traction, src, "constant", t) for src in "AB"}
-            contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
-            _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, t)
-            _, veh = cn.vehicle_transfer(v.wheel_diameter_m, t)
-            cnossos = {"track": track_db + self.squeal_db, "vehicle": veh + self.squeal_db}
-            if v.freight:  # L_H,VEH,SUP of Table G-3c: 0 dB, for freight vehicles only (eq. 2.3.9)
-                cnossos["superstructure"] = np.full(len(self.band), self.squeal_db)
-            if self.bridge_db is not None:
-                cnossos["bridge"] = self.bridge_db
-            mech = mechanics_transfer(self.band, site.track, v, float(contact.stiffness), cfg)
-            self.classes[name] = _ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, t), a3, cnossos,
-                                             mech, traction)
+        self.classes = class_terms(site, cfg, t, track_db, excess, self.bridge_db)
 
     def component_names(self, model: str) -> list[str]:
         """The model's source components over the site's classes, in a fixed order."""
@@ -181,7 +155,7 @@ class RollingNoiseModel:
             for terms in self.classes.values():
                 names.update(dict.fromkeys(terms.traction))
             if self.cfg.aerodynamic:
-                names.update(dict.fromkeys(("aerodynamic_a", "aerodynamic_b")))
+                names.update(dict.fromkeys(AERODYNAMIC_COMPONENTS))
         return list(names)
 
     @property
@@ -307,7 +281,7 @@ class RollingNoiseModel:
                 self._vehicle_sources(components, rows, self.classes[name], passes)
         return roughness, components
 
-    def _vehicle_sources(self, components: dict[str, np.ndarray], rows: np.ndarray, terms: _ClassTerms,
+    def _vehicle_sources(self, components: dict[str, np.ndarray], rows: np.ndarray, terms: ClassTerms,
                          passes: PassTable) -> None:
         """CNOSSOS-EU's traction and aerodynamic power per metre of train [dB re 1 pW/m] on the rows
         of one class: L_W,0 per vehicle + 10 lg(vehicles / train length)."""
@@ -316,8 +290,8 @@ class RollingNoiseModel:
             components[comp][rows] = lw0 + per_metre
         if self.cfg.aerodynamic:
             speed_kmh = passes.speed_mps[rows] * KMH_PER_MPS
-            for src in "AB":
-                components[f"aerodynamic_{src.lower()}"][rows] = \
+            for src in cn.SOURCE_HEIGHTS:
+                components[source_component("aerodynamic", src)][rows] = \
                     cn.aerodynamic_sound_power(speed_kmh, src, self.tables) + per_metre
 
     def _geometries(self, passes: PassTable, model: str) -> tuple[PassGeometry, PassGeometry | None]:
@@ -340,7 +314,7 @@ class RollingNoiseModel:
         return pass_by(total, self.band, geometry.length, geometry.speed, self.receiver, self.vertical_db,
                        time_weighted, geometry, elevated)
 
-    def _roughness(self, rail_db: np.ndarray, terms: _ClassTerms, speed: np.ndarray, model: str,
+    def _roughness(self, rail_db: np.ndarray, terms: ClassTerms, speed: np.ndarray, model: str,
                    filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
         rule = self.cfg.interpolation
@@ -350,34 +324,6 @@ class RollingNoiseModel:
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
         return lr, terms.mechanics
-
-
-def mechanics_transfer(band: np.ndarray, trk: Track, v: VehicleClass, contact_stiffness_npm: float,
-                       cfg: NoiseConfig) -> dict[str, np.ndarray]:
-    """The mechanics model's L_H,mech per component for an axle of the class (models.wheel_rail_noise.
-    axle_transfer), kept in the on-disk cache: 0.2 s a class at 400 frequencies per band, most of it
-    the wheel modes' radiation efficiencies, paid at every node start and command otherwise."""
-    inputs = {"band": np.asarray(band).tolist(), "track": dataclasses.asdict(trk),
-              "unsprung_mass_kg": v.unsprung_mass_kg, "contact_stiffness_npm": contact_stiffness_npm,
-              "wheel_diameter_m": v.wheel_diameter_m, "radiators": dataclasses.asdict(cfg.radiators),
-              "points": cfg.transfer_points, "wheel": cfg.wheel, "wheel_damping_ratio": v.wheel_damping_ratio}
-
-    def build() -> dict[str, np.ndarray]:
-        modes = wheel_modes(v.wheel_diameter_m) if cfg.wheel == "modal" else None
-        return wrn.axle_transfer(band, trk, v.unsprung_mass_kg, contact_stiffness_npm, v.wheel_diameter_m,
-                                 cfg.radiators, cfg.transfer_points, modes=modes,
-                                 wheel_damping_ratio=v.wheel_damping_ratio)
-
-    arrays = cached_arrays("axle_transfer", inputs, build)
-    return {name: arrays[name] for name in wrn.COMPONENTS}
-
-
-def wheel_modes(diameter_m: float) -> wm.WheelModes:
-    """The flexible modes of the representative wheel of this diameter (models.wheel_modes), kept in
-    the on-disk cache: their finite-element solution takes about 0.6 s per wheel."""
-    section = wm.WheelSection.scaled(diameter_m)
-    arrays = cached_arrays("wheel_modes", dataclasses.asdict(section), lambda: wm.wheel_modes(section).arrays())
-    return wm.WheelModes(*(np.array(arrays[k]) for k in wm.MODE_ARRAYS), section.rolling_radius_m)
 
 
 def _class_rows(passes: PassTable) -> Iterator[tuple[str, np.ndarray]]:
