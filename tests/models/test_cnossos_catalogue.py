@@ -1,4 +1,4 @@
-"""A user's own CNOSSOS-EU tables (models.cnossos.with_catalogue): added in the package's format, read
+"""A user's own CNOSSOS-EU tables (models.cnossos_catalogue.with_catalogue): added in the package's format, read
 the way the package's tables are, and every fault refused with one line that names it."""
 
 from __future__ import annotations
@@ -9,6 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_catalogue as cc
 
 T = cn.tables()
 
@@ -39,7 +40,7 @@ def catalogue() -> str:
 
 
 def test_the_catalogues_tables_are_read_as_the_packages_are():
-    t = cn.with_catalogue(T, catalogue())
+    t = cc.with_catalogue(T, catalogue())
     name, track = cn.track_transfer("monoblock", 3.5e8, t)      # the edition's own still there
     np.testing.assert_array_equal(track, T.by_frequency[name])
     np.testing.assert_array_equal(t.by_frequency["track_slab"], TRACK)       # the values exactly as written
@@ -50,7 +51,7 @@ def test_the_catalogues_tables_are_read_as_the_packages_are():
     np.testing.assert_array_equal(a3, FILTER)                                # put on the ascending grid
     np.testing.assert_array_equal(cn.traction_sound_power("shunter", "B", "constant", t), LOCO_B)
     np.testing.assert_array_equal(cn.traction_sound_power("shunter", "A", "idling", t), LOCO_A)  # idling: constant
-    assert "shunter" in t.traction_types and cn.with_catalogue(T, "  \n") is T
+    assert "shunter" in t.traction_types and cc.with_catalogue(T, "  \n") is T
     assert "track_slab" not in T.by_frequency                                # the edition's tables untouched
 
 
@@ -74,22 +75,22 @@ GRID = ",".join(f"{f:g}" for f in T.band_hz)
     (wavelength_table("contact_filter_80kN_760mm", FILTER[1:], T.wavelength_m[1:] * 1e3), "grid's 35 values"),
     (wavelength_table("vehicle_wheel_760mm", FILTER, T.wavelength_m * 1e3), "is none of"),
     ("frequency_hz," + ",".join(f"track_{i}" for i in range(300)) + "\n", "every row needs"),
-    ("#" * (cn.CATALOGUE_MAX_CHARS + 1), "more than"),
+    ("#" * (cc.CATALOGUE_MAX_CHARS + 1), "more than"),
     ("frequency_hz,track_x\n\r0", "not CSV text"),
     ("frequency_hz,track_x\n50,\x00\n", "not CSV text|every row|not a number"),
 ])
 def test_a_faulty_catalogue_is_refused_with_one_line(text, why):
     with pytest.raises(ValueError, match=why) as err:
-        cn.with_catalogue(T, text)
+        cc.with_catalogue(T, text)
     assert "\n" not in str(err.value)
 
 
 def test_a_2015_catalogue_is_on_the_2015_grid():
     t15 = cn.tables("2015")
     text = wavelength_table("contact_filter_80kN_760mm", FILTER[3:], t15.wavelength_m * 1e3)
-    assert (80e3, 0.76) in cn.with_catalogue(t15, text).contact_filters
+    assert (80e3, 0.76) in cc.with_catalogue(t15, text).contact_filters
     with pytest.raises(ValueError, match="edition 2015 grid's 32 values"):
-        cn.with_catalogue(t15, wavelength_table("contact_filter_80kN_760mm", FILTER, T.wavelength_m * 1e3))
+        cc.with_catalogue(t15, wavelength_table("contact_filter_80kN_760mm", FILTER, T.wavelength_m * 1e3))
 
 
 @settings(max_examples=300, deadline=None)
@@ -98,6 +99,6 @@ def test_a_2015_catalogue_is_on_the_2015_grid():
 def test_any_text_is_a_catalogue_or_one_line_refusal(text, head):
     # Hostile input: whatever the text, a ValueError of one line or tables; never another exception.
     try:
-        cn.with_catalogue(T, head + text)
+        cc.with_catalogue(T, head + text)
     except ValueError as exc:
         assert "\n" not in str(exc)

@@ -13,6 +13,7 @@ from rail_monitor.core.params import ParamSpec, resolve, section, values_of, val
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_rail_noise as wrn
+from rail_monitor.models.cnossos_catalogue import with_catalogue
 from rail_monitor.models.passby import Receiver
 
 if TYPE_CHECKING:
@@ -129,7 +130,7 @@ def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConf
 
 def site_tables(edition: str, catalogue: str) -> cn.Tables:
     """The CNOSSOS-EU tables a site selects: its edition's, with its catalogue."""
-    return cn.with_catalogue(cn.tables(edition), catalogue)
+    return with_catalogue(cn.tables(edition), catalogue)
 
 
 def check_traction(site: Site, cfg: NoiseConfig) -> cn.Tables:
