@@ -48,6 +48,8 @@ DAYS = 3.0
 # Short alert windows, so that the slice raises and clears a squeal alert (the shipped 200-pass
 # window needs weeks of history).
 ALERTS = {"alerts.squeal_window_passes": 20, "alerts.squeal_raise_share": 0.25, "alerts.squeal_clear_share": 0.05}
+# Day-long windows of indirect roughness, taken by the state: the 3-day slice closes three of them.
+INDIRECT = {"residual.indirect_days": 1.0}
 REL = 1e-9  # live equals batch to this (issue 6)
 
 
@@ -57,6 +59,7 @@ def _site_file(folder: Path, checkpoint: Path | None = None) -> Path:
     doc = yaml.safe_load(SITE_FILE.read_text())
     alerts = doc["/**"]["ros__parameters"]["alerts"]
     alerts.update({k.split(".", 1)[1]: v for k, v in ALERTS.items()})
+    doc["/**"]["ros__parameters"].setdefault("residual", {}).update(indirect_days=INDIRECT["residual.indirect_days"])
     if checkpoint is not None:
         doc["/**/corrugation_estimator"]["ros__parameters"].update(checkpoint_path=str(checkpoint),
                                                                     checkpoint_every_passes=10)
@@ -66,7 +69,7 @@ def _site_file(folder: Path, checkpoint: Path | None = None) -> Path:
 
 
 def _values() -> dict:
-    return {**load_parameter_file(SITE_FILE), **ALERTS}
+    return {**load_parameter_file(SITE_FILE), **ALERTS, **INDIRECT}
 
 
 def _slice():
@@ -141,7 +144,7 @@ def _assert_equal_runs(live, batch) -> None:
 # (published on a wall-clock period live, once on the final state in batch).
 COMPARED = ("rail_msgs/msg/TrainPass", "rail_msgs/msg/SquealPrediction", "rail_msgs/msg/RollingNoise",
             "rail_msgs/msg/CorrugationState", "rail_msgs/msg/WaysideAlert", "rail_msgs/msg/NoiseResidual",
-            "rail_msgs/msg/RoughnessSurvey", "rail_msgs/msg/MeasuredPassNoise")
+            "rail_msgs/msg/RoughnessSurvey", "rail_msgs/msg/MeasuredPassNoise", "rail_msgs/msg/IndirectRoughness")
 
 
 FORECAST_TIME_NS = 1_000_000  # a forecast time is float arithmetic over ~1e17 ns: equal within 1 ms
@@ -214,8 +217,14 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
     surveys = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/RoughnessSurvey"])["rail_msgs/msg/RoughnessSurvey"]
     assert [time_ns(m.header.stamp) for m in surveys] == [e.stamp_ns for e in _events()]
     states = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/CorrugationState"])["rail_msgs/msg/CorrugationState"]
-    assert [m.calibration_surveys for m in states][-1] == 2 and min(m.pass_count for m in states) == 1
-    assert runs["result"].estimator.calibration_surveys == 3  # the survey after the last pass, at the end
+    # and each day's indirect roughness too, taken as an observation (re-fitting K_b where the state
+    # grew since the last survey or observation)
+    result = runs["result"]
+    assert len(result.observations) == 3 and all(o.event is not None for o in result.observations)
+    fits = [m.calibration_surveys for m in states]
+    assert fits[-1] == result.trajectory.constants_at(len(result.trajectory) - 1).calibration_surveys > 2
+    assert min(m.pass_count for m in states) == 1
+    assert result.estimator.calibration_surveys == fits[-1] + 1  # the survey after the last pass, at the end
     # measured noise: every good measurement gives a residual per model; the four bad ones none
     # (their reasons: tests/measured/test_residuals.py)
     residuals = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/NoiseResidual"])["rail_msgs/msg/NoiseResidual"]

@@ -35,8 +35,9 @@ from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.forecast import Threads
 from rail_monitor.corrugation.records import StateSnapshot, Trajectory
-from rail_monitor.corrugation.surveys import MaintenanceEvent, apply_event, in_time_order, split_before
+from rail_monitor.corrugation.surveys import MaintenanceEvent, apply_event, in_time_order
 from rail_monitor.measured.config import residual_config
+from rail_monitor.measured.observer import IndirectObserver, Observation, next_cut
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual, ResidualTracker, predictions_of
 from rail_monitor.noise.config import noise_config
@@ -71,6 +72,7 @@ class BatchResult:
     events: list[MaintenanceEvent] = field(default_factory=list)  # surveys and grinding taken, applied or not
     measurements: list[Measurement] = field(default_factory=list)  # measured pass-bys taken, paired or not
     residuals: list[Residual] = field(default_factory=list)        # measured minus predicted, in stamp order
+    observations: list[Observation] = field(default_factory=list)  # indirect roughness windows closed
 
     @classmethod
     def merged(cls, parts: Sequence[BatchResult], held: list[Alert], advice: SpeedAdvice | None) -> BatchResult:
@@ -86,7 +88,7 @@ class BatchResult:
                    {m: NoisePrediction.concat([p.noise[m] for p in parts]) for m in last.noise},
                    [a for p in parts for a in p.alerts] + held, last.standing, advice, last.estimator, last.receiver,
                    dict(left_out), [e for p in parts for e in p.events], [m for p in parts for m in p.measurements],
-                   [r for p in parts for r in p.residuals])
+                   [r for p in parts for r in p.residuals], [o for p in parts for o in p.observations])
 
 
 @dataclass
@@ -152,8 +154,10 @@ class BatchRun:
         self.trailing_measurements: list[Measurement] = []
         self._measurements = sorted(measurements, key=lambda m: m.key)  # not yet taken, by pass
         receiver = self.model.receiver
-        self.tracker = ResidualTracker(residual_config(values), self.model.band_hz,
-                                       (receiver.distance_m, receiver.height_m), self.model.models)
+        rcfg = residual_config(values)
+        self.tracker = ResidualTracker(rcfg, self.model.band_hz, (receiver.distance_m, receiver.height_m),
+                                       self.model.models)
+        self.observer = IndirectObserver(self.model, rcfg, self.estimator.bands) if rcfg.indirect_days > 0 else None
 
     def feed(self, passes: PassTable) -> BatchResult:
         """The outputs of the next chunk of the history, with the events due within it applied (the
@@ -163,17 +167,25 @@ class BatchRun:
             raise PassOrderError(f"passes out of time order: a chunk has a pass at {format_iso_ns(int(stamps.min()))}, "
                              f"before {format_iso_ns(self.newest_ns)} of an earlier one")
         self.newest_ns = max(self.newest_ns, int(stamps.max(initial=self.newest_ns)))
-        parts, applied = [], []
-        while self._pending and (n := split_before(passes.stamp_ns, self._pending[0].stamp_ns)) < len(passes):
+        parts = []
+        while (cut := next_cut(passes.stamp_ns, self._pending, self.observer)) is not None:
+            n = cut[0]
             parts.append(self._segment(passes.take(slice(0, n))))
-            applied.append(self._apply(self._pending.pop(0)))
+            if cut[1]:
+                parts[-1].observations.extend(self._observe())
+            else:
+                parts[-1].events.append(self._apply(self._pending.pop(0)))
             passes = passes.take(slice(n, None))
         parts.append(self._segment(passes))
-        if len(parts) == 1:
-            return parts[0]
-        for part, event in zip(parts, applied, strict=False):
-            part.events.append(event)
-        return BatchResult.merged(parts, [], None)
+        return parts[0] if len(parts) == 1 else BatchResult.merged(parts, [], None)
+
+    def _observe(self) -> list[Observation]:
+        """Close the indirect roughness window and take it as the estimator node takes it."""
+        est = self.estimator
+        obs = self.observer.observe(Corrugation(est.bands, est.amplitude, est.grinding_amplitude))
+        if obs is not None and obs.event is not None:
+            self._apply(obs.event)
+        return [] if obs is None else [obs]
 
     def _apply(self, event: MaintenanceEvent) -> MaintenanceEvent:
         """Apply a survey or grinding as the estimator node does (refusals counted)."""
@@ -201,6 +213,8 @@ class BatchRun:
                 traj = _history(self.estimator, accepted)
             finally:
                 self.estimator.threads = None
+            if self.observer is not None and len(traj):
+                self.observer.add_counted(accepted.take(traj.index), traj.amplitude, traj.constants.grinding_amplitude)
             states = self._tail.then(traj)
             on = state_index(states.stamp_ns, states.train_id, accepted.stamp_ns, accepted.train_id.tolist())
             noise = _noise_on_states(pool, self.model, accepted, states.amplitude, traj.constants, on)
@@ -228,6 +242,8 @@ class BatchRun:
         def take(upto: int) -> None:  # the measurements stamped up to upto, as the replayer sends them
             n = bisect.bisect_right([m.stamp_ns for m in self._measurements], upto)
             taken.extend(self._measurements[:n])
+            if self.observer is not None:
+                self.observer.add_measurements(self._measurements[:n])
             out.extend(r for m in self._measurements[:n] for r in self.tracker.add_measurement(m))
             del self._measurements[:n]
 

@@ -88,6 +88,8 @@ class BatchBag:
         self._alerts(result.alerts)
         self.events(result.events)
         self.measured(result.measurements, result.residuals)
+        for obs in result.observations:
+            self._put("corrugation/indirect_roughness", fields.indirect_roughness_fields(obs, self.frame), obs.stamp_ns)
 
     def _alerts(self, events: list[Alert]) -> None:
         for a in events:

@@ -29,6 +29,7 @@ from rail_monitor.squeal.config import RISK_HIGH
 
 if TYPE_CHECKING:
     from rail_monitor.advice.plan import SpeedAdvice
+    from rail_monitor.measured.observer import Observation
 
 Fields = dict[str, Any]
 
@@ -146,6 +147,15 @@ def roughness_survey_fields(event: MaintenanceEvent, frame_id: str) -> Fields:
     return {"header": header_fields(event.stamp_ns, frame_id), "kind": event.kind,
             "wavelength_m": np.asarray(event.wavelength_m, float).tolist(),
             "amplitude_m": np.asarray(event.amplitude_m, float).tolist()}
+
+
+def indirect_roughness_fields(obs: Observation, frame_id: str) -> Fields:
+    ind = obs.indirect
+    return {"header": header_fields(obs.stamp_ns, frame_id), "window_days": obs.window_days,
+            "measured_passes": obs.measured_passes, "wavelength_m": ind.wavelength_m.tolist(),
+            "level_db": ind.level_db.tolist(), "sd_db": ind.sd_db.tolist(), "model_db": ind.model_db.tolist(),
+            "pass_bands": ind.passes.astype(int).tolist(), "rail_share": ind.rail_share.tolist(),
+            "observed_amplitude_m": obs.observed_amplitude_m.tolist()}
 
 
 def measured_pass_noise_fields(m: Measurement, frame_id: str) -> Fields:

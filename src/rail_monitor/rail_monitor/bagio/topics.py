@@ -74,8 +74,9 @@ GRAPH_TOPICS: dict[str, tuple[str, Qos]] = {
     "alerts/standing": ("rail_msgs/msg/WaysideAlertArray", LATEST),
     "speed_advisory": ("rail_msgs/msg/SpeedAdvisory", LATEST)}
 # Topics recorded only when they carry something: a replay's or batch's surveys and grinding,
-# measured pass-by noise, and the residuals computed from it.
+# measured pass-by noise, the residuals computed from it, and the indirect roughness fitted on it.
 OPTIONAL_TOPICS: dict[str, tuple[str, Qos]] = {
     "roughness_survey": ("rail_msgs/msg/RoughnessSurvey", EVENT),
     "noise/measured": ("rail_msgs/msg/MeasuredPassNoise", STREAM),
-    "noise/residual": ("rail_msgs/msg/NoiseResidual", STREAM)}
+    "noise/residual": ("rail_msgs/msg/NoiseResidual", STREAM),
+    "corrugation/indirect_roughness": ("rail_msgs/msg/IndirectRoughness", EVENT)}

@@ -4,17 +4,21 @@ previous good file.
 The file is a numpy .npz (zip members with CRCs): a JSON ``meta`` record (version, site, counts,
 times), the band centres, ln Z of every component, K_b, the last survey and the post-grinding
 amplitudes, the calibration (growth since the last survey per friction state, the covariance of
-ln K_b, each band's level variance), the last year's growth per day and the kept passes' columns.
+ln K_b, each band's level variance), the last year's growth per day and the kept passes' columns;
+with an indirect roughness observer (rail_monitor.measured.observer), its open window's fit too
+(optional arrays ``indirect_*``: a file without them resumes with the window empty).
 """
 
 from __future__ import annotations
 
+import copy
 import io
 import json
 import os
 import zipfile
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -47,7 +51,7 @@ def previous_checkpoint(path: str | Path) -> Path:
     return path.with_name(path.name + ".prev")
 
 
-def save(est: CorrugationEstimator, path: str | Path) -> None:
+def save(est: CorrugationEstimator, path: str | Path, observer: Any = None) -> None:
     """Write the state atomically: a temporary file, fsync, rename over path, fsync the folder.
 
     The file it replaces is kept as previous_checkpoint(path). A crash between the two renames
@@ -60,10 +64,11 @@ def save(est: CorrugationEstimator, path: str | Path) -> None:
     np.savez(buf, meta=np.array(json.dumps(meta)), bands=est.bands, log_components=est.log_components,
              k_b=est.k_b, survey_log_amplitude=est.survey_log_amplitude, grinding_amplitude=est.grinding_amplitude,
              growth_by_state=est.growth_by_state, calibration_cov=est.calibration.cov, level_var=est.level_var,
+             calibration_mean=est.calibration.mean,
              season_growth=est.season.growth, season_passes=est.season.passes,
              season_first_day=np.array(est.season.first_day),
              **{f"recent_{n}": est.kept.train_id.astype(str) if n == "train_id" else getattr(est.kept, n)
-                for n in COLUMNS})
+                for n in COLUMNS}, **(observer.to_arrays() if observer is not None else {}))
     tmp = path.with_name(f".{path.name}.tmp")
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(tmp, "wb") as fh:
@@ -101,10 +106,10 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
     return meta, data
 
 
-def load(est: CorrugationEstimator, path: str | Path) -> None:
-    """Resume est from a checkpoint of its site with the same bands (ConfigError otherwise; a file
-    that does not hold a whole, consistent state is CorruptCheckpoint). est is changed only once the
-    whole file has been read and checked."""
+def load(est: CorrugationEstimator, path: str | Path, observer: Any = None) -> None:
+    """Resume est (and observer's window, where the file has one) from a checkpoint of its site with
+    the same bands (ConfigError otherwise; a file that does not hold a whole, consistent state is
+    CorruptCheckpoint). Both are changed only once the whole file has been read and checked."""
     meta, data = _read(path)
     if not isinstance(meta, dict):
         raise CorruptCheckpoint(f"{path}: not a readable corrugation checkpoint: its meta record is not a mapping")
@@ -118,6 +123,13 @@ def load(est: CorrugationEstimator, path: str | Path) -> None:
                                 f"{(str(exc).splitlines() or [''])[0]}") from None
     if state is None:
         raise ConfigError(f"{path}: checkpoint bands differ from the configured ones")
+    if observer is not None and "indirect_sums" in data:
+        trial = copy.copy(observer)
+        try:
+            trial.restore(data)
+        except (TypeError, ValueError, KeyError) as exc:
+            raise CorruptCheckpoint(f"{path}: not a readable corrugation checkpoint: {exc}") from None
+        observer.__dict__.update(trial.__dict__)
     k_b = state.pop("_k_b")
     for key, value in state.items():
         setattr(est, key, value)
@@ -180,6 +192,8 @@ def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarr
     posterior mean is ln(K_b / the configured default), so a changed default keeps the fitted K_b."""
     default = est.cfg.k_b
     mean = np.log(np.divide(k_b, default, out=np.ones(4), where=(default > 0) & (k_b > 0)))
+    if "calibration_mean" in data and np.allclose(data["calibration_mean"], mean, rtol=1e-9, atol=1e-12):
+        mean = np.asarray(data["calibration_mean"], float)  # the bits, so a resumed fit equals an unbroken one
     if "calibration_cov" not in data:
         return {"growth_by_state": np.zeros_like(est.growth_by_state), "level_var": est.post_grinding_var.copy(),
                 "calibration": replace(est.calibration, mean=mean)}
@@ -197,7 +211,7 @@ def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarr
             "calibration": calibration.KbPosterior(mean, cov, fits)}
 
 
-def resume(est: CorrugationEstimator, path: str | Path) -> tuple[Path | None, list[str]]:
+def resume(est: CorrugationEstimator, path: str | Path, observer: Any = None) -> tuple[Path | None, list[str]]:
     """Load the newest readable checkpoint: path, else previous_checkpoint(path).
 
     Returns the file loaded (None: neither exists, the state stays as it is) and one line per
@@ -210,7 +224,7 @@ def resume(est: CorrugationEstimator, path: str | Path) -> tuple[Path | None, li
         if not candidate.exists():
             continue
         try:
-            load(est, candidate)
+            load(est, candidate, observer)
         except CorruptCheckpoint as exc:
             skipped.append(str(exc))
             continue

@@ -24,17 +24,20 @@ from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.models import calibration
 
 KIND_SURVEY, KIND_GRINDING = 1, 2  # as rail_msgs/RoughnessSurvey's KIND_*
+KIND_INDIRECT = 3  # the indirect roughness of a window of measured pass-bys (rail_monitor.measured.observer)
 MAX_SURVEY_BANDS = 1000  # a trolley survey has tens of 1/3-octave bands
 
 
 @dataclass(frozen=True)
 class MaintenanceEvent:
-    """A roughness survey or a grinding event (units as in rail_msgs/RoughnessSurvey)."""
+    """A roughness survey, a grinding event (units as in rail_msgs/RoughnessSurvey) or an indirect
+    observation."""
 
     stamp_ns: int
-    kind: int                  # KIND_SURVEY or KIND_GRINDING
+    kind: int                  # KIND_SURVEY, KIND_GRINDING or KIND_INDIRECT
     wavelength_m: np.ndarray   # band centre wavelengths [m] (a grinding may give none)
     amplitude_m: np.ndarray    # r.m.s. roughness per band [m]
+    log_variance: np.ndarray | None = None  # KIND_INDIRECT: variance of each band's ln amplitude [-]
 
 
 def apply_event(est: CorrugationEstimator, event: MaintenanceEvent) -> calibration.KbPosterior | None:
@@ -44,6 +47,8 @@ def apply_event(est: CorrugationEstimator, event: MaintenanceEvent) -> calibrati
         raise ValueError("not newer than the last survey or grinding applied")
     if event.kind == KIND_SURVEY:
         return apply_survey(est, event.wavelength_m, event.amplitude_m, event.stamp_ns)
+    if event.kind == KIND_INDIRECT and event.log_variance is not None:
+        return apply_survey(est, event.wavelength_m, event.amplitude_m, event.stamp_ns, event.log_variance)
     if event.kind == KIND_GRINDING:
         apply_grinding(est, event.stamp_ns, event.wavelength_m, event.amplitude_m)
         return None
@@ -102,13 +107,17 @@ def match_bands(bands: np.ndarray, wavelength: np.ndarray, amplitude: np.ndarray
 
 
 def apply_survey(est: CorrugationEstimator, wavelength: np.ndarray, amplitude: np.ndarray,
-                 stamp_ns: int = 0) -> calibration.KbPosterior | None:
+                 stamp_ns: int = 0, log_variance: np.ndarray | None = None) -> calibration.KbPosterior | None:
     """Take a measured roughness survey (wavelengths [m], r.m.s. amplitudes [m]): re-fit K_b from
     the growth since the last survey, then update the state's level of the measured bands. Returns
-    the posterior of K_b after the fit, or None without one (no growth since the last survey)."""
+    the posterior of K_b after the fit, or None without one (no growth since the last survey).
+    log_variance: each band's variance of ln amplitude [-] (an indirect observation; default the
+    site's survey uncertainty), which also leaves the last survey's spectrum as it was."""
     z, matched = match_bands(est.bands, wavelength, amplitude)
     measured = np.log(z[matched])
     noise_var = est.survey_var
+    if log_variance is not None:
+        noise_var = match_bands(est.bands, wavelength, log_variance)[0][matched]
     fit = None
     growth = est.growth_by_state
     if np.any(growth[:, matched] != 0.0):
@@ -127,7 +136,8 @@ def apply_survey(est: CorrugationEstimator, wavelength: np.ndarray, amplitude: n
     est.log_components[matched] += (gain * (measured - level[matched]))[:, None]
     est.level_var = predicted_var
     est.level_var[matched] = gain * noise_var
-    est.survey_log_amplitude = np.where(matched, np.log(np.where(matched, z, 1.0)), np.nan)
+    if log_variance is None:
+        est.survey_log_amplitude = np.where(matched, np.log(np.where(matched, z, 1.0)), np.nan)
     est.growth_by_state[:] = 0.0
     est.last_survey_ns = max(est.last_survey_ns, int(stamp_ns))
     return fit

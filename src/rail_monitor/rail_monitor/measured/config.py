@@ -17,6 +17,8 @@ RESIDUAL_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("outlier_db", 6.0, "A pass this far above the baseline is left out of it [dB].", 0.5, 60.0),
     ParamSpec("receiver_tolerance_m", 0.5, "A measurement's receiver may differ from the model's by this "
               "(distance and height) [m].", 0.0, 100.0),
+    ParamSpec("indirect_days", 0.0, "Window of the indirect rail roughness taken by the corrugation state as "
+              "an observation, from the Unix epoch (UTC) [day]; 0: not taken.", 0.0, 366.0),
     ParamSpec("held_predictions", 20_000, "Predictions kept for measurements still to come, and measurements "
               "kept waiting for their passes' predictions [-].", 10, 10_000_000),
 )

@@ -46,30 +46,105 @@ class IndirectRoughness:
         return 1e-6 * 10.0 ** (self.level_db / 20.0)
 
 
+@dataclass
+class IndirectSums:
+    """The fit's sums per wavelength band, added pass by pass in the order given (so that passes
+    added one at a time or many at once give the same bits): pass-bands n, sum s^2, sum s y,
+    sum y^2 and sum s."""
+
+    n: np.ndarray
+    ss: np.ndarray
+    sy: np.ndarray
+    yy: np.ndarray
+    s: np.ndarray
+
+    @classmethod
+    def empty(cls, bands: int) -> IndirectSums:
+        return cls(np.zeros(bands, np.int64), *(np.zeros(bands) for _ in range(4)))
+
+    def as_array(self) -> np.ndarray:
+        """(5, K): n, ss, sy, yy, s (for a checkpoint)."""
+        return np.stack([self.n.astype(float), self.ss, self.sy, self.yy, self.s])
+
+    @classmethod
+    def from_array(cls, a: np.ndarray) -> IndirectSums:
+        a = np.asarray(a, float)
+        if a.ndim != 2 or a.shape[0] != 5 or not np.all(np.isfinite(a)) or np.any(a[0] < 0) \
+                or np.any(a[0] != np.round(a[0])):
+            raise ValueError("indirect sums have the wrong shape, are not finite or count negative pass-bands")
+        return cls(a[0].astype(np.int64), a[1].copy(), a[2].copy(), a[3].copy(), a[4].copy())
+
+    def add(self, residual_db: np.ndarray, share: np.ndarray, speed_mps: np.ndarray, band_hz: np.ndarray,
+            wavelength_m: np.ndarray) -> None:
+        """Add N passes' residuals (N, B) [dB] and rail shares (N, B) [-] at speeds (N,) [m/s] on
+        noise bands (B,) [Hz] to the wavelength bands (K,) [m] (each pass-band at lambda = v / f,
+        within 1/6 octave of a band centre; both values finite, the share positive)."""
+        residual_db, share = np.atleast_2d(residual_db), np.atleast_2d(share)
+        n, kk = len(residual_db), len(self.n)
+        if not n:
+            return
+        lam = np.asarray(speed_mps, float)[:, None] / np.asarray(band_hz, float)[None, :]
+        octaves = np.abs(np.log2(lam[..., None] / np.asarray(wavelength_m, float)))
+        k = np.argmin(octaves, axis=-1)
+        use = (np.take_along_axis(octaves, k[..., None], axis=-1)[..., 0] <= 1.0 / 6.0) \
+            & np.isfinite(residual_db) & np.isfinite(share) & (share > 0)
+        y = np.expm1(np.where(use, residual_db, 0.0) / DB_PER_LN)
+        s = np.where(use, share, 0.0)
+        cell = (np.arange(n)[:, None] * kk + k)[use]
+
+        def per_pass(w: np.ndarray) -> np.ndarray:  # each pass's sum over its own bands, in band order
+            return np.bincount(cell, weights=w[use], minlength=n * kk).reshape(n, kk)
+
+        # Running sums in pass order (cumsum adds one row after the other): any grouping of the
+        # passes gives the same totals.
+        for name, rows in (("ss", per_pass(s * s)), ("sy", per_pass(s * y)), ("yy", per_pass(y * y)),
+                           ("s", per_pass(s))):
+            setattr(self, name, np.cumsum(np.vstack([getattr(self, name), rows]), axis=0)[-1])
+        self.n = self.n + np.bincount(cell % kk, minlength=kk)
+
+    def estimate(self, wavelength_m: np.ndarray, model_db: np.ndarray, prediction_sd_db: float) -> IndirectRoughness:
+        """The indirect rail roughness on the wavelength bands whose model rail level is model_db
+        (K,) [dB re 1 um]; a band needs MIN_PASSES pass-bands."""
+        n = self.n
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = self.sy / self.ss
+            # sum of (y - s x)^2 from the sums (y is O(1) here: no cancellation to speak of)
+            sq = np.maximum(self.yy - 2.0 * x * self.sy + x * x * self.ss, 0.0)
+            var = sq / np.maximum(n - 1, 1) / self.ss
+            ok = (n >= MIN_PASSES) & (1.0 + x > 0)
+            level = np.where(ok, model_db + DB_PER_LN * np.log1p(np.where(ok, x, 0.0)), np.nan)
+            fit_db = DB_PER_LN * np.sqrt(var) / (1.0 + x)
+            sd = np.where(ok, np.hypot(fit_db, prediction_sd_db), np.nan)
+        return IndirectRoughness(np.asarray(wavelength_m, float), level, sd, np.asarray(model_db, float), n.copy(),
+                                 self.s / np.maximum(n, 1))
+
+
 def indirect_rail_roughness(residual_db: np.ndarray, share: np.ndarray, speed_mps: np.ndarray, band_hz: np.ndarray,
                             wavelength_m: np.ndarray, model_db: np.ndarray, prediction_sd_db: float
                             ) -> IndirectRoughness:
     """Residuals (N, B) [dB] and rail shares (N, B) [-] of N passes at speeds (N,) [m/s] on noise
     bands (B,) [Hz], onto wavelength bands (K,) [m] whose model rail level is model_db (K,)
     [dB re 1 um]. A pass-band counts where both are finite; a wavelength band needs MIN_PASSES."""
-    lam = np.asarray(speed_mps, float)[:, None] / np.asarray(band_hz, float)[None, :]
-    octaves = np.abs(np.log2(lam[..., None] / np.asarray(wavelength_m, float)))
-    k = np.argmin(octaves, axis=-1)
-    use = (np.take_along_axis(octaves, k[..., None], axis=-1)[..., 0] <= 1.0 / 6.0) \
-        & np.isfinite(residual_db) & np.isfinite(share) & (share > 0)
-    y = np.expm1(np.where(use, residual_db, 0.0) / DB_PER_LN)
-    kk = len(wavelength_m)
-    n = np.bincount(k[use], minlength=kk)
-    ss = np.bincount(k[use], weights=share[use] ** 2, minlength=kk)
-    sy = np.bincount(k[use], weights=share[use] * y[use], minlength=kk)
-    mean_share = np.bincount(k[use], weights=share[use], minlength=kk)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = sy / ss
-        err = y[use] - share[use] * x[k[use]]
-        var = np.bincount(k[use], weights=err**2, minlength=kk) / np.maximum(n - 1, 1) / ss
-        ok = (n >= MIN_PASSES) & (1.0 + x > 0)
-        level = np.where(ok, model_db + DB_PER_LN * np.log1p(np.where(ok, x, 0.0)), np.nan)
-        fit_db = DB_PER_LN * np.sqrt(var) / (1.0 + x)
-        sd = np.where(ok, np.hypot(fit_db, prediction_sd_db), np.nan)
-        return IndirectRoughness(np.asarray(wavelength_m, float), level, sd, np.asarray(model_db, float), n,
-                                 mean_share / np.maximum(n, 1))
+    sums = IndirectSums.empty(len(wavelength_m))
+    sums.add(residual_db, share, speed_mps, band_hz, wavelength_m)
+    return sums.estimate(wavelength_m, model_db, prediction_sd_db)
+
+
+def state_observation(ind: IndirectRoughness, baseline_db: np.ndarray, post_grinding_m: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """The corrugation amplitude an indirect rail level implies [m] and the variance of its ln [-]
+    per band (NaN: no observation). The noise model's rail roughness energy is the baseline's plus
+    the state's growth since grinding, E = P_base + Z^2 - Z_0^2 (RollingNoiseModel.rail_roughness_db),
+    so the observed E_obs gives Z^2 = Z_0^2 + E_obs - P_base, and by the delta method
+    var(ln Z) = (E_obs / (2 Z^2))^2 var(ln E_obs). A band whose observed energy is not above the
+    baseline's says nothing about the growth and is left out. baseline_db: the baseline rail
+    roughness on the bands [dB re 1 um]; post_grinding_m: Z_0 [m]."""
+    e_obs = 1e-12 * 10.0 ** (ind.level_db / 10.0)          # [m^2]
+    growth = e_obs - 1e-12 * 10.0 ** (np.asarray(baseline_db, float) / 10.0)
+    z2 = np.asarray(post_grinding_m, float) ** 2 + growth
+    ok = np.isfinite(ind.level_db) & (growth > 0)
+    var_ln_e = (ind.sd_db / DB_PER_LN) ** 2
+    with np.errstate(invalid="ignore", divide="ignore"):
+        amplitude = np.where(ok, np.sqrt(np.where(ok, z2, 1.0)), np.nan)
+        var = np.where(ok, (e_obs / (2.0 * np.where(ok, z2, 1.0))) ** 2 * var_ln_e, np.nan)
+    return amplitude, var

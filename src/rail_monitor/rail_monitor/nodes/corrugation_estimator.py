@@ -6,6 +6,9 @@ grinding event resets the state). A survey or grinding is applied before the fir
 later than it, as batch mode applies it (one stamped after every pass so far waits for the next
 pass, or shutdown; one stamped before a pass already counted is applied on arrival and counted as
 late); surveys queued behind a backlog of passes are taken first. Publishes
+With ``residual.indirect_days`` > 0 it also subscribes ``noise/measured`` and takes each window's
+indirect rail roughness as an observation (rail_monitor.measured.observer; published on
+``corrugation/indirect_roughness``, rail_msgs/IndirectRoughness). Publishes
 ``corrugation/state`` (rail_msgs/CorrugationState, per pass or at most every ``state_period_s``)
 and ``speed_advisory`` (rail_msgs/SpeedAdvisory, every ``advisory_period_s``), both latched;
 serves ``evaluate_speed_distribution``. With
@@ -24,7 +27,13 @@ from diagnostic_msgs.msg import DiagnosticStatus
 
 from rail_monitor.advice import plan
 from rail_monitor.advice.consequences import Consequences
-from rail_monitor.bagio.messages import corrugation_state_fields, event_from_msg, speed_advisory_fields
+from rail_monitor.bagio.messages import (
+    corrugation_state_fields,
+    event_from_msg,
+    indirect_roughness_fields,
+    measurement_from_msg,
+    speed_advisory_fields,
+)
 from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
@@ -33,23 +42,33 @@ from rail_monitor.corrugation import advice, checkpoint, surveys
 from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.surveys import MaintenanceEvent
-from rail_monitor.nodes.base import Sent, declare, take_queued, wall_timer
+from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
+from rail_monitor.measured.observer import IndirectObserver, next_cut
+from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
-from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS
+from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_SUB_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
-from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
-from rail_msgs.msg import CorrugationState, RoughnessSurvey, SpeedAdvisory, TrainPass
+from rail_msgs.msg import (
+    CorrugationState,
+    IndirectRoughness,
+    MeasuredPassNoise,
+    RoughnessSurvey,
+    SpeedAdvisory,
+    TrainPass,
+)
 from rail_msgs.srv import EvaluateSpeedDistribution
 
 
 class CorrugationEstimatorNode(PassConsumerNode):
     EXECUTABLE = "corrugation_estimator"
-    # noise.* and squeal.*: what the speed advice weighs besides corrugation (rail_monitor.advice).
+    # noise.* and squeal.*: what the speed advice weighs besides corrugation (rail_monitor.advice);
+    # residual.*: the indirect roughness taken as an observation.
     PARAMETERS = (*PassConsumerNode.PARAMETERS, ("", ESTIMATOR_SPECS), ("corrugation.", CORRUGATION_SPECS),
-                  ("noise.", NOISE_SPECS), ("squeal.", SQUEAL_SPECS))
+                  ("noise.", NOISE_SPECS), ("squeal.", SQUEAL_SPECS), ("residual.", RESIDUAL_SPECS))
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("corrugation_estimator", **kwargs)
@@ -59,6 +78,10 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self._noise_cfg = noise_config(declare(self, NOISE_SPECS, prefix="noise."), prefix="")
         self._squeal_cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
         self._consequences: Consequences | None = None
+        self._noise_model: RollingNoiseModel | None = None
+        residual_cfg = residual_config(declare(self, RESIDUAL_SPECS, prefix="residual."), prefix="")
+        self.observer = IndirectObserver(self.noise_model(), residual_cfg, self.est.bands) \
+            if residual_cfg.indirect_days > 0 else None
         self.checkpoint = self.params.checkpoint_path
         self.counts: Counter[str] = Counter()
         self.sent = Sent()
@@ -67,7 +90,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if self.checkpoint:
             # An unreadable checkpoint falls back to the previous one; none readable is a ConfigError
             # (no silent fresh start).
-            used, self.checkpoint_skipped = checkpoint.resume(self.est, self.checkpoint)
+            used, self.checkpoint_skipped = checkpoint.resume(self.est, self.checkpoint, self.observer)
             for why in self.checkpoint_skipped:
                 self.get_logger().error(f"checkpoint skipped: {why}")
             if used is not None:
@@ -79,6 +102,11 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
         self.pending: list[MaintenanceEvent] = []  # surveys and grinding waiting for a later pass, by stamp
         self.survey_sub = self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
+        self.measured_sub = self.indirect_pub = None
+        if self.observer is not None:
+            self.measured_sub = subscribe_batched(self, MeasuredPassNoise, "noise/measured", self._on_measured,
+                                                  STREAM_SUB_QOS, self.max_batch)
+            self.indirect_pub = self.create_publisher(IndirectRoughness, "corrugation/indirect_roughness", EVENT_QOS)
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
         wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
         self.listen()
@@ -92,22 +120,41 @@ class CorrugationEstimatorNode(PassConsumerNode):
         # first later pass, acknowledged): take them first, so they wait for the right pass.
         for msg in take_queued(self.survey_sub, 1000):
             self._on_survey(msg)
+        if self.measured_sub is not None:  # measured passes before these: in their window's fit
+            self._on_measured(take_queued(self.measured_sub, self.max_batch))
         super()._on_train_passes(raws)
+
+    def _on_measured(self, msgs: list[MeasuredPassNoise]) -> None:
+        self.observer.add_measurements([measurement_from_msg(m) for m in msgs])
 
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         start = 0
-        while self.pending:
-            n = surveys.split_before(table.stamp_ns[start:], self.pending[0].stamp_ns)
-            if start + n == len(table):
-                break
+        while (cut := next_cut(table.stamp_ns[start:], self.pending, self.observer)) is not None:
+            n, window = cut
             self._count(table.take(slice(start, start + n)))
-            self._apply(self.pending.pop(0))
+            if window:
+                self._observe()
+            else:
+                self._apply(self.pending.pop(0))
             start += n
         self._count(table.take(slice(start, None)) if start else table)
+
+    def _observe(self) -> None:
+        """Close the indirect roughness window: publish its fit, and take it as an observation."""
+        est = self.est
+        obs = self.observer.observe(Corrugation(est.bands, est.amplitude, est.grinding_amplitude))
+        if obs is None:
+            return
+        msg = to_msg(IndirectRoughness, indirect_roughness_fields(obs, self.site.site_id))
+        self.sent.publish(self.indirect_pub, msg)
+        if obs.event is not None:
+            self._apply(obs.event)
 
     def _count(self, table: PassTable) -> None:
         # The state and forecast after each counted pass, as advancing one pass at a time gives them.
         traj = self.est.advance_history(table)
+        if self.observer is not None and len(traj):
+            self.observer.add_counted(table.take(traj.index), traj.amplitude, traj.constants.grinding_amplitude)
         if len(traj) < len(table):
             self.counts["not counted (already counted, or older than the history)"] += len(table) - len(traj)
         if not len(traj):
@@ -129,12 +176,16 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.sent.publish(self.state_pub, to_msg(CorrugationState, corrugation_state_fields(
             self.est, self.est.forecast(), self.site.site_id)))
 
+    def noise_model(self) -> RollingNoiseModel:
+        """The site's noise model (built at the first use: its tables are not needed until then)."""
+        if self._noise_model is None:
+            self._noise_model = RollingNoiseModel(self.site, self._noise_cfg)
+        return self._noise_model
+
     def consequences(self) -> Consequences:
-        """The noise model and squeal parameters the advice weighs (built at the first use: the
-        noise model's tables are not needed until then)."""
+        """The noise model and squeal parameters the advice weighs."""
         if self._consequences is None:
-            self._consequences = Consequences(self.site, RollingNoiseModel(self.site, self._noise_cfg),
-                                              self._squeal_cfg)
+            self._consequences = Consequences(self.site, self.noise_model(), self._squeal_cfg)
         return self._consequences
 
     def publish_advisory(self) -> None:
@@ -171,6 +222,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
             return False
         if event.kind == surveys.KIND_GRINDING:
             self.counts["grindings"] += 1
+        elif event.kind == surveys.KIND_INDIRECT:
+            self.counts["indirect observations"] += 1
         else:
             self.counts["surveys"] += 1
             if fit is not None:
@@ -204,7 +257,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if not self.checkpoint:
             return
         try:
-            checkpoint.save(self.est, self.checkpoint)
+            checkpoint.save(self.est, self.checkpoint, self.observer)
             self.counts["checkpoints"] += 1
         except OSError as exc:
             self.counts["checkpoint failures"] += 1
@@ -228,6 +281,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
                   "state_age_s": f"{(time.time_ns() - self.est.newest_ns) / 1e9:.0f}" if self.est.newest_ns else "",
                   "last_grinding": format_iso_ns(self.est.last_grinding_ns) if self.est.last_grinding_ns else ""}
         values["surveys pending"] = len(self.pending)
+        if self.observer is not None:
+            values.update({f"indirect {k}": v for k, v in sorted(self.observer.counts.items())})
         values.update({f"survey rejected: {why}": n for why, n in sorted(self.surveys_rejected.items())})
         values.update({f"checkpoint skipped {i + 1}": why for i, why in enumerate(self.checkpoint_skipped)})
         return values
