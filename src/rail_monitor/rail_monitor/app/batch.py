@@ -197,6 +197,9 @@ class BatchRun:
             apply_event(self.estimator, event)
         except ValueError as exc:
             self.events_refused[str(exc)] += 1
+            return event
+        if self.observer is not None:
+            self.observer.note(event)
         return event
 
     def _segment(self, passes: PassTable) -> BatchResult:

@@ -123,7 +123,7 @@ def load(est: CorrugationEstimator, path: str | Path, observer: Any = None) -> N
                                 f"{(str(exc).splitlines() or [''])[0]}") from None
     if state is None:
         raise ConfigError(f"{path}: checkpoint bands differ from the configured ones")
-    if observer is not None and "indirect_sums" in data:
+    if observer is not None and "indirect_pairs" in data:
         trial = copy.copy(observer)
         try:
             trial.restore(data)

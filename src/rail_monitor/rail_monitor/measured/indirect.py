@@ -27,6 +27,10 @@ import numpy as np
 
 DB_PER_LN = 10.0 / math.log(10.0)
 MIN_PASSES = 20  # per wavelength band, for an estimate
+_GN_ITERATIONS = 8
+# A band observes the state's growth where the growth is at least this share of the observed rail
+# energy: there an error in the energy is at most as large in the amplitude (d ln Z <= d ln E).
+MIN_GROWTH_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -47,76 +51,86 @@ class IndirectRoughness:
 
 
 @dataclass
-class IndirectSums:
-    """The fit's sums per wavelength band, added pass by pass in the order given (so that passes
-    added one at a time or many at once give the same bits): pass-bands n, sum s^2, sum s y,
-    sum y^2 and sum s."""
+class IndirectPairs:
+    """The (wavelength band, rail share, residual) of every pass-band added, in the order added
+    (so that passes added one at a time or many at once give the same fit)."""
 
-    n: np.ndarray
-    ss: np.ndarray
-    sy: np.ndarray
-    yy: np.ndarray
-    s: np.ndarray
+    band: np.ndarray      # (M,) index of the wavelength band
+    share: np.ndarray     # (M,) rail share s [-]
+    residual: np.ndarray  # (M,) residual r [dB]
+    bands: int
 
     @classmethod
-    def empty(cls, bands: int) -> IndirectSums:
-        return cls(np.zeros(bands, np.int64), *(np.zeros(bands) for _ in range(4)))
+    def empty(cls, bands: int) -> IndirectPairs:
+        return cls(np.zeros(0, np.int64), np.zeros(0), np.zeros(0), bands)
+
+    @property
+    def n(self) -> np.ndarray:
+        """Pass-bands per wavelength band."""
+        return np.bincount(self.band, minlength=self.bands)
 
     def as_array(self) -> np.ndarray:
-        """(5, K): n, ss, sy, yy, s (for a checkpoint)."""
-        return np.stack([self.n.astype(float), self.ss, self.sy, self.yy, self.s])
+        """(3, M): band, share, residual (for a checkpoint)."""
+        return np.stack([self.band.astype(float), self.share, self.residual])
 
     @classmethod
-    def from_array(cls, a: np.ndarray) -> IndirectSums:
+    def from_array(cls, a: np.ndarray, bands: int) -> IndirectPairs:
         a = np.asarray(a, float)
-        if a.ndim != 2 or a.shape[0] != 5 or not np.all(np.isfinite(a)) or np.any(a[0] < 0) \
-                or np.any(a[0] != np.round(a[0])):
-            raise ValueError("indirect sums have the wrong shape, are not finite or count negative pass-bands")
-        return cls(a[0].astype(np.int64), a[1].copy(), a[2].copy(), a[3].copy(), a[4].copy())
+        if a.ndim != 2 or a.shape[0] != 3 or not np.all(np.isfinite(a)) or np.any(a[0] < 0) \
+                or np.any(a[0] >= bands) or np.any(a[0] != np.round(a[0])) or np.any(a[1] <= 0):
+            raise ValueError("indirect pass-bands have the wrong shape, an unknown band or a share not positive")
+        return cls(a[0].astype(np.int64), a[1].copy(), a[2].copy(), bands)
 
     def add(self, residual_db: np.ndarray, share: np.ndarray, speed_mps: np.ndarray, band_hz: np.ndarray,
             wavelength_m: np.ndarray) -> None:
         """Add N passes' residuals (N, B) [dB] and rail shares (N, B) [-] at speeds (N,) [m/s] on
-        noise bands (B,) [Hz] to the wavelength bands (K,) [m] (each pass-band at lambda = v / f,
-        within 1/6 octave of a band centre; both values finite, the share positive)."""
+        noise bands (B,) [Hz] (each pass-band at lambda = v / f, within 1/6 octave of a band centre
+        of wavelength_m [m]; both values finite, the share positive)."""
         residual_db, share = np.atleast_2d(residual_db), np.atleast_2d(share)
-        n, kk = len(residual_db), len(self.n)
-        if not n:
+        if not len(residual_db):
             return
         lam = np.asarray(speed_mps, float)[:, None] / np.asarray(band_hz, float)[None, :]
         octaves = np.abs(np.log2(lam[..., None] / np.asarray(wavelength_m, float)))
         k = np.argmin(octaves, axis=-1)
         use = (np.take_along_axis(octaves, k[..., None], axis=-1)[..., 0] <= 1.0 / 6.0) \
             & np.isfinite(residual_db) & np.isfinite(share) & (share > 0)
-        y = np.expm1(np.where(use, residual_db, 0.0) / DB_PER_LN)
-        s = np.where(use, share, 0.0)
-        cell = (np.arange(n)[:, None] * kk + k)[use]
-
-        def per_pass(w: np.ndarray) -> np.ndarray:  # each pass's sum over its own bands, in band order
-            return np.bincount(cell, weights=w[use], minlength=n * kk).reshape(n, kk)
-
-        # Running sums in pass order (cumsum adds one row after the other): any grouping of the
-        # passes gives the same totals.
-        for name, rows in (("ss", per_pass(s * s)), ("sy", per_pass(s * y)), ("yy", per_pass(y * y)),
-                           ("s", per_pass(s))):
-            setattr(self, name, np.cumsum(np.vstack([getattr(self, name), rows]), axis=0)[-1])
-        self.n = self.n + np.bincount(cell % kk, minlength=kk)
+        self.band = np.concatenate([self.band, k[use]])
+        self.share = np.concatenate([self.share, share[use]])
+        self.residual = np.concatenate([self.residual, residual_db[use]])
 
     def estimate(self, wavelength_m: np.ndarray, model_db: np.ndarray, prediction_sd_db: float) -> IndirectRoughness:
         """The indirect rail roughness on the wavelength bands whose model rail level is model_db
-        (K,) [dB re 1 um]; a band needs MIN_PASSES pass-bands."""
-        n = self.n
+        (K,) [dB re 1 um]; a band needs MIN_PASSES pass-bands. Per band, x minimises
+        sum (r - 10 lg(1 + s x))^2: least squares in dB, where the spread of a pass-by level about
+        its mean is (wheels, weather, the instrument), so that it does not bias x as an energy
+        mean would (E[10^(r/10)] > 10^(E[r]/10)). Gauss-Newton from the energy fit."""
+        kk, n = self.bands, self.n
+        s, r, k = self.share, self.residual, self.band
+        y = np.expm1(r / DB_PER_LN)
         with np.errstate(divide="ignore", invalid="ignore"):
-            x = self.sy / self.ss
-            # sum of (y - s x)^2 from the sums (y is O(1) here: no cancellation to speak of)
-            sq = np.maximum(self.yy - 2.0 * x * self.sy + x * x * self.ss, 0.0)
-            var = sq / np.maximum(n - 1, 1) / self.ss
-            ok = (n >= MIN_PASSES) & (1.0 + x > 0)
+            x = np.bincount(k, weights=s * y, minlength=kk) / np.bincount(k, weights=s * s, minlength=kk)
+            largest = np.zeros(kk)
+            np.maximum.at(largest, k, s)
+            floor = -(1.0 - 1e-9) / np.where(largest > 0, largest, np.inf)  # 1 + s x > 0 on every pass-band
+            x = np.maximum(x, floor)
+            for _ in range(_GN_ITERATIONS):
+                xs = x[k]
+                f = DB_PER_LN * np.log1p(s * xs)
+                jac = DB_PER_LN * s / (1.0 + s * xs)
+                step = np.bincount(k, weights=jac * (r - f), minlength=kk) / np.bincount(k, weights=jac**2,
+                                                                                       minlength=kk)
+                x = np.maximum(x + step, floor)
+            xs = x[k]
+            jac = DB_PER_LN * s / (1.0 + s * xs)
+            err = r - DB_PER_LN * np.log1p(s * xs)
+            var_x = np.bincount(k, weights=err**2, minlength=kk) / np.maximum(n - 1, 1) \
+                / np.bincount(k, weights=jac**2, minlength=kk)
+            ok = (n >= MIN_PASSES) & (1.0 + x > 0) & np.isfinite(x)
             level = np.where(ok, model_db + DB_PER_LN * np.log1p(np.where(ok, x, 0.0)), np.nan)
-            fit_db = DB_PER_LN * np.sqrt(var) / (1.0 + x)
+            fit_db = DB_PER_LN * np.sqrt(var_x) / (1.0 + x)
             sd = np.where(ok, np.hypot(fit_db, prediction_sd_db), np.nan)
-        return IndirectRoughness(np.asarray(wavelength_m, float), level, sd, np.asarray(model_db, float), n.copy(),
-                                 self.s / np.maximum(n, 1))
+            mean_share = np.bincount(k, weights=s, minlength=kk) / np.maximum(n, 1)
+        return IndirectRoughness(np.asarray(wavelength_m, float), level, sd, np.asarray(model_db, float), n, mean_share)
 
 
 def indirect_rail_roughness(residual_db: np.ndarray, share: np.ndarray, speed_mps: np.ndarray, band_hz: np.ndarray,
@@ -125,9 +139,9 @@ def indirect_rail_roughness(residual_db: np.ndarray, share: np.ndarray, speed_mp
     """Residuals (N, B) [dB] and rail shares (N, B) [-] of N passes at speeds (N,) [m/s] on noise
     bands (B,) [Hz], onto wavelength bands (K,) [m] whose model rail level is model_db (K,)
     [dB re 1 um]. A pass-band counts where both are finite; a wavelength band needs MIN_PASSES."""
-    sums = IndirectSums.empty(len(wavelength_m))
-    sums.add(residual_db, share, speed_mps, band_hz, wavelength_m)
-    return sums.estimate(wavelength_m, model_db, prediction_sd_db)
+    pairs = IndirectPairs.empty(len(wavelength_m))
+    pairs.add(residual_db, share, speed_mps, band_hz, wavelength_m)
+    return pairs.estimate(wavelength_m, model_db, prediction_sd_db)
 
 
 def state_observation(ind: IndirectRoughness, baseline_db: np.ndarray, post_grinding_m: np.ndarray
@@ -142,7 +156,7 @@ def state_observation(ind: IndirectRoughness, baseline_db: np.ndarray, post_grin
     e_obs = 1e-12 * 10.0 ** (ind.level_db / 10.0)          # [m^2]
     growth = e_obs - 1e-12 * 10.0 ** (np.asarray(baseline_db, float) / 10.0)
     z2 = np.asarray(post_grinding_m, float) ** 2 + growth
-    ok = np.isfinite(ind.level_db) & (growth > 0)
+    ok = np.isfinite(ind.level_db) & (growth >= MIN_GROWTH_SHARE * e_obs)
     var_ln_e = (ind.sd_db / DB_PER_LN) ** 2
     with np.errstate(invalid="ignore", divide="ignore"):
         amplitude = np.where(ok, np.sqrt(np.where(ok, z2, 1.0)), np.nan)

@@ -4,13 +4,16 @@ With ``residual.indirect_days`` = w > 0, time is cut into windows of w days, (k 
 from the Unix epoch (UTC), the same in every process. Each measured pass of a counted pass is
 compared with the CNOSSOS-EU prediction of that pass on the state that includes it (the noise
 predictor's), and its residuals and the rail's share of the combined roughness are added to the
-window's fit (:class:`rail_monitor.measured.indirect.IndirectSums`), leaving out passes measured
+window's fit (:class:`rail_monitor.measured.indirect.IndirectPairs`), leaving out passes measured
 squealing and passes whose 500-2000 Hz residual is more than ``residual.outlier_db`` above the
 running median of the last ``residual.baseline_passes`` (a wheel flat is not rail roughness). At
 the first pass stamped after a window's end, the window's indirect roughness is fitted, turned
 into the corrugation amplitude it implies (:func:`~rail_monitor.measured.indirect.state_observation`)
 and taken by the estimator as a survey with that per-band uncertainty: a re-fit of K_b and a
-Kalman update of the levels (:mod:`rail_monitor.corrugation.surveys`).
+Kalman update of the levels (:mod:`rail_monitor.corrugation.surveys`). Taken on a rail that has
+had no survey since its last grinding: where surveys come, they calibrate and the windows are
+published beside them (the sequential fit keeps no covariance between the levels and K_b, so a
+survey after a weak observation's partial level update over-fits K_b; docs/models.md).
 
 A measurement is paired once its pass is counted, in stamp order, and must arrive before the
 first pass after its window's end (a replay sends each after its pass and before the next); one
@@ -29,13 +32,15 @@ import numpy as np
 
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_DAY
-from rail_monitor.corrugation.surveys import KIND_INDIRECT, MaintenanceEvent, split_before
+from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_INDIRECT, KIND_SURVEY, MaintenanceEvent, split_before
 from rail_monitor.measured.config import ResidualConfig
-from rail_monitor.measured.indirect import IndirectRoughness, IndirectSums, state_observation
+from rail_monitor.measured.indirect import IndirectPairs, IndirectRoughness, state_observation
 from rail_monitor.measured.records import Measurement, measurement_refusal
 from rail_monitor.measured.residuals import Baseline, Predicted, compare
 from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
 
+MAX_AWAITING = 10_000  # counted passes kept in a checkpoint for their measurements still to come
+TEXT = ("train_id", "vehicle_class")  # PassTable's text columns
 MODEL = "cnossos"  # the prediction the residuals are taken against: its transfer functions are the standard's
 
 
@@ -60,7 +65,7 @@ class IndirectObserver:
         self.bands = np.asarray(bands, float)
         self.interval_ns = round(cfg.indirect_days * NS_PER_DAY)
         self.window_end_ns = 0                    # end of the open window (0: none yet)
-        self.sums = IndirectSums.empty(len(self.bands))
+        self.pairs = IndirectPairs.empty(len(self.bands))
         self.fitted = 0                           # measured passes in the open window's fit
         self.baseline = Baseline(cfg.baseline_passes, cfg.baseline_min_passes, cfg.outlier_db)
         # (stamp, train_id) -> (its counted table, row, state that includes it, post-grinding amplitudes)
@@ -69,6 +74,8 @@ class IndirectObserver:
         self.queue: list[tuple[int, str]] = []    # measurements waiting for their pass, in stamp order
         self.waiting: dict[tuple[int, str], Measurement] = {}
         self.taken: OrderedDict[tuple[int, str], None] = OrderedDict()  # measured passes paired (the newest)
+        self.newest_taken_ns = -1                 # stamp of the newest of them
+        self.surveyed = False                     # a survey applied since the last grinding: surveys calibrate
         self.counts: Counter[str] = Counter()
 
     @property
@@ -121,6 +128,7 @@ class IndirectObserver:
                 break  # its pass may still be counted
             m = self.waiting.pop(self.queue.pop(0))
             self.taken[key] = None
+            self.newest_taken_ns = max(self.newest_taken_ns, key[0])
             if len(self.taken) > self.cfg.held_predictions:
                 self.taken.popitem(last=False)
             if key in self.counted:
@@ -158,25 +166,51 @@ class IndirectObserver:
         self.counts["fitted"] += int(keep.sum())
         self.counts["not fitted: squealing or a wheel-defect outlier"] += int((~keep).sum())
         self.fitted += int(keep.sum())
-        self.sums.add(residual[keep], share[keep], passes.speed_mps[keep], self.model.band_hz, self.bands)
+        self.pairs.add(residual[keep], share[keep], passes.speed_mps[keep], self.model.band_hz, self.bands)
+
+    def note(self, event: MaintenanceEvent) -> None:
+        """A survey or grinding the state has taken: after a survey (until the next grinding) the
+        windows are published but not taken, the surveys being the calibration."""
+        if event.kind in (KIND_SURVEY, KIND_GRINDING):
+            self.surveyed = event.kind == KIND_SURVEY
 
     def to_arrays(self) -> dict[str, np.ndarray]:
-        """The open window's fit and the outlier baseline, for a checkpoint (measurements still
-        waiting for their passes are not kept: a restart loses at most those in flight)."""
-        return {"indirect_sums": self.sums.as_array(), "indirect_baseline": np.array(self.baseline.window, float),
-                "indirect_scalars": np.array([self.window_end_ns, self.fitted], np.int64),
-                "indirect_reference": np.array(self.baseline.reference)}
+        """The open window's fit, the outlier baseline and the counted passes whose measurements may
+        still come (stamped after the newest measurement taken), for a checkpoint; measurements
+        waiting for their passes are not kept (a replay after a restart sends them again)."""
+        awaiting = [(k, v) for k, v in self.counted.items() if k[0] > self.newest_taken_ns][-MAX_AWAITING:]
+        rows = [table.row(i) for _, (table, i, _, _) in awaiting]
+        cols = {f"indirect_pass_{c}": np.array([r[c] for r in rows], dtype=str if c in TEXT else PassTable.DTYPES[c])
+                for c in PassTable.columns()}
+        nb = len(self.bands)
+        return {"indirect_pairs": self.pairs.as_array(), "indirect_baseline": np.array(self.baseline.window, float),
+                "indirect_scalars": np.array([self.window_end_ns, self.fitted, self.newest_taken_ns, self.surveyed],
+                                             np.int64),
+                "indirect_reference": np.array(self.baseline.reference), **cols,
+                "indirect_pass_state": np.array([v[2] for _, v in awaiting], float).reshape(-1, nb),
+                "indirect_pass_post": np.array([v[3] for _, v in awaiting], float).reshape(-1, nb)}
 
     def restore(self, arrays: dict[str, np.ndarray]) -> None:
         """Resume from to_arrays's records (ValueError, the observer untouched, if they are not usable)."""
-        sums = IndirectSums.from_array(arrays["indirect_sums"])
+        pairs = IndirectPairs.from_array(arrays["indirect_pairs"], len(self.bands))
         window = np.asarray(arrays["indirect_baseline"], float)
         scalars = np.asarray(arrays["indirect_scalars"]).astype(np.int64, casting="same_kind")
         reference = float(arrays["indirect_reference"])
-        if sums.n.shape != self.sums.n.shape or window.ndim != 1 or not np.all(np.isfinite(window)) \
-                or scalars.shape != (2,) or np.any(scalars < 0):
-            raise ValueError("indirect roughness records have the wrong shape or negative counts")
-        self.sums, self.window_end_ns, self.fitted = sums, int(scalars[0]), int(scalars[1])
+        passes = PassTable(**{c: np.asarray(arrays[f"indirect_pass_{c}"]).astype(object if c in TEXT else
+                                                                                 PassTable.DTYPES[c])
+                              for c in PassTable.columns()})
+        state, post = np.asarray(arrays["indirect_pass_state"], float), np.asarray(arrays["indirect_pass_post"], float)
+        if window.ndim != 1 or not np.all(np.isfinite(window)) or scalars.shape != (4,) \
+                or np.any(scalars[:2] < 0) or scalars[3] not in (0, 1) \
+                or state.shape != (len(passes), len(self.bands)) or post.shape != state.shape \
+                or not (np.all(np.isfinite(state)) and np.all(post > 0)):
+            raise ValueError("indirect roughness records have the wrong shape, negative counts or bad states")
+        self.pairs, self.window_end_ns, self.fitted = pairs, int(scalars[0]), int(scalars[1])
+        self.newest_taken_ns, self.surveyed = int(scalars[2]), bool(scalars[3])
+        self.counted = OrderedDict()
+        for i, key in enumerate(zip(passes.stamp_ns.tolist(), passes.train_id.tolist(), strict=True)):
+            self.counted[key] = (passes, i, state[i], post[i])
+        self.newest_counted_ns = int(passes.stamp_ns.max(initial=-1))
         self.baseline = Baseline(self.cfg.baseline_passes, self.cfg.baseline_min_passes, self.cfg.outlier_db)
         for v in window[-self.cfg.baseline_passes:].tolist():
             self.baseline.window.append(v)
@@ -192,14 +226,16 @@ class IndirectObserver:
             return None
         rail_db = np.interp(self.bands, self.model.grid, self.model.rail_roughness_db(model_state))
         base_db = np.interp(self.bands, self.model.grid, self.model.baseline_db)
-        ind = self.sums.estimate(self.bands, rail_db, self.cfg.prediction_sd_db)
+        ind = self.pairs.estimate(self.bands, rail_db, self.cfg.prediction_sd_db)
         amplitude, var = state_observation(ind, base_db, model_state.post_grinding_m)
+        if self.surveyed:
+            amplitude = np.full(len(self.bands), np.nan)
         ok = np.isfinite(amplitude)
         event = None
         if ok.any():
             event = MaintenanceEvent(end, KIND_INDIRECT, self.bands[ok], amplitude[ok], var[ok])
         out = Observation(end, self.interval_ns / NS_PER_DAY, self.fitted, ind, amplitude, event)
-        self.sums = IndirectSums.empty(len(self.bands))
+        self.pairs = IndirectPairs.empty(len(self.bands))
         self.fitted = 0
         self.counts["windows fitted"] += 1
         self.counts["observations taken"] += event is not None

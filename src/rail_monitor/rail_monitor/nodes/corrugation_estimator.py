@@ -220,6 +220,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
         except ValueError as exc:
             self._refuse(str(exc))
             return False
+        if self.observer is not None:
+            self.observer.note(event)
         if event.kind == surveys.KIND_GRINDING:
             self.counts["grindings"] += 1
         elif event.kind == surveys.KIND_INDIRECT:
