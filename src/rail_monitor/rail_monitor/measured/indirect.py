@@ -8,10 +8,11 @@ Rolling noise in a band is proportional to the combined effective roughness ener
 Directive 2015/996 Annex II, eq. 2.3.6: L_R,TOT = 10 lg(10^(L_r,rail/10) + 10^(L_r,veh/10)) + A3),
 so a band's residual r (measured minus predicted, dB) scales that energy by 10^(r/10). With the
 rail's share s of the predicted combined energy (RollingNoiseModel.rail_share) and the wheels as
-the model has them, the rail's energy is scaled by 1 + x, where y = 10^(r/10) - 1 = s x per pass.
-Over many passes of several classes, whose wheels differ (disc-braked wheels leave the rail most
-of the combined roughness), x is the least-squares fit through the origin, x = sum(s y) / sum(s^2),
-per wavelength band of the corrugation state (each pass and noise band at lambda = v / f). The
+the model has them, the rail's energy is scaled by 1 + x, where r = 10 lg(1 + s x) per pass. Over
+many passes of several classes, whose wheels differ (disc-braked wheels leave the rail most of the
+combined roughness), x is the least-squares fit of that in dB (the spread of pass-by levels is
+symmetric in dB; an energy mean of them reads high), per wavelength band of the corrugation state
+(each pass and noise band at lambda = v / f). The
 indirect rail level is the model's rail level plus 10 lg(1 + x). Its standard uncertainty is the
 fit's standard error (delta method) and the prediction's own band uncertainty
 (``residual.prediction_sd_db``) added in quadrature: with the model's transfer functions in place
