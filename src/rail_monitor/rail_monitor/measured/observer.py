@@ -17,8 +17,8 @@ survey after a weak observation's partial level update over-fits K_b; docs/model
 
 A measurement is paired once its pass is counted, in stamp order, and must arrive before the
 first pass after its window's end (a replay sends each after its pass and before the next); one
-that comes later joins the window then open. One whose pass is not counted is counted in
-``dropped``.
+that comes later joins the window then open. What is not fitted is counted by reason
+(``counts``: a bad or repeated measurement, no counted pass, squealing or a wheel-defect outlier).
 """
 
 from __future__ import annotations
@@ -46,8 +46,9 @@ MODEL = "cnossos"  # the prediction the residuals are taken against: its transfe
 
 @dataclass(frozen=True)
 class Observation:
-    """One window's indirect roughness and the survey-like event it gives the state (None: no band
-    with an estimate above the baseline)."""
+    """One window's indirect roughness and the survey-like event it gives the state (None: not
+    taken, as no band's growth is half its observed energy, or a survey came since the last
+    grinding)."""
 
     stamp_ns: int
     window_days: float
@@ -85,10 +86,6 @@ class IndirectObserver:
     def boundary(self, stamp_ns: int) -> int:
         """The end of the window holding stamp_ns [ns]."""
         return -(-int(stamp_ns) // self.interval_ns) * self.interval_ns
-
-    def due(self, stamp_ns: int) -> int | None:
-        """The end of the open window if a pass at stamp_ns is after it (its observation comes first)."""
-        return self.window_end_ns if self.window_end_ns and stamp_ns > self.window_end_ns else None
 
     def add_measurements(self, measurements: list[Measurement]) -> None:
         for m in measurements:
@@ -212,10 +209,7 @@ class IndirectObserver:
             self.counted[key] = (passes, i, state[i], post[i])
         self.newest_counted_ns = int(passes.stamp_ns.max(initial=-1))
         self.baseline = Baseline(self.cfg.baseline_passes, self.cfg.baseline_min_passes, self.cfg.outlier_db)
-        for v in window[-self.cfg.baseline_passes:].tolist():
-            self.baseline.window.append(v)
-            bisect.insort(self.baseline._sorted, v)
-        self.baseline.reference = reference
+        self.baseline.resume(window.tolist(), reference)
 
     def observe(self, model_state: Corrugation) -> Observation | None:
         """Close the open window: its indirect roughness against the state at its end, and the

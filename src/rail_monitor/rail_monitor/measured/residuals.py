@@ -97,6 +97,13 @@ class Baseline:
         self.min_passes, self.outlier_db = min_passes, outlier_db
         self.reference = math.nan
 
+    def resume(self, window: list[float], reference: float) -> None:
+        """Continue from a window of values (oldest first; the newest maxlen kept) and its reference."""
+        for v in window[-self.window.maxlen:]:
+            self.window.append(v)
+            bisect.insort(self._sorted, v)
+        self.reference = reference
+
     def median(self) -> float:
         """The window's median, as numpy's (the mean of the middle two of an even count) [dB]."""
         s, n = self._sorted, len(self._sorted)
