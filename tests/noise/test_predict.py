@@ -356,3 +356,50 @@ def test_the_mechanics_speed_law_is_25_to_32_lg_v(model, vehicle_class):
     slope = np.polyfit(np.log10(speeds), out, 1)[0]
     assert 25.0 <= slope <= 32.0, slope
     assert np.all(np.diff(out) / np.log2(speeds[1:] / speeds[:-1]) <= 10.0)
+
+
+@pytest.fixture(scope="module")
+def model_a3():
+    """The site's model with the mechanics model on CNOSSOS-EU's 2-D contact filter A3."""
+    values = {**load_parameter_file(SITE_FILE), "noise.contact_filter": "cnossos"}
+    return RollingNoiseModel(load_site(SITE_FILE), noise_config(values))
+
+
+@pytest.mark.parametrize("vehicle_class", ["emu", "dmu", "freight"])
+def test_on_cnossos_contact_filter_the_mechanics_model_is_within_3_dba_of_cnossos(model_a3, vehicle_class):
+    """With the contact filter of roughness not correlated across the contact (A3, Table G-2, the
+    class's nearest entry) in place of the 1-D Hertzian line filter, the mechanics model's own
+    transfers (rail, sleeper, modal wheel) give every class within 3 dB(A) of CNOSSOS-EU at 15 m/s
+    to 120 km/h (measured: EMU +0.4 to +0.9, DMU 0.0 to +0.7, freight +0.7 to +1.5), the freight
+    wagon included (+2.5 to +4.5 on the line filter)."""
+    passes = _passes(model_a3.site, vehicle_class, [15.0, 20.0, 80 / 3.6, 30.0, 120 / 3.6])
+    gap = model_a3.predict(passes, "mechanics").lpaeq_tp_dba - model_a3.predict(passes, "cnossos").lpaeq_tp_dba
+    assert np.all(np.abs(gap) <= 3.0), gap
+
+
+@pytest.mark.parametrize("vehicle_class", ["emu", "freight"])
+def test_on_cnossos_contact_filter_the_speed_law_is_25_to_32_lg_v(model_a3, vehicle_class):
+    """The speed law of test_the_mechanics_speed_law_is_25_to_32_lg_v on A3: EMU 27.7, freight
+    28.2 lg v, at most 9.8 dB(A) per doubling over 10-40 m/s (on the line filter both fail)."""
+    speeds = np.array([10.0, 15.0, 20.0, 30.0, 40.0])
+    out = model_a3.predict(_passes(model_a3.site, vehicle_class, speeds), "mechanics").lpaeq_tp_dba
+    slope = np.polyfit(np.log10(speeds), out, 1)[0]
+    assert 25.0 <= slope <= 32.0, slope
+    assert np.all(np.diff(out) / np.log2(speeds[1:] / speeds[:-1]) <= 10.0)
+
+
+def test_the_dmus_flatter_speed_law_on_a3_is_cnossos_own(model_a3):
+    """The composite-braked DMU on A3 grows 21.9 lg v over 10-40 m/s: CNOSSOS-EU itself gives 19.7
+    for it, its composite wheel roughness being high at the short wavelengths that low speeds put in
+    the A-weighted range. Its 25-32 lg v bar and 3 dB(A) from CNOSSOS cannot both hold on these
+    tables: the mechanics slope stays within 3 lg v of CNOSSOS's."""
+    speeds = np.array([10.0, 15.0, 20.0, 30.0, 40.0])
+    p = _passes(model_a3.site, "dmu", speeds)
+    mech, cnos = (np.polyfit(np.log10(speeds), model_a3.predict(p, m).lpaeq_tp_dba, 1)[0]
+                  for m in ("mechanics", "cnossos"))
+    assert cnos < 25.0 and abs(mech - cnos) <= 3.0, (mech, cnos)
+
+
+def test_a_contact_filter_the_model_does_not_know_is_refused(site_values):
+    with pytest.raises(ConfigError, match="contact_filter"):
+        noise_config({**site_values, "noise.contact_filter": "dprs"})

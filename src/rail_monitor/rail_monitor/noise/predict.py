@@ -253,8 +253,9 @@ class RollingNoiseModel:
 
     def _filter_db(self, passes: PassTable, model: str) -> np.ndarray | None:
         """The mechanics model's contact filter level per pass (passes x bands; its own patch, from
-        its wheel load, the same on both rails); None for CNOSSOS, whose filter is in its tables."""
-        if model == "cnossos":
+        its wheel load, the same on both rails); None for CNOSSOS, whose filter is in its tables, and for
+        the mechanics model on CNOSSOS-EU's A3 (noise.contact_filter: cnossos)."""
+        if model == "cnossos" or self.cfg.contact_filter == "cnossos":
             return None
         return level(wrn.contact_filter_power(passes.speed_mps, self.band, contact_state(self.site, passes).patch.a,
                                               self.cfg.band_points))
@@ -321,6 +322,9 @@ class RollingNoiseModel:
         if model == "cnossos":
             return cb.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
                                      self.impact_db, self.edition), terms.cnossos
+        if filter_db is None:  # CNOSSOS-EU's A3 (noise.contact_filter: cnossos), joints left out as above
+            return cb.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule, None,
+                                     self.edition), terms.mechanics
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
         return lr, terms.mechanics
