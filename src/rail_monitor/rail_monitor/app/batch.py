@@ -128,9 +128,9 @@ class BatchRun:
     first pass stamped later than it, as the estimator node applies them when a replay sends them
     so; those after the last pass at finish(). One the node would refuse is counted in
     ``events_refused`` by reason and changes nothing. measurements: measured pass-bys
-    (rail_monitor.measured), paired with their passes' predictions and scored as alert_manager
-    does (``tracker.refused`` counts the refused); their residuals feed the alerts.
-    """
+    (rail_monitor.measured), paired and scored as alert_manager does (``tracker.refused`` counts the
+    refused), their residuals feeding the alerts; with ``residual.indirect_days`` each window's
+    indirect roughness is taken as the estimator node takes it (``observer``, ``observations``)."""
 
     def __init__(self, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
                  threads: int = 0, events: Sequence[MaintenanceEvent] = (),
