@@ -34,6 +34,7 @@ class ClassTerms:
 
     wheel_db: np.ndarray                 # on the CNOSSOS wavelength grid [dB re 1 um]
     a3_db: np.ndarray                    # CNOSSOS contact filter on the grid [dB]
+    a3_patch_m: float                    # Hertz semi-length along the rail of A3's table entry [m]
     cnossos: dict[str, np.ndarray]       # L_H per component [dB per axle], 24 bands
     mechanics: dict[str, np.ndarray]     # L_H,mech per component [dB per axle]
     traction: dict[str, np.ndarray]      # CNOSSOS L_W,0 per vehicle by source [dB re 1 pW], 24 bands
@@ -49,7 +50,7 @@ def class_terms(site: Site, cfg: NoiseConfig, tables: cn.Tables, track_db: np.nd
             source_component("traction", src): cn.traction_sound_power(v.traction, src, "constant", tables)
             for src in cn.SOURCE_HEIGHTS}
         contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
-        _, a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, tables)
+        (a3_load, a3_diameter), a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, tables)
         _, veh = cn.vehicle_transfer(v.wheel_diameter_m, tables)
         cnossos = {"track": track_db + rolling_excess_db, "vehicle": veh + rolling_excess_db}
         if v.freight:  # L_H,VEH,SUP of Table G-3c: 0 dB, for freight vehicles only (eq. 2.3.9)
@@ -57,8 +58,9 @@ def class_terms(site: Site, cfg: NoiseConfig, tables: cn.Tables, track_db: np.nd
         if bridge_db is not None:
             cnossos["bridge"] = bridge_db
         mech = mechanics_transfer(tables.band, site.track, v, float(contact.stiffness), cfg)
-        out[name] = ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, tables), a3, cnossos, mech,
-                               traction)
+        a3_patch = float(site.contact_patch(a3_diameter / 2.0, a3_load).a)
+        out[name] = ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, tables), a3, a3_patch, cnossos,
+                               mech, traction)
     return out
 
 

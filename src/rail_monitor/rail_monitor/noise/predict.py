@@ -253,12 +253,23 @@ class RollingNoiseModel:
 
     def _filter_db(self, passes: PassTable, model: str) -> np.ndarray | None:
         """The mechanics model's contact filter level per pass (passes x bands; its own patch, from
-        its wheel load, the same on both rails); None for CNOSSOS, whose filter is in its tables, and for
-        the mechanics model on CNOSSOS-EU's A3 (noise.contact_filter: cnossos)."""
-        if model == "cnossos" or self.cfg.contact_filter == "cnossos":
+        its wheel load, the same on both rails); None for CNOSSOS, whose filter is in its tables.
+
+        noise.contact_filter: hertz_line, the 1-D filter of models.wheel_rail_noise; cnossos,
+        CNOSSOS-EU's A3 of the class's table entry at the pass's patch: a contact filter is a function
+        of the wavenumber times the contact length (Remington 1987), so the entry's filter is read at
+        lambda a_entry / a_pass, i.e. at a speed scaled by that ratio (patches of one shape assumed)."""
+        if model == "cnossos":
             return None
-        return level(wrn.contact_filter_power(passes.speed_mps, self.band, contact_state(self.site, passes).patch.a,
-                                              self.cfg.band_points))
+        patch_a = contact_state(self.site, passes).patch.a
+        if self.cfg.contact_filter == "hertz_line":
+            return level(wrn.contact_filter_power(passes.speed_mps, self.band, patch_a, self.cfg.band_points))
+        out = np.empty((len(passes), len(self.band)))
+        for name, rows in _class_rows(passes):
+            terms = self.classes[name]
+            speed = passes.speed_mps[rows] * terms.a3_patch_m / np.asarray(patch_a)[rows]
+            out[rows] = cb.at_band_frequencies(terms.a3_db, speed, self.band_hz, self.cfg.interpolation, self.edition)
+        return out
 
     def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str,
                  filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -322,9 +333,9 @@ class RollingNoiseModel:
         if model == "cnossos":
             return cb.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
                                      self.impact_db, self.edition), terms.cnossos
-        if filter_db is None:  # CNOSSOS-EU's A3 (noise.contact_filter: cnossos), joints left out as above
-            return cb.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule, None,
-                                     self.edition), terms.mechanics
+        if self.cfg.contact_filter == "cnossos":  # each table read on its own, as CNOSSOS-EU's total
+            both = cb.band_roughness(rail_db, terms.wheel_db, 0.0, speed, self.band_hz, rule, None, self.edition)
+            return both + filter_db, terms.mechanics
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
         return lr, terms.mechanics
