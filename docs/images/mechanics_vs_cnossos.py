@@ -1,4 +1,5 @@
-"""Regenerate mechanics_vs_cnossos.png, the README's figure of the mechanics model (modal wheel)
+"""Regenerate mechanics_vs_cnossos.png, the README's figure of the mechanics model (modal wheel, the default
+contact filter A3 at the pass's contact length)
 against CNOSSOS-EU for the same vehicle, track and roughness:
 
     ros2_ws/run python docs/images/mechanics_vs_cnossos.py

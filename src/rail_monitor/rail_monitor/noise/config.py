@@ -79,10 +79,10 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("sleeper_area_m2", wrn.Radiators.sleeper_area_m2, "Mechanics: radiating top area of a half sleeper "
               "[m2].", 0.0, 5.0),
     ParamSpec("wheel_rim_width_m", wrn.Radiators.wheel_rim_width_m, "Mechanics: wheel rim width [m].", 0.01, 0.5),
-    ParamSpec("contact_filter", "cnossos", "Mechanics: the contact filter. hertz_line: averaging over the "
-              "Hertzian contact length of roughness fully correlated across the contact (1-D); cnossos: CNOSSOS-EU's "
-              "A3 (Table G-2, the nearest wheel-load and diameter entry), a 2-D filter of roughness not correlated "
-              "across the contact.", choices=CONTACT_FILTERS),
+    ParamSpec("contact_filter", "cnossos", "Mechanics: the contact filter. cnossos: CNOSSOS-EU's A3 (Table G-2, "
+              "the nearest wheel-load and diameter entry) read at the pass's own contact length, a 2-D filter of "
+              "roughness not correlated across the contact; hertz_line: averaging over the Hertzian contact length of "
+              "roughness fully correlated across the contact (1-D).", choices=CONTACT_FILTERS),
     ParamSpec("band_points", 5, "Mechanics: frequencies per 1/3-octave band for the contact filter's band "
               "average per pass [-].", 1, 50),
     ParamSpec("transfer_points", 400, "Mechanics: frequencies per 1/3-octave band for the speed-independent "
