@@ -76,6 +76,19 @@ def band_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: A
     return total if impact_db is None else level(power(total) + power(at(impact_db)))
 
 
+def contact_filter_at_patch(filter_db: ArrayLike, speed_mps: ArrayLike, table_patch_m: float,
+                            patch_m: ArrayLike, band_hz: ArrayLike | None = None, rule: str = "reference",
+                            edition: str = DEFAULT_EDITION) -> FloatArray:
+    """A contact filter tabulated for one contact (A3 of Table G-2, for a patch of semi-length a_0
+    along the rail = table_patch_m [m]) at another contact of semi-length a (patch_m [m], per
+    pass): a contact filter is a function of the wavenumber times the contact length (Remington,
+    JASA 81, 1987; Ford & Thompson, JSV 293, 2006), H(k a), so the table is read at
+    lambda a_0 / a, that is at the speed v a_0 / a: shape speed.shape + (bands,) [dB]. Patches of
+    one shape (aspect ratio) assumed."""
+    speed = np.asarray(speed_mps, float) * table_patch_m / np.asarray(patch_m, float)
+    return at_band_frequencies(filter_db, speed, band_hz, rule, edition)
+
+
 def at_band_frequencies(level_db: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
                         rule: str = "reference", edition: str = DEFAULT_EDITION) -> FloatArray:
     """A spectrum on the tables' wavelength grid [dB], last axis (it may carry leading axes

@@ -253,22 +253,19 @@ class RollingNoiseModel:
 
     def _filter_db(self, passes: PassTable, model: str) -> np.ndarray | None:
         """The mechanics model's contact filter level per pass (passes x bands; its own patch, from
-        its wheel load, the same on both rails); None for CNOSSOS, whose filter is in its tables.
-
-        noise.contact_filter: hertz_line, the 1-D filter of models.wheel_rail_noise; cnossos,
-        CNOSSOS-EU's A3 of the class's table entry at the pass's patch: a contact filter is a function
-        of the wavenumber times the contact length (Remington 1987), so the entry's filter is read at
-        lambda a_entry / a_pass, i.e. at a speed scaled by that ratio (patches of one shape assumed)."""
+        its wheel load, the same on both rails): the 1-D filter of models.wheel_rail_noise
+        (noise.contact_filter: hertz_line) or the class's A3 at the pass's patch (cnossos); None
+        for CNOSSOS, whose filter is in its tables."""
         if model == "cnossos":
             return None
-        patch_a = contact_state(self.site, passes).patch.a
+        patch_a = np.asarray(contact_state(self.site, passes).patch.a)
         if self.cfg.contact_filter == "hertz_line":
             return level(wrn.contact_filter_power(passes.speed_mps, self.band, patch_a, self.cfg.band_points))
         out = np.empty((len(passes), len(self.band)))
         for name, rows in _class_rows(passes):
             terms = self.classes[name]
-            speed = passes.speed_mps[rows] * terms.a3_patch_m / np.asarray(patch_a)[rows]
-            out[rows] = cb.at_band_frequencies(terms.a3_db, speed, self.band_hz, self.cfg.interpolation, self.edition)
+            out[rows] = cb.contact_filter_at_patch(terms.a3_db, passes.speed_mps[rows], terms.a3_patch_m,
+                                                   patch_a[rows], self.band_hz, self.cfg.interpolation, self.edition)
         return out
 
     def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str,
