@@ -181,8 +181,7 @@ class BatchRun:
 
     def _observe(self) -> list[Observation]:
         """Close the indirect roughness window and take it as the estimator node takes it."""
-        est = self.estimator
-        obs = self.observer.observe(Corrugation(est.bands, est.amplitude, est.grinding_amplitude))
+        obs = self.observer.observe(self.estimator)
         if obs is not None and obs.event is not None:
             self._apply(obs.event)
         return [] if obs is None else [obs]
@@ -216,8 +215,8 @@ class BatchRun:
                 traj = _history(self.estimator, accepted)
             finally:
                 self.estimator.threads = None
-            if self.observer is not None and len(traj):
-                self.observer.add_counted(accepted.take(traj.index), traj.amplitude, traj.constants.grinding_amplitude)
+            if self.observer is not None:
+                self.observer.add_counted(accepted, traj)
             states = self._tail.then(traj)
             on = state_index(states.stamp_ns, states.train_id, accepted.stamp_ns, accepted.train_id.tolist())
             noise = _noise_on_states(pool, self.model, accepted, states.amplitude, traj.constants, on)

@@ -18,7 +18,7 @@ import os
 import zipfile
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,6 +27,9 @@ from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.history import COLUMNS, KeptPasses
 from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
+
+if TYPE_CHECKING:  # the observer's module imports the noise model: not needed to read a checkpoint
+    from rail_monitor.measured.observer import IndirectObserver
 
 VERSION = 5
 # 1: before grinding_amplitude (read as the post-grinding default); 1-2: before the contact regime
@@ -51,7 +54,7 @@ def previous_checkpoint(path: str | Path) -> Path:
     return path.with_name(path.name + ".prev")
 
 
-def save(est: CorrugationEstimator, path: str | Path, observer: Any = None) -> None:
+def save(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None) -> None:
     """Write the state atomically: a temporary file, fsync, rename over path, fsync the folder.
 
     The file it replaces is kept as previous_checkpoint(path). A crash between the two renames
@@ -106,7 +109,7 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
     return meta, data
 
 
-def load(est: CorrugationEstimator, path: str | Path, observer: Any = None) -> None:
+def load(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None) -> None:
     """Resume est (and observer's window, where the file has one) from a checkpoint of its site with
     the same bands (ConfigError otherwise; a file that does not hold a whole, consistent state is
     CorruptCheckpoint). Both are changed only once the whole file has been read and checked."""
@@ -211,7 +214,8 @@ def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarr
             "calibration": calibration.KbPosterior(mean, cov, fits)}
 
 
-def resume(est: CorrugationEstimator, path: str | Path, observer: Any = None) -> tuple[Path | None, list[str]]:
+def resume(est: CorrugationEstimator, path: str | Path,
+           observer: IndirectObserver | None = None) -> tuple[Path | None, list[str]]:
     """Load the newest readable checkpoint: path, else previous_checkpoint(path).
 
     Returns the file loaded (None: neither exists, the state stays as it is) and one line per

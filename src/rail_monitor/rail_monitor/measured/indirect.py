@@ -151,8 +151,9 @@ def state_observation(ind: IndirectRoughness, baseline_db: np.ndarray, post_grin
     per band (NaN: no observation). The noise model's rail roughness energy is the baseline's plus
     the state's growth since grinding, E = P_base + Z^2 - Z_0^2 (RollingNoiseModel.rail_roughness_db),
     so the observed E_obs gives Z^2 = Z_0^2 + E_obs - P_base, and by the delta method
-    var(ln Z) = (E_obs / (2 Z^2))^2 var(ln E_obs). A band whose observed energy is not above the
-    baseline's says nothing about the growth and is left out. baseline_db: the baseline rail
+    var(ln Z) = (E_obs / (2 Z^2))^2 var(ln E_obs). Only bands whose observed growth E_obs - P_base is
+    at least MIN_GROWTH_SHARE of E_obs are kept (elsewhere a small energy error is a large amplitude
+    error). baseline_db: the baseline rail
     roughness on the bands [dB re 1 um]; post_grinding_m: Z_0 [m]."""
     e_obs = 1e-12 * 10.0 ** (ind.level_db / 10.0)          # [m^2]
     growth = e_obs - 1e-12 * 10.0 ** (np.asarray(baseline_db, float) / 10.0)

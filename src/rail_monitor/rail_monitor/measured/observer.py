@@ -32,6 +32,8 @@ import numpy as np
 
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_DAY
+from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_INDIRECT, KIND_SURVEY, MaintenanceEvent, split_before
 from rail_monitor.measured.config import ResidualConfig
 from rail_monitor.measured.indirect import IndirectPairs, IndirectRoughness, state_observation
@@ -103,11 +105,12 @@ class IndirectObserver:
             self.waiting[m.key] = m
         self._drain()
 
-    def add_counted(self, passes: PassTable, amplitude: np.ndarray, post_grinding_m: np.ndarray) -> None:
-        """Counted passes (valid, class defaults filled, in stream order), each with the state that
-        includes it (N, K) [m] and the post-grinding amplitudes then (K,) [m]."""
-        if not len(passes):
+    def add_counted(self, table: PassTable, traj: Trajectory) -> None:
+        """The passes an advance over table (valid, class defaults filled, in stream order) counted,
+        each with the state that includes it."""
+        if not len(traj):
             return
+        passes, amplitude, post_grinding_m = table.take(traj.index), traj.amplitude, traj.constants.grinding_amplitude
         if not self.window_end_ns:
             self.window_end_ns = self.boundary(int(passes.stamp_ns[0]))
         for i, key in enumerate(zip(passes.stamp_ns.tolist(), passes.train_id.tolist(), strict=True)):
@@ -211,10 +214,11 @@ class IndirectObserver:
         self.baseline = Baseline(self.cfg.baseline_passes, self.cfg.baseline_min_passes, self.cfg.outlier_db)
         self.baseline.resume(window.tolist(), reference)
 
-    def observe(self, model_state: Corrugation) -> Observation | None:
-        """Close the open window: its indirect roughness against the state at its end, and the
+    def observe(self, est: CorrugationEstimator) -> Observation | None:
+        """Close the open window: its indirect roughness against est's state at its end, and the
         survey-like event for the estimator (None: no measured pass fitted in it); the next window
         opens empty at the next pass."""
+        model_state = Corrugation(est.bands, est.amplitude, est.grinding_amplitude)
         end, self.window_end_ns = self.window_end_ns, 0
         if not self.fitted:
             return None

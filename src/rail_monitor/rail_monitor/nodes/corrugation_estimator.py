@@ -5,10 +5,10 @@ Subscribes ``train_pass`` (each accepted pass advances the state once: passes ar
 grinding event resets the state). A survey or grinding is applied before the first pass stamped
 later than it, as batch mode applies it (one stamped after every pass so far waits for the next
 pass, or shutdown; one stamped before a pass already counted is applied on arrival and counted as
-late); surveys queued behind a backlog of passes are taken first. Publishes
-With ``residual.indirect_days`` > 0 it also subscribes ``noise/measured`` and takes each window's
-indirect rail roughness as an observation (rail_monitor.measured.observer; published on
-``corrugation/indirect_roughness``, rail_msgs/IndirectRoughness). Publishes
+late); surveys queued behind a backlog of passes are taken first. With ``residual.indirect_days``
+> 0 it also subscribes ``noise/measured`` and takes each window's indirect rail roughness as an
+observation (rail_monitor.measured.observer; published on ``corrugation/indirect_roughness``,
+rail_msgs/IndirectRoughness). Publishes
 ``corrugation/state`` (rail_msgs/CorrugationState, per pass or at most every ``state_period_s``)
 and ``speed_advisory`` (rail_msgs/SpeedAdvisory, every ``advisory_period_s``), both latched;
 serves ``evaluate_speed_distribution``. With
@@ -50,7 +50,7 @@ from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_SUB_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
-from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
 from rail_msgs.msg import (
     CorrugationState,
@@ -141,8 +141,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
 
     def _observe(self) -> None:
         """Close the indirect roughness window: publish its fit, and take it as an observation."""
-        est = self.est
-        obs = self.observer.observe(Corrugation(est.bands, est.amplitude, est.grinding_amplitude))
+        obs = self.observer.observe(self.est)
         if obs is None:
             return
         msg = to_msg(IndirectRoughness, indirect_roughness_fields(obs, self.site.site_id))
@@ -153,8 +152,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
     def _count(self, table: PassTable) -> None:
         # The state and forecast after each counted pass, as advancing one pass at a time gives them.
         traj = self.est.advance_history(table)
-        if self.observer is not None and len(traj):
-            self.observer.add_counted(table.take(traj.index), traj.amplitude, traj.constants.grinding_amplitude)
+        if self.observer is not None:
+            self.observer.add_counted(table, traj)
         if len(traj) < len(table):
             self.counts["not counted (already counted, or older than the history)"] += len(table) - len(traj)
         if not len(traj):
