@@ -11,7 +11,8 @@ from noise.test_predict import _passes
 from rail_monitor.cli import main
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.noise.config import noise_config
-from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.noise.records import Corrugation
 from rail_monitor.site_file import load_parameter_file, load_site
 
 from conftest import SITE_FILE

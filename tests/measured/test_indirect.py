@@ -37,7 +37,8 @@ def test_a_simulated_station_reads_the_true_rail_roughness(site_values):
     from rail_monitor.app.simulator import simulate, simulator_config
     from rail_monitor.core.site import site_from_values
     from rail_monitor.noise.config import noise_config
-    from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+    from rail_monitor.noise.predict import RollingNoiseModel
+    from rail_monitor.noise.records import Corrugation
 
     site = site_from_values(site_values)
     passes = simulate(site, simulator_config({**site_values, "simulator.days": 300.0, "simulator.seed": 20}))

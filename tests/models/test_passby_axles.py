@@ -140,3 +140,41 @@ def test_a_second_source_line_adds_its_energy_and_shares_the_time_history(axles)
     silent = passby.pass_by(lw_a, band, [length], speed, RECEIVER, geometry=ga,
                             elevated=(np.full_like(lw_b, -np.inf), gb))
     np.testing.assert_array_equal(silent.lp_db, a_alone.lp_db)
+
+
+def _mixed_trains(n: int, seed: int = 3):
+    """n trains of 1-30 vehicles (short ones summed axle by axle whole, long ones with far segments)."""
+    rng = np.random.default_rng(seed)
+    vehicles = rng.integers(1, 31, n)
+    length = vehicles * rng.uniform(10.0, 26.0, n)
+    layout = passby_axles.axle_layout(length, vehicles, vehicles * rng.choice([2, 3, 4, 6], n), 0.7, 1.25)
+    return layout, length, rng.uniform(5.0, 45.0, n), rng
+
+
+def test_the_compiled_engine_gives_the_numpy_engines_peaks():
+    # models.passby_axles_jit is the numpy engine's arithmetic fused: the same bits where no far
+    # segment's arctangent enters, to 1e-13 elsewhere; two sets of paths share one history.
+    layout, length, speed, rng = _mixed_trains(300)
+    r3 = float(np.hypot(D, 2.8))
+    paths = [[(rng.uniform(0.5, 2.0, 300), R1), (rng.uniform(0.5, 2.0, 300), R2)],
+             [(rng.uniform(0.5, 2.0, 300), R1), (rng.uniform(0.5, 2.0, 300), R2), (rng.uniform(0, 1, 300), r3)]]
+    want = passby_axles.f_weighted_peaks(paths, layout, length, speed, D, "numpy")
+    got = passby_axles.f_weighted_peaks(paths, layout, length, speed, D, "numba")
+    np.testing.assert_allclose(got, want, rtol=1e-13, atol=0.0)
+    whole = layout.vehicles <= 4   # within the near zone whatever the speed: no arctangent
+    assert whole.any() and np.array_equal(got[:, whole], want[:, whole])
+    for m, p in enumerate(paths):  # a set alone, on the joint window (the largest path distance)
+        alone = passby_axles.f_weighted_peak(p, layout, length, speed, D, "numba", window_r=r3)
+        np.testing.assert_array_equal(alone, got[m])
+
+
+def test_a_pass_gets_the_same_peak_alone_as_in_a_batch_with_either_engine():
+    layout, length, speed, rng = _mixed_trains(40, 8)
+    paths = [(rng.uniform(0.5, 2.0, 40), R1), (rng.uniform(0.5, 2.0, 40), R2)]
+    for engine in ("numpy", "numba"):
+        batch = passby_axles.f_weighted_peak(paths, layout, length, speed, D, engine)
+        for i in (0, 17, 39):
+            one = passby_axles._take(layout, np.array([i]))
+            alone = passby_axles.f_weighted_peak([(c[i:i + 1], r) for c, r in paths], one, length[i:i + 1],
+                                                 speed[i:i + 1], D, engine)
+            assert alone[0] == batch[i], engine

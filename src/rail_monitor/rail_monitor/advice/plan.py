@@ -24,7 +24,7 @@ from rail_monitor.core.passes import KMH_PER_MPS
 from rail_monitor.corrugation.advice import growth_at_speeds
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.models.speed_plan import optimise_speed_plan, plan_growth
-from rail_monitor.noise.predict import Corrugation
+from rail_monitor.noise.records import Corrugation
 
 POINTS_PER_BAND = 5  # speeds across a band over which its growth, noise and squeal are averaged
 

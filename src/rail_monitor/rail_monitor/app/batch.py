@@ -41,13 +41,14 @@ from rail_monitor.measured.observer import IndirectObserver, Observation, next_c
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual, ResidualTracker, predictions_of
 from rail_monitor.noise.config import noise_config
-from rail_monitor.noise.predict import Corrugation, NoisePrediction, RollingNoiseModel
+from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.noise.records import Corrugation, NoisePrediction
 from rail_monitor.noise.state_of_pass import state_index
 from rail_monitor.squeal.config import squeal_config
 from rail_monitor.squeal.predict import predict as predict_squeal
 
 HISTORY_CHUNK = 50_000  # passes per advance_history call: bounds its (passes x bands x components) arrays
-NOISE_CHUNK = 20_000  # passes per noise prediction: bounds the (passes x time steps) arrays of LpAFmax
+NOISE_CHUNK = 8_192  # passes per noise prediction (every model): bounds its (passes x bands) arrays
 PAIR_BLOCK = 1_000  # passes whose predictions are given to the residual tracker at once (at most half it holds)
 
 
@@ -139,7 +140,8 @@ class BatchRun:
         self.site = site_from_values(values)
         self.margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
         self.estimator = estimator or CorrugationEstimator(self.site, corrugation_config(values))
-        self.model = RollingNoiseModel(self.site, noise_config(values))
+        self.estimator.engine = "numba"  # compiled kernels for many passes (their numpy twins in the nodes)
+        self.model = RollingNoiseModel(self.site, noise_config(values), engine="numba")
         self.alerts = AlertManager(alert_config(values, self.estimator.cfg.lead_time_days))
         self.threads = threads or os.cpu_count() or 1
         self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
@@ -304,28 +306,26 @@ def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepte
     """Every model's noise of every accepted pass, each on its state (row of amplitude; -1: passes
     before any state, on none), as tasks of pool."""
     have = state_of_pass >= 0
-    on_state = accepted.take(have)
     state = Corrugation(constants.bands, amplitude[state_of_pass[have]], constants.grinding_amplitude)
-    jobs = {name: (_noise_chunks(pool, model, on_state, name, state),
-                   None if have.all() else _noise_chunks(pool, model, accepted.take(~have), name))
-            for name in model.models}
+    with_state = _noise_chunks(pool, model, accepted.take(have), state)
+    without = None if have.all() else _noise_chunks(pool, model, accepted.take(~have))
     out = {}
-    for name, (with_state, without) in jobs.items():
-        joined = NoisePrediction.concat([f.result() for f in with_state])
+    for name in model.models:
+        joined = NoisePrediction.concat([f.result()[name] for f in with_state])
         out[name] = joined if without is None else joined.merged(have, NoisePrediction.concat(
-            [f.result() for f in without]))
+            [f.result()[name] for f in without]))
     return out
 
 
-def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable, name: str,
+def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable,
                   corrugation: Corrugation | None = None) -> list[Future]:
-    """model.predict over chunks of NOISE_CHUNK passes (each pass is independent), one task each."""
+    """model.predict_models over chunks of NOISE_CHUNK passes (each pass is independent), one task each."""
     jobs = []
     for i in range(0, max(len(passes), 1), NOISE_CHUNK):
         rows = slice(i, i + NOISE_CHUNK)
         state = corrugation if corrugation is None or corrugation.amplitude_m.ndim == 1 else Corrugation(
             corrugation.wavelength_m, corrugation.amplitude_m[rows], corrugation.post_grinding_m)
-        jobs.append(pool.submit(model.predict, passes.take(rows), name, state))
+        jobs.append(pool.submit(model.predict_models, passes.take(rows), (), state))
     return jobs
 
 

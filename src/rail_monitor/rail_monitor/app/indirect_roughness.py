@@ -15,7 +15,8 @@ from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.measured.config import residual_config
 from rail_monitor.measured.indirect import IndirectRoughness, indirect_rail_roughness
 from rail_monitor.noise.config import noise_config
-from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.noise.records import Corrugation
 
 
 def indirect_of_run(result: BatchResult, values: Mapping[str, Any], days: float) -> IndirectRoughness:

@@ -269,7 +269,8 @@ def _reference_pass(run: RunData, values: Mapping[str, Any]) -> PassTable:
 def _spectra(run: RunData, values: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
     """A-weighted 1/3-octave spectra of the reference pass on the post-grinding and the final rail."""
     from rail_monitor.noise.config import noise_config
-    from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+    from rail_monitor.noise.predict import RollingNoiseModel
+    from rail_monitor.noise.records import Corrugation
 
     ref = _reference_pass(run, values)
     model = RollingNoiseModel(site_from_values(values), noise_config(values))

@@ -24,7 +24,7 @@ from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import SQUEAL, Predicted, Residual
 from rail_monitor.noise.config import MODELS
-from rail_monitor.noise.predict import Corrugation, NoisePrediction
+from rail_monitor.noise.records import Corrugation, NoisePrediction
 from rail_monitor.squeal.config import RISK_HIGH
 
 if TYPE_CHECKING:

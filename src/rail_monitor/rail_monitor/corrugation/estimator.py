@@ -65,6 +65,7 @@ class CorrugationEstimator:
         self.kept = KeptPasses()
         self.season = DailyGrowth(self.log_components.shape)  # the last year day by day (forecast interval)
         self.threads: fcst.Threads | None = None  # threads a history's forecasts may use (batch: its pool)
+        self.engine = "numpy"  # of a history's per-band reductions (batch: numba, forecast.band_kernels)
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
         # (B, P). A window's growth is a difference of two, so it is the same however the passes
         # were split into calls (live backlogs, batch chunks).
@@ -162,7 +163,7 @@ class CorrugationEstimator:
         ordinal = np.arange(1, m + 1)
         return Trajectory(
             index=np.flatnonzero(counted), stamp_ns=new.stamp_ns.copy(), train_id=new.train_id.copy(),
-            amplitude=cg.band_amplitude(steps), pass_count=before.pass_count + ordinal,
+            amplitude=np.exp(fcst.band_kernels(self.engine).band_log_amplitude(steps)), pass_count=before.pass_count + ordinal,
             axle_pass_count=before.axle_pass_count + np.cumsum(new.axle_count),
             total_pass_count=before.total_pass_count + ordinal, forecast=fc, constants=before)
 
@@ -283,4 +284,4 @@ class CorrugationEstimator:
     def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
                    newest_ns: np.ndarray) -> Forecast:
         return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
-                              self.cfg.lead_time_days, self.site.mean_axles_per_train, self.threads)
+                              self.cfg.lead_time_days, self.site.mean_axles_per_train, self.threads, self.engine)

@@ -8,6 +8,7 @@ days = train passes / train passes per day (docs/models.md, "Grinding forecast")
 from __future__ import annotations
 
 from concurrent.futures import Executor
+from types import ModuleType
 from typing import NamedTuple
 
 import numpy as np
@@ -35,16 +36,18 @@ class Threads(NamedTuple):
 
 def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
               newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
-              fallback_axles: float, threads: Threads | None = None) -> Forecast:
+              fallback_axles: float, threads: Threads | None = None, engine: str = "numpy") -> Forecast:
     """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
     day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
     band thresholds (B,) [m]; a Forecast of arrays (grinding_due_ns 0: no date, the forecast
     being infinite or beyond MAX_DATED_DAYS). threads: to split the states' root finding over
-    (each band's root is found on its own, so the split changes no bit)."""
+    (each band's root is found on its own, so the split changes no bit). engine: of the per-band
+    reductions (numpy, or numba: models.corrugation_jit)."""
+    kernels = band_kernels(engine)
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
     log_threshold = np.log(threshold)
-    margin = log_threshold - np.log(cg.band_amplitude(log_components))
-    axle_passes = _passes_to_level_split(log_components, growth, log_threshold, threads)
+    margin = log_threshold - kernels.band_log_amplitude(log_components)
+    axle_passes = _passes_to_level_split(kernels, log_components, growth, log_threshold, threads)
     rows = np.arange(len(rate))
     worst = np.where(np.isfinite(axle_passes).any(axis=1), np.argmin(axle_passes, axis=1),
                      np.argmin(margin, axis=1))
@@ -58,14 +61,26 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     return Forecast(growth.max(axis=2), worst, passes, days, rate, due, due_ns)
 
 
-def _passes_to_level_split(log_components: np.ndarray, growth: np.ndarray, log_threshold: np.ndarray,
-                     threads: Threads | None) -> np.ndarray:
+def band_kernels(engine: str) -> ModuleType:
+    """The module of the per-band reductions (band_log_amplitude, passes_to_band_level) of an engine."""
+    if engine == "numba":
+        from rail_monitor.models import corrugation_jit
+
+        return corrugation_jit
+    if engine != "numpy":
+        raise ValueError(f"unknown engine {engine!r}: numpy or numba")
+    return cg
+
+
+def _passes_to_level_split(kernels: ModuleType, log_components: np.ndarray, growth: np.ndarray,
+                           log_threshold: np.ndarray, threads: Threads | None) -> np.ndarray:
     parts = 0 if threads is None else min(threads.count, len(log_components) // PARALLEL_MIN_STATES)
     if threads is None or parts <= 1:
-        return cg.passes_to_band_level(log_components, growth, log_threshold)
+        return kernels.passes_to_band_level(log_components, growth, log_threshold)
     bounds = np.linspace(0, len(log_components), parts + 1).astype(int)
-    done = threads.pool.map(lambda lo, hi: cg.passes_to_band_level(log_components[lo:hi], growth[lo:hi], log_threshold),
-                    bounds[:-1], bounds[1:])  # numpy's ufuncs release the GIL
+    done = threads.pool.map(lambda lo, hi: kernels.passes_to_band_level(log_components[lo:hi], growth[lo:hi],
+                                                                        log_threshold),
+                            bounds[:-1], bounds[1:])  # both engines release the GIL
     return np.concatenate(list(done))
 
 

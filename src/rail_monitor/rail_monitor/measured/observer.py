@@ -39,7 +39,8 @@ from rail_monitor.measured.config import ResidualConfig
 from rail_monitor.measured.indirect import IndirectPairs, IndirectRoughness, state_observation
 from rail_monitor.measured.records import Measurement, measurement_refusal
 from rail_monitor.measured.residuals import Baseline, Predicted, compare
-from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.noise.records import Corrugation
 
 MAX_AWAITING = 10_000  # counted passes kept in a checkpoint for their measurements still to come
 TEXT = ("train_id", "vehicle_class")  # PassTable's text columns

@@ -38,6 +38,7 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -209,55 +210,86 @@ def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, re
 def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike,
             receiver: Receiver, direct_correction_db: ArrayLike = 0.0, time_weighted: bool = True,
             geometry: PassGeometry | None = None,
-            elevated: tuple[ArrayLike, PassGeometry] | None = None) -> PassBy:
+            elevated: tuple[ArrayLike, PassGeometry] | None = None, engine: str = "numpy") -> PassBy:
     """Pass-by levels of trains with band sound power per metre [dB re 1 pW/m] (passes x bands).
 
     length_m, speed_mps: per pass [m], [m/s]. band: IEC 61260-1 band numbers. direct_correction_db:
     per band, added to the direct path only (CNOSSOS-EU's vertical directivity of source A).
-    time_weighted: compute LpAFmax (the costly part; NaN without it). geometry: pass_geometry of
-    the same bands, passes and receiver, when it is already at hand. elevated: a second source
-    line of the same trains at another height (CNOSSOS-EU's source B, 4 m): its power per metre
-    and its pass_geometry (the same passes, bands and axles), without directivity correction; its
-    paths join the time history, so LpAFmax is that of both lines together.
+    time_weighted: compute LpAFmax (the costly part; NaN without it, see f_weighted_peaks for
+    several spectra on the same trains at once). geometry: pass_geometry of the same bands, passes
+    and receiver, when it is already at hand. elevated: a second source line of the same trains at
+    another height (CNOSSOS-EU's source B, 4 m): its power per metre and its pass_geometry (the same
+    passes, bands and axles), without directivity correction; its paths join the time history, so
+    LpAFmax is that of both lines together. engine: of the per-axle time history (numpy or numba).
     """
     g = geometry or pass_geometry(band, length_m, speed_mps, receiver)
-    lw = np.atleast_2d(np.asarray(lw_per_metre_db, float))
-    w_direct = power(lw + np.asarray(direct_correction_db, float))     # per band, direct path
-    w_image = g.ground_reflection * power(lw)
-    mean = w_direct * g.k1 + w_image * g.k2
-    exposure = w_direct * g.total1 + w_image * g.total2
+    paths = band_paths(lw_per_metre_db, g, direct_correction_db, elevated)
+    fmax = level(f_weighted_peaks(g, [a_weighted_paths(g, paths)], engine)[0]) if time_weighted else None
+    return pass_by_levels(g, paths, fmax)
+
+
+def pass_by_levels(g: PassGeometry, paths: BandPaths, lpafmax_dba: FloatArray | None = None) -> PassBy:
+    """pass_by of the band paths (band_paths) on their geometry, given LpAFmax (None: NaN); the
+    A-weighted totals summed in energy, without a round trip through decibels."""
+    mean = _per_line(w * k for w, k, _, _ in paths)
+    exposure = _per_line(w * total for w, _, total, _ in paths)
     a = g.a_weight
-    paths = [(w_direct, g.r1), (w_image, g.r2)]
-    if elevated is not None:
-        lw_b, gb = np.atleast_2d(np.asarray(elevated[0], float)), elevated[1]
-        wb_direct, wb_image = power(lw_b), gb.ground_reflection * power(lw_b)
-        mean = mean + (wb_direct * gb.k1 + wb_image * gb.k2)
-        exposure = exposure + (wb_direct * gb.total1 + wb_image * gb.total2)
-        paths += [(wb_direct, gb.r1), (wb_image, gb.r2)]
-    lp = level(mean)
-    tel_band = level(exposure)
-    fmax = level(_peak(g, [(np.sum(w * a, axis=-1), r) for w, r in paths])) if time_weighted \
-        else np.full(len(g.length), np.nan)
     return PassBy(
-        lp_db=lp,
-        lpaeq_tp_dba=level(np.sum(power(lp) * a, axis=-1)),
-        tel_dba=level(np.sum(power(tel_band) * a, axis=-1)),
-        lpafmax_dba=fmax,
+        lp_db=level(mean),
+        lpaeq_tp_dba=level(np.sum(mean * a, axis=-1)),
+        tel_dba=level(np.sum(exposure * a, axis=-1)),
+        lpafmax_dba=np.full(len(g.length), np.nan) if lpafmax_dba is None else lpafmax_dba,
         pass_by_time_s=g.length / g.speed,
     )
 
 
+def _per_line(terms: Iterator[FloatArray]) -> FloatArray:
+    """Sum of the paths' terms, the direct and image paths of each source line first."""
+    terms = list(terms)
+    out = terms[0] + terms[1]
+    return out if len(terms) == 2 else out + (terms[2] + terms[3])
+
+
 # The paths of a pass-by: (A-weighted power per metre per pass [any unit], perpendicular distance [m]).
 Paths = list[tuple[FloatArray, float]]
+# A path per band: (power per metre per pass and band [W/m-like], its kernel window mean [1/m], its
+# kernel total [1/m], its perpendicular distance [m]).
+BandPaths = list[tuple[FloatArray, FloatArray, float, float]]
 
 
-def _peak(g: PassGeometry, paths: Paths) -> FloatArray:
-    """The F-time-weighted peak of the pass's sources (line or axles) along these paths."""
+def band_paths(lw_per_metre_db: ArrayLike, g: PassGeometry, direct_correction_db: ArrayLike = 0.0,
+               elevated: tuple[ArrayLike, PassGeometry] | None = None) -> BandPaths:
+    """The direct and image paths of the source line (and of the elevated one) with their power
+    per metre per band (pass_by's arguments)."""
+    high = None if elevated is None else (power(np.atleast_2d(np.asarray(elevated[0], float))), elevated[1])
+    return power_paths(power(np.atleast_2d(np.asarray(lw_per_metre_db, float))), g, power(direct_correction_db), high)
+
+
+def power_paths(w: FloatArray, g: PassGeometry, direct_gain: ArrayLike = 1.0,
+                elevated: tuple[FloatArray, PassGeometry] | None = None) -> BandPaths:
+    """band_paths of power per metre w (power ratio re 1 pW/m per pass and band; direct_gain:
+    the direct path's power ratio per band, and the elevated line's power per metre)."""
+    out = [(w * direct_gain, g.k1, g.total1, g.r1), (g.ground_reflection * w, g.k2, g.total2, g.r2)]
+    if elevated is not None:
+        w_b, gb = elevated
+        out += [(w_b, gb.k1, gb.total1, gb.r1), (gb.ground_reflection * w_b, gb.k2, gb.total2, gb.r2)]
+    return out
+
+
+def a_weighted_paths(g: PassGeometry, paths: BandPaths) -> Paths:
+    """The A-weighted power per metre of each path (summed over bands), for the time history."""
+    return [(np.sum(w * g.a_weight, axis=-1), r) for w, _, _, r in paths]
+
+
+def f_weighted_peaks(g: PassGeometry, paths_of: list[Paths], engine: str = "numpy") -> FloatArray:
+    """The F-time-weighted peak of the squared pressure (sets x passes) of each set of paths on the
+    same trains (line or axles; several spectra share the axles' time histories, over windows set
+    by the source line's paths, g's, whatever other lines the sets hold)."""
     if g.axles is None:
-        return _f_weighted_peak(paths, g.length, g.speed, g.d)
+        return np.stack([_f_weighted_peak(paths, g.length, g.speed, g.d) for paths in paths_of])
     from rail_monitor.models import passby_axles
 
-    return passby_axles.f_weighted_peak(paths, g.axles, g.length, g.speed, g.d)
+    return passby_axles.f_weighted_peaks(paths_of, g.axles, g.length, g.speed, g.d, engine, max(g.r1, g.r2))
 
 
 def _f_weighted_peak(paths: Paths, length: FloatArray, speed: FloatArray, d: float,

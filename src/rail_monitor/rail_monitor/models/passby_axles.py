@@ -35,6 +35,7 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -153,15 +154,28 @@ def _take(layout: AxleLayout, rows: NDArray[np.int64]) -> AxleLayout:
 
 
 def f_weighted_peak(paths: Paths, layout: AxleLayout, length_m: ArrayLike, speed_mps: ArrayLike,
-                    d: float) -> FloatArray:
+                    d: float, engine: str = "numpy", window_r: float | None = None) -> FloatArray:
     """Peak of the F-time-weighted squared pressure of the axles (passes,) along the paths (c, R): c
     the A-weighted power per metre [W/m-like, any unit] of a path (per pass), R its perpendicular
-    distance [m]: the direct and image paths of each source line (module docstring). Each pass's
-    time step, window and near vehicles are its own, so the result is the same bits in a batch as
-    alone."""
+    distance [m]: the direct and image paths of each source line (module docstring)."""
+    return f_weighted_peaks([paths], layout, length_m, speed_mps, d, engine, window_r)[0]
+
+
+def f_weighted_peaks(paths_of: Sequence[Paths], layout: AxleLayout, length_m: ArrayLike, speed_mps: ArrayLike,
+                     d: float, engine: str = "numpy", window_r: float | None = None) -> FloatArray:
+    """f_weighted_peak of several sets of paths on the same trains (models x passes): the time
+    history of each distinct path distance R is computed once and shared, each set's squared
+    pressure being sum_i c_i X_R_i(t). Each pass's time step, window and near vehicles are its own
+    (from the path distance window_r [m], default the largest of the paths': a set's peak depends
+    on the sets computed with it only through it), so the result is the same bits in a batch as
+    alone. engine: ``numpy``, or ``numba`` (the same arithmetic compiled, models.passby_axles_jit;
+    equal but for the arctangent's last bit)."""
     length = np.atleast_1d(np.asarray(length_m, float))
     speed = np.atleast_1d(np.asarray(speed_mps, float))
-    tau, r = F_TIME_CONSTANT_S, max(r for _, r in paths)
+    radii = list(dict.fromkeys(r for paths in paths_of for _, r in paths))
+    use = [[radii.index(r) for _, r in paths] for paths in paths_of]
+    c = [[np.broadcast_to(np.asarray(ci, float), length.shape) for ci, _ in paths] for paths in paths_of]
+    tau, r = F_TIME_CONSTANT_S, max(radii) if window_r is None else window_r
     dt = np.maximum(tau / STEPS_PER_TAU, d / (SAMPLES_PER_DISTANCE * speed))
     before = np.ceil(6.0 * tau / dt).astype(np.int64)
     samples = before + np.ceil((_travel(layout, r) / speed + 3.0 * tau) / dt).astype(np.int64) + 1
@@ -170,20 +184,32 @@ def f_weighted_peak(paths: Paths, layout: AxleLayout, length_m: ArrayLike, speed
     half = np.ceil(_reach(layout, r, speed, duration) / layout.pitch_m).astype(np.int64)
     lo = np.maximum(middle - half, 0)
     hi = np.minimum(middle + half, layout.vehicles - 1)
-    out = np.empty(len(length))
+    decay = np.exp(-dt / tau)
+    weight = (layout.pitch_m / layout.axles_per_vehicle) / (4.0 * np.pi)
+    if engine == "numba":
+        from rail_monitor.models.passby_axles_jit import f_weighted_peaks as compiled
+
+        return compiled(length, speed, dt, decay, before, samples, lo, hi, layout, weight, d, radii, use, c)
+    if engine != "numpy":
+        raise ValueError(f"unknown engine {engine!r}: numpy or numba")
+    out = np.empty((len(paths_of), len(length)))
     order = np.lexsort((hi - lo, samples))   # blocks of passes alike, so that little of a block is idle
     start = 0
     while start < len(order):
         stop = start + 1
-        while stop < len(order) and (stop + 1 - start) * samples[order[stop]] <= HISTORY_ELEMENTS:
+        while stop < len(order) and (stop + 1 - start) * samples[order[stop]] * len(radii) <= HISTORY_ELEMENTS:
             stop += 1
         part = order[start:stop]
         t = (np.arange(int(samples[part].max()))[None, :] - before[part, None]) * dt[part, None]
-        x = _history([(c[part], r_path) for c, r_path in paths], _take(layout, part), length[part], speed[part],
-                     lo[part], hi[part], t, d)
-        y = exponential_average(x, np.exp(-dt[part] / tau))
-        own = np.arange(y.shape[1])[None, :] < samples[part, None]
-        out[part] = np.where(own, y, -np.inf).max(axis=1)
+        x = _histories(radii, _take(layout, part), length[part], speed[part], lo[part], hi[part], weight[part],
+                       t, d)
+        own = np.arange(t.shape[1])[None, :] < samples[part, None]
+        for m, (ks, cs) in enumerate(zip(use, c, strict=True)):
+            total = cs[0][part, None] * x[ks[0]]
+            for k, ck in zip(ks[1:], cs[1:], strict=True):
+                total = total + ck[part, None] * x[k]
+            y = exponential_average(total, decay[part])
+            out[m, part] = np.where(own, y, -np.inf).max(axis=1)
         start = stop
     return out
 
@@ -199,37 +225,36 @@ def _reach(layout: AxleLayout, r: float, speed: FloatArray, duration: FloatArray
     return NEAR_PATH_DISTANCES * r + speed * duration + layout.pitch_m
 
 
-def _history(paths: Paths, layout: AxleLayout, length: FloatArray, speed: FloatArray, lo: NDArray[np.int64],
-             hi: NDArray[np.int64], t: FloatArray, d: float) -> FloatArray:
-    """The squared pressure (passes, samples) at the times t [s] after the train's middle passes
-    (per pass, from 6 tau before): vehicles lo ... hi axle by axle, the rest as line segments."""
+def _histories(radii: list[float], layout: AxleLayout, length: FloatArray, speed: FloatArray,
+               lo: NDArray[np.int64], hi: NDArray[np.int64], weight: FloatArray, t: FloatArray, d: float) -> FloatArray:
+    """X_R(t) per path distance R, (radii, passes, samples): the squared pressure of unit power per
+    metre at the times t [s] after the train's middle passes (per pass, from 6 tau before), the
+    vehicles lo ... hi axle by axle (weight: P / (k 4 pi) per pass), the rest, where a pass has
+    any, as the line segments they occupy."""
     front = 0.5 * length[:, None] + speed[:, None] * t                             # (passes, T) [m]
-    broad = _BROADSIDE * d * d
-    weights = [(c[:, None, None], r * r) for c, r in paths]
+    broad, r2 = _BROADSIDE * d * d, [r * r for r in radii]
 
-    def pressure(s: FloatArray) -> FloatArray:
-        """sum over paths of c / (x^2 + R^2), times the horizontal directivity [1/m^2 x 4 pi]
-        (passes, w, T), of the axles s (passes, w) behind the front, in place (the arrays are the
-        cost)."""
+    def per_radius(s: FloatArray) -> FloatArray:
+        """directivity / (x^2 + R^2) per R (passes, w, radii, T) of the axles s (passes, w) behind
+        the front (the arrays are the cost: computed in place)."""
         x2 = np.subtract(front[:, None, :], s[:, :, None])
-        g1, g2 = np.empty_like(x2), np.empty_like(x2)
         np.square(x2, out=x2)
-        (c_first, r2_first), *rest = weights
-        np.divide(c_first, np.add(x2, r2_first, out=g1), out=g1)
-        for c_path, r2_path in rest:
-            np.divide(c_path, np.add(x2, r2_path, out=g2), out=g2)
-            np.add(g1, g2, out=g1)
-        np.divide(broad, np.add(x2, d * d, out=x2), out=x2)
-        np.add(x2, _OMNI, out=x2)
-        return np.multiply(g1, x2, out=g1)
+        directivity = np.add(np.divide(broad, x2 + d * d), _OMNI)
+        out = np.empty((*x2.shape[:2], len(radii), x2.shape[2]))
+        for k, rk in enumerate(r2):
+            np.divide(directivity, np.add(x2, rk), out=out[:, :, k])
+        return out
 
-    weight = (layout.pitch_m / layout.axles_per_vehicle)[:, None] / (4.0 * np.pi)
-    total = weight * _sum_over_axles(layout, lo, hi - lo + 1, pressure, max(1, HISTORY_ELEMENTS // front.size))
+    width = max(1, HISTORY_ELEMENTS // (front.size * len(radii)))
+    total = weight[None, :, None] * np.moveaxis(_sum_over_axles(layout, lo, hi - lo + 1, per_radius, width), 1, 0)
+    far = (lo > 0) | (hi < layout.vehicles - 1)
+    if not far.any():
+        return total
     # The vehicles before lo and after hi, as the line segments they occupy.
-    head_start = front - (lo * layout.pitch_m)[:, None]
-    tail_start = front - ((hi + 1) * layout.pitch_m)[:, None]
-    rear = front - length[:, None]
-    for c, r in paths:
-        g = kernel_antiderivative
-        total = total + c[:, None] * (g(front, d, r) - g(head_start, d, r) + g(tail_start, d, r) - g(rear, d, r))
+    f = front[far]
+    head, tail = f - (lo * layout.pitch_m)[far, None], f - ((hi + 1) * layout.pitch_m)[far, None]
+    rear = f - length[far, None]
+    g = kernel_antiderivative
+    for k, r in enumerate(radii):
+        total[k, far] += g(f, d, r) - g(head, d, r) + g(tail, d, r) - g(rear, d, r)
     return total

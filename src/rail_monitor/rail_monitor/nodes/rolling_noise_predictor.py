@@ -37,7 +37,8 @@ from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
-from rail_monitor.noise.predict import Corrugation, RollingNoiseModel
+from rail_monitor.noise.predict import RollingNoiseModel
+from rail_monitor.noise.records import Corrugation
 from rail_monitor.noise.state_of_pass import first_state_needed, state_arrived, state_index
 from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
 
@@ -155,7 +156,7 @@ class RollingNoisePredictor(PassConsumerNode):
             corrugation = None if first is None else Corrugation(
                 first.wavelength_m, np.stack([np.asarray(s.amplitude_m) for s in states[rows]]), first.post_grinding_m)
             passes = ready[rows]
-            values = [self.model.predict(_rows(passes), name, corrugation) for name in self.model.models]
+            values = self.model.predict_models(_rows(passes), (), corrugation).values()
             for k, p in enumerate(passes):
                 for v in values:
                     self.sent.publish(self.pub, to_msg(RollingNoise, rolling_noise_fields(

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -38,7 +37,15 @@ from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.levels import level, power
-from rail_monitor.models.passby import PassBy, PassGeometry, pass_by, pass_geometry
+from rail_monitor.models.passby import (
+    BandPaths,
+    PassGeometry,
+    a_weighted_paths,
+    f_weighted_peaks,
+    pass_by_levels,
+    pass_geometry,
+    power_paths,
+)
 from rail_monitor.models.passby_axles import AxleLayout, axle_layout
 from rail_monitor.noise.class_terms import (
     AERODYNAMIC_COMPONENTS,
@@ -48,6 +55,7 @@ from rail_monitor.noise.class_terms import (
     source_component,
 )
 from rail_monitor.noise.config import MODELS, NoiseConfig, check_traction, selected_models
+from rail_monitor.noise.records import Corrugation, NoisePrediction
 
 # What roughness_growth_increase_db is measured against, for every label that shows it.
 INCREASE_REFERENCE = ("the same pass on the site's baseline rail roughness (noise.rail_roughness: as ground, "
@@ -59,74 +67,11 @@ def roughness_power(amplitude_m: np.ndarray) -> np.ndarray:
     return (np.asarray(amplitude_m, float) / 1e-6) ** 2
 
 
-@dataclass(frozen=True)
-class Corrugation:
-    """The part of a CorrugationState the noise needs: bands [m] and r.m.s. amplitudes [m].
-
-    amplitude_m and post_grinding_m are (bands,) for one state, or (passes, bands) for a state per
-    pass (batch mode)."""
-
-    wavelength_m: np.ndarray
-    amplitude_m: np.ndarray
-    post_grinding_m: np.ndarray
-
-
-@dataclass(frozen=True)
-class NoisePrediction:
-    """Rolling noise of passes by one source model (fields and units as in rail_msgs/RollingNoise):
-    the model, band centres and component names, then arrays over passes (bands last)."""
-
-    model: str
-    band_centre_hz: np.ndarray              # (B,) [Hz]
-    component_names: list[str]
-    speed_mps: np.ndarray                   # (N,) [m/s]
-    lp_db: np.ndarray                       # (N, B) LpZeq,Tp per band [dB re 20 uPa]
-    lw_db: np.ndarray                       # (N, B) sound power per metre of train [dB re 1 pW/m]
-    roughness_db: np.ndarray                # (N, B) effective roughness [dB re 1 um]
-    pass_by_time_s: np.ndarray              # (N,) [s]
-    lpaeq_tp_dba: np.ndarray                # (N,) [dB(A)]
-    lpafmax_dba: np.ndarray                 # (N,) [dB(A)]
-    tel_dba: np.ndarray                     # (N,) [dB(A)]
-    component_lpaeq_dba: np.ndarray         # (N, components) [dB(A)]
-    roughness_growth_increase_db: np.ndarray  # (N,) [dB]
-
-    CONSTANTS = ("model", "band_centre_hz", "component_names")
-
-    def __len__(self) -> int:
-        return len(self.speed_mps)
-
-    def components(self, i: int) -> tuple[list[str], list[float]]:
-        """Pass i's source components and their LpAeq,Tp [dB(A)]: those its class has (the
-        superstructure term is for freight only), in component_names order."""
-        pairs = [(c, float(x)) for c, x in zip(self.component_names, self.component_lpaeq_dba[i], strict=True)
-                 if x > -np.inf]
-        return [c for c, _ in pairs], [x for _, x in pairs]
-
-    def per_pass(self) -> dict[str, np.ndarray]:
-        """The arrays over passes, by field name."""
-        return {f.name: getattr(self, f.name) for f in fields(self) if f.name not in self.CONSTANTS}
-
-    @classmethod
-    def concat(cls, parts: Sequence[NoisePrediction]) -> NoisePrediction:
-        """The passes of parts (same model and bands), one after the other."""
-        return replace(parts[0], **{k: np.concatenate([p.per_pass()[k] for p in parts])
-                                    for k in parts[0].per_pass()})
-
-    def merged(self, mask: np.ndarray, other: NoisePrediction) -> NoisePrediction:
-        """These rows where mask is true and other's where it is false, in pass order."""
-        out = {}
-        for k, mine in self.per_pass().items():
-            col = np.empty((len(mask), *mine.shape[1:]), mine.dtype)
-            col[mask], col[~mask] = mine, other.per_pass()[k]
-            out[k] = col
-        return replace(self, **out)
-
-
 class RollingNoiseModel:
     """Both source models for one site, with everything speed-independent computed once."""
 
-    def __init__(self, site: Site, cfg: NoiseConfig) -> None:
-        self.site, self.cfg = site, cfg
+    def __init__(self, site: Site, cfg: NoiseConfig, engine: str = "numpy") -> None:
+        self.site, self.cfg, self.engine = site, cfg, engine
         self.edition = ed = cfg.cnossos_edition
         self.tables = t = check_traction(site, cfg)
         self.grid = t.wavelength_m
@@ -134,6 +79,7 @@ class RollingNoiseModel:
         self.receiver = cfg.receiver
         (_, psi), _ = self.receiver.paths()
         self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz, ed)
+        self.vertical_gain = power(self.vertical_db)
         self.baseline_db = self._baseline()
         self.impact_db = cn.impact_roughness(cfg.joints_per_100m / 100.0, t) if cfg.joints_per_100m > 0 else None
         if cfg.track_transfer:
@@ -208,30 +154,45 @@ class RollingNoiseModel:
 
     def predict(self, passes: PassTable, model: str | None = None,
                 corrugation: Corrugation | None = None) -> NoisePrediction:
-        """RollingNoise fields per pass (arrays over passes; bands last), vectorised.
-
-        ``passes`` must be valid for the site with class defaults filled. model: one of MODELS
-        (default: the first of the site's ``noise.model``).
-        """
+        """RollingNoise fields per pass of one model (default: the first of the site's
+        ``noise.model``): predict_models of it alone."""
         model = model or self.models[0]
-        if model not in MODELS:
-            raise ValueError(f"unknown noise model {model!r}; use one of {MODELS}")
-        filter_db = self._filter_db(passes, model)
-        roughness, components = self._sources(self.rail_roughness_db(corrugation), passes, model, filter_db)
-        geometry = self._geometries(passes, model)
-        pb = self._pass_by(components, geometry)
-        names = list(components)
-        growth = np.zeros(len(passes))
-        if corrugation is not None:
-            _, ground = self._sources(self.baseline_db, passes, model, filter_db)
-            growth = pb.lpaeq_tp_dba - self._pass_by(ground, geometry, False).lpaeq_tp_dba
-        return NoisePrediction(
-            model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
-            lp_db=pb.lp_db, lw_db=_total(components), roughness_db=roughness, pass_by_time_s=pb.pass_by_time_s,
-            lpaeq_tp_dba=pb.lpaeq_tp_dba, lpafmax_dba=pb.lpafmax_dba, tel_dba=pb.tel_dba,
-            component_lpaeq_dba=np.stack([self._pass_by({c: components[c]}, geometry, False).lpaeq_tp_dba
-                                          for c in names], axis=-1),
-            roughness_growth_increase_db=growth)
+        return self.predict_models(passes, (model,), corrugation)[model]
+
+    def predict_models(self, passes: PassTable, models: Sequence[str] = (),
+                       corrugation: Corrugation | None = None) -> dict[str, NoisePrediction]:
+        """RollingNoise fields per pass (arrays over passes; bands last) of each model (default: the
+        site's ``noise.model``), vectorised; the passes' geometry and the time histories of their
+        axles are computed once for all the models.
+
+        ``passes`` must be valid for the site with class defaults filled.
+        """
+        models = tuple(models) or self.models
+        if unknown := [m for m in models if m not in MODELS]:
+            raise ValueError(f"unknown noise model {unknown[0]!r}; use one of {MODELS}")
+        geometry = self._geometries(passes, models)
+        rail = self.rail_roughness_db(corrugation)
+        out, paths = {}, []
+        for model in models:
+            filter_db = self._filter_db(passes, model)
+            roughness, components = self._sources(rail, passes, model, filter_db)
+            components = {c: power(lw) for c, lw in components.items()}  # energy from here on
+            lines = self._paths(components, geometry)
+            pb = pass_by_levels(geometry[0], lines)
+            paths.append(a_weighted_paths(geometry[0], lines))
+            names = list(components)
+            growth = np.zeros(len(passes))
+            if corrugation is not None:
+                _, ground = self._sources(self.baseline_db, passes, model, filter_db)
+                growth = pb.lpaeq_tp_dba - self._levels({c: power(lw) for c, lw in ground.items()}, geometry)
+            out[model] = NoisePrediction(
+                model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
+                lp_db=pb.lp_db, lw_db=level(sum(components.values())), roughness_db=roughness, pass_by_time_s=pb.pass_by_time_s,
+                lpaeq_tp_dba=pb.lpaeq_tp_dba, lpafmax_dba=pb.lpafmax_dba, tel_dba=pb.tel_dba,
+                component_lpaeq_dba=np.stack([self._levels({c: components[c]}, geometry) for c in names], axis=-1),
+                roughness_growth_increase_db=growth)
+        peaks = level(f_weighted_peaks(geometry[0], paths, self.engine))
+        return {m: dataclasses.replace(p, lpafmax_dba=peak) for (m, p), peak in zip(out.items(), peaks, strict=True)}
 
     def vehicle_sound_power(self, passes: PassTable, model: str,
                             corrugation: Corrugation | None = None) -> dict[str, np.ndarray]:
@@ -303,25 +264,29 @@ class RollingNoiseModel:
                 components[source_component("aerodynamic", src)][rows] = \
                     cn.aerodynamic_sound_power(speed_kmh, src, self.tables) + per_metre
 
-    def _geometries(self, passes: PassTable, model: str) -> tuple[PassGeometry, PassGeometry | None]:
-        """The pass geometry of source A, and of source B (4 m) where the model has components there."""
+    def _geometries(self, passes: PassTable, models: Sequence[str]) -> tuple[PassGeometry, PassGeometry | None]:
+        """The pass geometry of source A, and of source B (4 m) where a model has components there."""
         axles = self._axles(passes) if self.cfg.pass_by_sources == "axles" else None
         low = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver, axles)
-        if not set(self.component_names(model)) & set(SOURCE_B_COMPONENTS):
+        if not {c for m in models for c in self.component_names(m)} & set(SOURCE_B_COMPONENTS):
             return low, None
         return low, pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver_b, axles)
 
-    def _pass_by(self, components: dict[str, np.ndarray], geometries: tuple[PassGeometry, PassGeometry | None],
-                 time_weighted: bool = True) -> PassBy:
-        """Pass-by of the components: those of source B as a second source line of the same trains
-        (CNOSSOS-EU's horizontal directivity alone), the others at source A."""
+    def _paths(self, components: dict[str, np.ndarray],
+               geometries: tuple[PassGeometry, PassGeometry | None]) -> BandPaths:
+        """The band paths of the components (power per metre, power ratios): those of source B as
+        a second source line of the same trains (CNOSSOS-EU's horizontal directivity alone), the
+        others at source A."""
         geometry, geometry_b = geometries
-        low = {c: lw for c, lw in components.items() if c not in SOURCE_B_COMPONENTS}
-        high = {c: lw for c, lw in components.items() if c in SOURCE_B_COMPONENTS}
-        elevated = (_total(high), geometry_b) if high else None
-        total = _total(low) if low else np.full_like(next(iter(high.values())), -np.inf)
-        return pass_by(total, self.band, geometry.length, geometry.speed, self.receiver, self.vertical_db,
-                       time_weighted, geometry, elevated)
+        low = [w for c, w in components.items() if c not in SOURCE_B_COMPONENTS]
+        high = [w for c, w in components.items() if c in SOURCE_B_COMPONENTS]
+        total = sum(low) if low else np.zeros_like(high[0])
+        return power_paths(total, geometry, self.vertical_gain, (sum(high), geometry_b) if high else None)
+
+    def _levels(self, components: dict[str, np.ndarray],
+                geometries: tuple[PassGeometry, PassGeometry | None]) -> np.ndarray:
+        """LpAeq,Tp of the components (power ratios) alone [dB(A)] (passes,)."""
+        return pass_by_levels(geometries[0], self._paths(components, geometries)).lpaeq_tp_dba
 
     def _roughness(self, rail_db: np.ndarray, terms: ClassTerms, speed: np.ndarray, model: str,
                    filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -342,8 +307,3 @@ def _class_rows(passes: PassTable) -> Iterator[tuple[str, np.ndarray]]:
     """(vehicle class, its rows' mask) for each class among passes: the class terms are per class."""
     for name in set(passes.vehicle_class.tolist()):
         yield name, passes.vehicle_class == name
-
-
-def _total(components: dict[str, np.ndarray]) -> np.ndarray:
-    """Energy sum of component levels [dB]."""
-    return level(sum(power(c) for c in components.values()))

@@ -14,7 +14,8 @@ from rail_monitor.core.passes import FRICTION_BY_NAME, MAX_SPEED_MPS, PassTable,
 from rail_monitor.core.site import Site, VehicleClass, site_from_values
 from rail_monitor.models.passby import METRIC_DEFINITIONS
 from rail_monitor.noise.config import noise_config
-from rail_monitor.noise.predict import INCREASE_REFERENCE, Corrugation, NoisePrediction, RollingNoiseModel
+from rail_monitor.noise.predict import INCREASE_REFERENCE, RollingNoiseModel
+from rail_monitor.noise.records import Corrugation, NoisePrediction
 
 # What each spectrum of the JSON holds (bands: band_centre_hz).
 SPECTRUM_DEFINITIONS = {
