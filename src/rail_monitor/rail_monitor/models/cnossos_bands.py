@@ -35,6 +35,8 @@ References
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -97,9 +99,11 @@ def at_band_frequencies(level_db: ArrayLike, speed_mps: ArrayLike, band_hz: Arra
     t = tables(edition)
     f = t.band_hz if band_hz is None else np.asarray(band_hz, float)
     speed = np.asarray(speed_mps, float)
-    lv = np.broadcast_to(np.asarray(level_db, float), speed.shape + t.wavelength_m.shape)
     if check_rule(rule, edition) == "reference":
-        return _interp_rows(speed[..., None] / f, t.wavelength_m, lv)
+        if np.ndim(level_db) == 0:  # a constant table reads as itself
+            return np.full(speed.shape + f.shape, float(level_db))
+        return _interp_at(_positions(speed.tobytes(), speed.shape, f.tobytes(), edition), np.asarray(level_db, float))
+    lv = np.broadcast_to(np.asarray(level_db, float), speed.shape + t.wavelength_m.shape)
     # In u = lg f - lg v = -lg(lambda) the grid is one for every pass, ascending in frequency.
     u_grid = -np.log10(NOISEMODELLING_WAVELENGTH_M[::-1])
     u = np.log10(exact_centre(band_index(f))) - np.log10(speed)[..., None]
@@ -117,6 +121,30 @@ def _noisemodelling_fill(out: FloatArray, inside: NDArray[np.bool_]) -> FloatArr
     high = out.shape[-1] - 1 - np.argmax(inside[..., ::-1], axis=-1)[..., None]
     idx = np.where(k < low, np.minimum(low + 1, high), np.minimum(k, high))
     return np.take_along_axis(out, idx, axis=-1)
+
+
+@functools.lru_cache(maxsize=16)
+def _positions(speed: bytes, shape: tuple[int, ...], band_hz: bytes, edition: str) -> tuple[FloatArray, FloatArray]:
+    """Where lambda = v / f_i falls on the edition's wavelength grid: the interval j and the
+    weight w of _interp_rows, per pass and band (cached: every table of a prediction, every model
+    and the baseline are read at the same passes' speeds)."""
+    x = np.frombuffer(speed, float).reshape(shape)[..., None] / np.frombuffer(band_hz, float)
+    xp = tables(edition).wavelength_m
+    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
+    w = np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
+    j.flags.writeable = w.flags.writeable = False  # shared by every caller
+    return j, w
+
+
+def _interp_at(at: tuple[FloatArray, FloatArray], fp: FloatArray) -> FloatArray:
+    """_interp_rows at cached positions: fp one table (n,) or one per pass (..., n)."""
+    j, w = at
+    if fp.ndim == 1:
+        lo, hi = fp[j], fp[j + 1]
+    else:
+        fp = np.broadcast_to(fp, j.shape[:-1] + fp.shape[-1:])
+        lo, hi = np.take_along_axis(fp, j, axis=-1), np.take_along_axis(fp, j + 1, axis=-1)
+    return lo + w * (hi - lo)
 
 
 def _interp_rows(x: FloatArray, xp: FloatArray, fp: FloatArray) -> FloatArray:

@@ -18,7 +18,7 @@ FloatArray = NDArray[np.float64]
 MAX_NEWTON_STEPS = 200  # as models.corrugation._passes_to_level
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _band_log_amplitude(x, out):  # pragma: no cover  (compiled; its twin is the numpy engine)
     for m in range(x.shape[0]):
         top = x[m, 0]
@@ -39,7 +39,7 @@ def band_log_amplitude(log_components: ArrayLike) -> FloatArray:
     return out.reshape(x.shape[:-1])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _excess(x, g, target, n):  # pragma: no cover
     """(ln(band r.m.s.) - ln(level), its slope in n) of one band's components after n passes."""
     top = -np.inf
@@ -54,7 +54,7 @@ def _excess(x, g, target, n):  # pragma: no cover
     return 0.5 * (top + np.log(total)) - target, slope / total
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _passes_to_level(x, g, target, out):  # pragma: no cover
     for m in range(x.shape[0]):
         xm, gm = x[m], g[m]

@@ -29,7 +29,7 @@ FloatArray = NDArray[np.float64]
 _FOUR_PI = 4.0 * np.pi
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _antiderivative(x: float, d: float, r: float, close: bool, at_d: float) -> float:
     """models.passby._antiderivative_with at one x (at_d = atan(x / d) / d, shared by the radii)."""
     at_r = np.arctan(x / r) / r
@@ -37,57 +37,68 @@ def _antiderivative(x: float, d: float, r: float, close: bool, at_d: float) -> f
     return (_OMNI * at_r + _BROADSIDE * broad) / _FOUR_PI
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _peaks(length, speed, dt, decay, before, samples, lo, hi, vehicles, pitch, offsets, weight, d, radii, close,
            use, count, c, out):  # pragma: no cover  (compiled; its twin is the numpy engine)
     n_r, n_m = len(radii), out.shape[0]
     r2 = radii * radii
     broad = _BROADSIDE * d * d
-    s_sum = np.empty(n_r)
-    x = np.empty(n_r)
-    state = np.empty(n_m)
+    longest = samples.max() if len(samples) else 0
+    front = np.empty(longest)
+    x2 = np.empty(longest)
+    directivity = np.empty(longest)
+    x = np.empty((n_r, longest))
     for i in range(len(length)):
-        a = decay[i]
-        b0 = 1.0 - a
-        far = lo[i] > 0 or hi[i] < vehicles[i] - 1
-        for m in range(n_m):
-            out[m, i] = -np.inf
-        for n in range(samples[i]):
-            front = 0.5 * length[i] + speed[i] * ((n - before[i]) * dt[i])
-            for k in range(n_r):
-                s_sum[k] = 0.0
-            for j in range(lo[i], hi[i] + 1):
-                for q in range(offsets.shape[1]):
-                    off = offsets[i, q]
-                    if np.isnan(off):
-                        continue
-                    xa = front - (j * pitch[i] + off)
-                    x2 = xa * xa
-                    directivity = broad / (x2 + d * d) + _OMNI
-                    for k in range(n_r):
-                        s_sum[k] += directivity / (x2 + r2[k])
-            for k in range(n_r):
-                x[k] = weight[i] * s_sum[k]
-            if far:
-                head = front - lo[i] * pitch[i]
-                tail = front - (hi[i] + 1) * pitch[i]
-                rear = front - length[i]
-                f_d, h_d = np.arctan(front / d) / d, np.arctan(head / d) / d
+        n_t = samples[i]
+        for n in range(n_t):
+            front[n] = 0.5 * length[i] + speed[i] * ((n - before[i]) * dt[i])
+        x[:, :n_t] = 0.0
+        # Axle by axle, vehicle by vehicle: each time sample sums its axles in the numpy engine's
+        # order; the loops over samples are the vectorisable ones.
+        for j in range(lo[i], hi[i] + 1):
+            for q in range(offsets.shape[1]):
+                off = offsets[i, q]
+                if np.isnan(off):
+                    continue
+                s = j * pitch[i] + off
+                for n in range(n_t):
+                    xa = front[n] - s
+                    x2[n] = xa * xa
+                    directivity[n] = broad / (x2[n] + d * d) + _OMNI
+                for k in range(n_r):
+                    rk = r2[k]
+                    for n in range(n_t):
+                        x[k, n] += directivity[n] / (x2[n] + rk)
+        for k in range(n_r):
+            for n in range(n_t):
+                x[k, n] = weight[i] * x[k, n]
+        if lo[i] > 0 or hi[i] < vehicles[i] - 1:
+            for n in range(n_t):
+                f = front[n]
+                head = f - lo[i] * pitch[i]
+                tail = f - (hi[i] + 1) * pitch[i]
+                rear = f - length[i]
+                f_d, h_d = np.arctan(f / d) / d, np.arctan(head / d) / d
                 t_d, r_d = np.arctan(tail / d) / d, np.arctan(rear / d) / d
                 for k in range(n_r):
                     r, cl = radii[k], close[k]
-                    x[k] += (_antiderivative(front, d, r, cl, f_d) - _antiderivative(head, d, r, cl, h_d)
-                             + _antiderivative(tail, d, r, cl, t_d) - _antiderivative(rear, d, r, cl, r_d))
-            for m in range(n_m):
+                    x[k, n] += (_antiderivative(f, d, r, cl, f_d) - _antiderivative(head, d, r, cl, h_d)
+                                + _antiderivative(tail, d, r, cl, t_d) - _antiderivative(rear, d, r, cl, r_d))
+        a = decay[i]
+        b0 = 1.0 - a
+        for m in range(n_m):
+            peak = -np.inf
+            state = 0.0
+            for n in range(n_t):
                 total = 0.0
                 for p in range(count[m]):
-                    total += c[m, p, i] * x[use[m, p]]
+                    total += c[m, p, i] * x[use[m, p], n]
                 if n == 0:
-                    state[m] = a * total
-                y = b0 * total + state[m]
-                state[m] = a * y
-                if y > out[m, i]:
-                    out[m, i] = y
+                    state = a * total
+                y = b0 * total + state
+                state = a * y
+                peak = max(peak, y)
+            out[m, i] = peak
 
 
 def f_weighted_peaks(length: FloatArray, speed: FloatArray, dt: FloatArray, decay: FloatArray,
