@@ -14,7 +14,7 @@ from __future__ import annotations
 import bisect
 import os
 from collections import Counter
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -33,7 +33,6 @@ from rail_monitor.core.site import Site, site_from_values
 from rail_monitor.core.timeutil import fits_time_msg, format_iso_ns
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.corrugation.forecast import Threads
 from rail_monitor.corrugation.records import StateSnapshot, Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent, apply_event, in_time_order
 from rail_monitor.measured.config import residual_config
@@ -47,7 +46,8 @@ from rail_monitor.noise.state_of_pass import state_index
 from rail_monitor.squeal.config import squeal_config
 from rail_monitor.squeal.predict import predict as predict_squeal
 
-HISTORY_CHUNK = 50_000  # passes per advance_history call: bounds its (passes x bands x components) arrays
+HISTORY_CHUNK = 16_384  # passes per advance_history call: bounds its (passes x bands x components) arrays,
+#                         and the noise of one chunk is predicted while the next is advanced
 NOISE_CHUNK = 8_192  # passes per noise prediction (every model): bounds its (passes x bands) arrays
 PAIR_BLOCK = 1_000  # passes whose predictions are given to the residual tracker at once (at most half it holds)
 
@@ -212,18 +212,23 @@ class BatchRun:
         accepted = with_class_defaults(table.take(reasons == ""), self.site)
         with ThreadPoolExecutor(max_workers=self.threads) as pool:
             squeal_job = pool.submit(predict_squeal, squeal_config(self.values), self.site, accepted)
-            self.estimator.threads = Threads(pool, self.threads)  # the forecasts' roots on the same threads
-            try:
-                traj = _history(self.estimator, accepted)
-            finally:
-                self.estimator.threads = None
-            if self.observer is not None:
-                self.observer.add_counted(accepted, traj)
-            states = self._tail.then(traj)
-            on = state_index(states.stamp_ns, states.train_id, accepted.stamp_ns, accepted.train_id.tolist())
-            noise = _noise_on_states(pool, self.model, accepted, states.amplitude, traj.constants, on)
+            # The corrugation history in chunks on this thread, each chunk's noise on the pool while
+            # the next is advanced (the estimator carries the kept passes, _Tail the states a later
+            # pass may be predicted on: the chunks give one call's states and predictions).
+            trajs, noise_parts = [], []
+            for lo in range(0, max(len(accepted), 1), HISTORY_CHUNK):
+                part = accepted.take(slice(lo, lo + HISTORY_CHUNK))
+                traj = self.estimator.advance_history(part)
+                if self.observer is not None:
+                    self.observer.add_counted(part, traj)
+                states = self._tail.then(traj)
+                on = state_index(states.stamp_ns, states.train_id, part.stamp_ns, part.train_id.tolist())
+                noise_parts.append(_noise_on_states(pool, self.model, part, states.amplitude, traj.constants, on))
+                self._tail = states.last_stamp()
+                trajs.append((lo, traj))
+            traj = trajs[0][1] if len(trajs) == 1 else Trajectory.concat(trajs)
+            noise = {name: NoisePrediction.concat([part()[name] for part in noise_parts]) for name in self.model.models}
             squeal = squeal_job.result()
-        self._tail = states.last_stamp()
         measured, residuals = self._measured(table, accepted, noise, squeal["risk"])
         self.alerts.on_residuals(residuals)
         events = sorted(self._held + _feed_alerts(self.alerts, table, reasons, accepted, squeal, traj, noise),
@@ -291,30 +296,25 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
                    events=out.events + run.trailing_events, measurements=out.measurements + run.trailing_measurements)
 
 
-def _history(est: CorrugationEstimator, passes: PassTable) -> Trajectory:
-    """est.advance_history in chunks of passes (the estimator carries the kept passes from one to
-    the next, so the states are those of one call), joined."""
-    if len(passes) <= HISTORY_CHUNK:
-        return est.advance_history(passes)
-    return Trajectory.concat([(i, est.advance_history(passes.take(slice(i, i + HISTORY_CHUNK))))
-                              for i in range(0, len(passes), HISTORY_CHUNK)])
-
-
 def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable,
                      amplitude: np.ndarray, constants: StateSnapshot, state_of_pass: np.ndarray
-                     ) -> dict[str, NoisePrediction]:
+                     ) -> Callable[[], dict[str, NoisePrediction]]:
     """Every model's noise of every accepted pass, each on its state (row of amplitude; -1: passes
-    before any state, on none), as tasks of pool."""
+    before any state, on none), submitted as tasks of pool: the call that waits for them."""
     have = state_of_pass >= 0
     state = Corrugation(constants.bands, amplitude[state_of_pass[have]], constants.grinding_amplitude)
     with_state = _noise_chunks(pool, model, accepted.take(have), state)
     without = None if have.all() else _noise_chunks(pool, model, accepted.take(~have))
-    out = {}
-    for name in model.models:
-        joined = NoisePrediction.concat([f.result()[name] for f in with_state])
-        out[name] = joined if without is None else joined.merged(have, NoisePrediction.concat(
-            [f.result()[name] for f in without]))
-    return out
+
+    def result() -> dict[str, NoisePrediction]:
+        out = {}
+        for name in model.models:
+            joined = NoisePrediction.concat([f.result()[name] for f in with_state])
+            out[name] = joined if without is None else joined.merged(have, NoisePrediction.concat(
+                [f.result()[name] for f in without]))
+        return out
+
+    return result
 
 
 def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable,

@@ -159,11 +159,12 @@ class CorrugationEstimator:
         with np.errstate(divide="ignore", invalid="ignore"):
             rate = np.where((span_days > 0) & (span_days >= self.cfg.min_traffic_days),
                             (end - start - 1) / span_days, np.nan)
-        fc = self._forecasts(steps, growth, rate, axles / (end - start), new.stamp_ns)
+        log_amplitude = fcst.band_kernels(self.engine).band_log_amplitude(steps)
+        fc = self._forecasts(steps, growth, rate, axles / (end - start), new.stamp_ns, log_amplitude)
         ordinal = np.arange(1, m + 1)
         return Trajectory(
             index=np.flatnonzero(counted), stamp_ns=new.stamp_ns.copy(), train_id=new.train_id.copy(),
-            amplitude=np.exp(fcst.band_kernels(self.engine).band_log_amplitude(steps)), pass_count=before.pass_count + ordinal,
+            amplitude=np.exp(log_amplitude), pass_count=before.pass_count + ordinal,
             axle_pass_count=before.axle_pass_count + np.cumsum(new.axle_count),
             total_pass_count=before.total_pass_count + ordinal, forecast=fc, constants=before)
 
@@ -282,6 +283,7 @@ class CorrugationEstimator:
                                            np.array([self.newest_ns])))
 
     def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
-                   newest_ns: np.ndarray) -> Forecast:
+                   newest_ns: np.ndarray, log_amplitude: np.ndarray | None = None) -> Forecast:
         return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
-                              self.cfg.lead_time_days, self.site.mean_axles_per_train, self.threads, self.engine)
+                              self.cfg.lead_time_days, self.site.mean_axles_per_train, self.threads, self.engine,
+                              log_amplitude)

@@ -36,17 +36,21 @@ class Threads(NamedTuple):
 
 def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
               newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
-              fallback_axles: float, threads: Threads | None = None, engine: str = "numpy") -> Forecast:
+              fallback_axles: float, threads: Threads | None = None, engine: str = "numpy",
+              log_amplitude: np.ndarray | None = None) -> Forecast:
     """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
     day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
     band thresholds (B,) [m]; a Forecast of arrays (grinding_due_ns 0: no date, the forecast
     being infinite or beyond MAX_DATED_DAYS). threads: to split the states' root finding over
     (each band's root is found on its own, so the split changes no bit). engine: of the per-band
-    reductions (numpy, or numba: models.corrugation_jit)."""
+    reductions (numpy, or numba: models.corrugation_jit); log_amplitude: ln of each band's r.m.s.
+    (N, B) when the caller has it."""
     kernels = band_kernels(engine)
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
     log_threshold = np.log(threshold)
-    margin = log_threshold - kernels.band_log_amplitude(log_components)
+    if log_amplitude is None:
+        log_amplitude = kernels.band_log_amplitude(log_components)
+    margin = log_threshold - log_amplitude
     axle_passes = _passes_to_level_split(kernels, log_components, growth, log_threshold, threads)
     rows = np.arange(len(rate))
     worst = np.where(np.isfinite(axle_passes).any(axis=1), np.argmin(axle_passes, axis=1),

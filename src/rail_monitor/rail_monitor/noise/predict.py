@@ -187,7 +187,8 @@ class RollingNoiseModel:
                 growth = pb.lpaeq_tp_dba - self._levels({c: power(lw) for c, lw in ground.items()}, geometry)
             out[model] = NoisePrediction(
                 model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
-                lp_db=pb.lp_db, lw_db=level(sum(components.values())), roughness_db=roughness, pass_by_time_s=pb.pass_by_time_s,
+                lp_db=pb.lp_db, lw_db=level(sum(components.values())), roughness_db=roughness,
+                pass_by_time_s=pb.pass_by_time_s,
                 lpaeq_tp_dba=pb.lpaeq_tp_dba, lpafmax_dba=pb.lpafmax_dba, tel_dba=pb.tel_dba,
                 component_lpaeq_dba=np.stack([self._levels({c: components[c]}, geometry) for c in names], axis=-1),
                 roughness_growth_increase_db=growth)
