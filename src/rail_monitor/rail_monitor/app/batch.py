@@ -227,7 +227,8 @@ class BatchRun:
                 self._tail = states.last_stamp()
                 trajs.append((lo, traj))
             traj = trajs[0][1] if len(trajs) == 1 else Trajectory.concat(trajs)
-            noise = {name: NoisePrediction.concat([part()[name] for part in noise_parts]) for name in self.model.models}
+            chunks = [chunk for part in noise_parts for chunk in part()]
+            noise = {name: NoisePrediction.concat([c[name] for c in chunks]) for name in self.model.models}
             squeal = squeal_job.result()
         measured, residuals = self._measured(table, accepted, noise, squeal["risk"])
         self.alerts.on_residuals(residuals)
@@ -298,21 +299,20 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
 
 def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable,
                      amplitude: np.ndarray, constants: StateSnapshot, state_of_pass: np.ndarray
-                     ) -> Callable[[], dict[str, NoisePrediction]]:
+                     ) -> Callable[[], list[dict[str, NoisePrediction]]]:
     """Every model's noise of every accepted pass, each on its state (row of amplitude; -1: passes
-    before any state, on none), submitted as tasks of pool: the call that waits for them."""
+    before any state, on none), submitted as tasks of pool: the call that waits for them and gives
+    the predictions of consecutive runs of the passes, in order."""
     have = state_of_pass >= 0
     state = Corrugation(constants.bands, amplitude[state_of_pass[have]], constants.grinding_amplitude)
     with_state = _noise_chunks(pool, model, accepted.take(have), state)
     without = None if have.all() else _noise_chunks(pool, model, accepted.take(~have))
 
-    def result() -> dict[str, NoisePrediction]:
-        out = {}
-        for name in model.models:
-            joined = NoisePrediction.concat([f.result()[name] for f in with_state])
-            out[name] = joined if without is None else joined.merged(have, NoisePrediction.concat(
-                [f.result()[name] for f in without]))
-        return out
+    def result() -> list[dict[str, NoisePrediction]]:
+        if without is None:
+            return [f.result() for f in with_state]
+        return [{name: NoisePrediction.concat([f.result()[name] for f in with_state]).merged(
+            have, NoisePrediction.concat([f.result()[name] for f in without])) for name in model.models}]
 
     return result
 
