@@ -178,3 +178,12 @@ def test_a_pass_gets_the_same_peak_alone_as_in_a_batch_with_either_engine():
             alone = passby_axles.f_weighted_peak([(c[i:i + 1], r) for c, r in paths], one, length[i:i + 1],
                                                  speed[i:i + 1], D, engine)
             assert alone[0] == batch[i], engine
+
+
+def test_the_compiled_window_kernel_gives_the_numpy_engines():
+    # LpAeq,Tp's exact sum over every axle: equal but for the arctangent's last bit.
+    layout, length, _, _ = _mixed_trains(200, 4)
+    want = passby_axles.window_kernels(layout, length, D, [R1, R2], "numpy")
+    got = passby_axles.window_kernels(layout, length, D, [R1, R2], "numba")
+    np.testing.assert_allclose(got, want, rtol=1e-13, atol=0.0)
+    np.testing.assert_array_equal(want[1], passby_axles.window_kernel(layout, length, D, R2))

@@ -190,9 +190,10 @@ class PassGeometry:
 
 
 def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, receiver: Receiver,
-                  axles: AxleLayout | None = None) -> PassGeometry:
+                  axles: AxleLayout | None = None, engine: str = "numpy") -> PassGeometry:
     """The PassGeometry of passes of these lengths [m] and speeds [m/s] (IEC 61260-1 band numbers):
-    a moving point source per axle of the layout, or without one the uniform line source."""
+    a moving point source per axle of the layout (its kernels by engine, models.passby_axles), or
+    without one the uniform line source."""
     from rail_monitor.models import passby_axles
 
     length = np.atleast_1d(np.asarray(length_m, float))
@@ -201,7 +202,7 @@ def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, re
     if axles is None:
         k1, k2 = kernel_window_mean(length, d, r1), kernel_window_mean(length, d, r2)
     else:
-        k1, k2 = passby_axles.window_kernel(axles, length, d, r1), passby_axles.window_kernel(axles, length, d, r2)
+        k1, k2 = passby_axles.window_kernels(axles, length, d, [r1, r2], engine)
     return PassGeometry(length, np.atleast_1d(np.asarray(speed_mps, float)), d, r1, r2, k1[:, None], k2[:, None],
                         kernel_total(d, r1), kernel_total(d, r2), power(a_weighted(0.0, band)),
                         receiver.image_weight(band), axles)

@@ -133,19 +133,33 @@ def _sum_over_axles(layout: AxleLayout, first: NDArray[np.int64], count: NDArray
     return np.zeros(len(count)) if total is None else total
 
 
-def window_kernel(layout: AxleLayout, length_m: ArrayLike, d: float, r: float) -> FloatArray:
+def window_kernel(layout: AxleLayout, length_m: ArrayLike, d: float, r: float, engine: str = "numpy") -> FloatArray:
     """Mean over the pass-by time of the kernel of the axles [1/m] (passes,): exact, every axle."""
+    return window_kernels(layout, length_m, d, [r], engine)[0]
+
+
+def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Sequence[float],
+                   engine: str = "numpy") -> FloatArray:
+    """window_kernel for each path distance R [m] (radii x passes); engine as f_weighted_peaks's."""
     length = np.atleast_1d(np.asarray(length_m, float))
-    out = np.empty(len(length))
+    if engine == "numba":
+        from rail_monitor.models.passby_axles_jit import window_sums
+
+        both = window_sums(layout, length, d, list(radii))
+        return (layout.pitch_m / layout.axles_per_vehicle) * both / length
+    if engine != "numpy":
+        raise ValueError(f"unknown engine {engine!r}: numpy or numba")
+    out = np.empty((len(radii), len(length)))
     order = np.argsort(layout.vehicles, kind="stable")   # blocks alike in vehicles: few idle columns
     for lo in range(0, len(length), PASS_CHUNK):
         part = order[lo:lo + PASS_CHUNK]
         sub = _take(layout, part)
         ell = length[part, None]
-        both = _sum_over_axles(sub, np.zeros(len(part), np.int64), sub.vehicles,
-                               lambda s, ell=ell: kernel_antiderivative(ell - s, d, r) + kernel_antiderivative(s, d, r),
-                               max(1, HISTORY_ELEMENTS // len(part)))
-        out[part] = (sub.pitch_m / sub.axles_per_vehicle) * both / length[part]
+        for k, r in enumerate(radii):
+            both = _sum_over_axles(sub, np.zeros(len(part), np.int64), sub.vehicles,
+                                   lambda s, ell=ell, r=r: kernel_antiderivative(ell - s, d, r)
+                                   + kernel_antiderivative(s, d, r), max(1, HISTORY_ELEMENTS // len(part)))
+            out[k, part] = (sub.pitch_m / sub.axles_per_vehicle) * both / length[part]
     return out
 
 

@@ -101,6 +101,33 @@ def _peaks(length, speed, dt, decay, before, samples, lo, hi, vehicles, pitch, o
             out[m, i] = peak
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _window_sums(length, vehicles, pitch, offsets, d, radii, close, out):  # pragma: no cover
+    for i in range(len(length)):
+        for k in range(len(radii)):
+            out[k, i] = 0.0
+        for j in range(vehicles[i]):
+            for q in range(offsets.shape[1]):
+                off = offsets[i, q]
+                if np.isnan(off):
+                    continue
+                s = j * pitch[i] + off
+                a = length[i] - s
+                a_d, s_d = np.arctan(a / d) / d, np.arctan(s / d) / d
+                for k in range(len(radii)):
+                    r, cl = radii[k], close[k]
+                    out[k, i] += _antiderivative(a, d, r, cl, a_d) + _antiderivative(s, d, r, cl, s_d)
+
+
+def window_sums(layout: AxleLayout, length: FloatArray, d: float, radii: list[float]) -> FloatArray:
+    """models.passby_axles.window_kernel's sum over every axle of G(L - s) + G(s), compiled, per
+    path distance (radii x passes)."""
+    out = np.empty((len(radii), len(length)))
+    _window_sums(length, layout.vehicles, layout.pitch_m, np.ascontiguousarray(layout.offsets_m), float(d),
+                 np.asarray(radii, float), np.array([_close(d, rk) for rk in radii]), out)
+    return out
+
+
 def f_weighted_peaks(length: FloatArray, speed: FloatArray, dt: FloatArray, decay: FloatArray,
                      before: NDArray[np.int64], samples: NDArray[np.int64], lo: NDArray[np.int64],
                      hi: NDArray[np.int64], layout: AxleLayout, weight: FloatArray, d: float, radii: list[float],

@@ -268,10 +268,11 @@ class RollingNoiseModel:
     def _geometries(self, passes: PassTable, models: Sequence[str]) -> tuple[PassGeometry, PassGeometry | None]:
         """The pass geometry of source A, and of source B (4 m) where a model has components there."""
         axles = self._axles(passes) if self.cfg.pass_by_sources == "axles" else None
-        low = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver, axles)
+        low = pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver, axles, self.engine)
         if not {c for m in models for c in self.component_names(m)} & set(SOURCE_B_COMPONENTS):
             return low, None
-        return low, pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver_b, axles)
+        return low, pass_geometry(self.band, passes.train_length_m, passes.speed_mps, self.receiver_b, axles,
+                                  self.engine)
 
     def _paths(self, components: dict[str, np.ndarray],
                geometries: tuple[PassGeometry, PassGeometry | None]) -> BandPaths:
