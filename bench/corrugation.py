@@ -104,7 +104,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "state.npz"
         t_s = best_of(lambda: checkpoint.save(est, path), 5)
-        t_l = best_of(lambda: CorrugationEstimator(site, cfg, tables).load(path), 5)
+        t_l = best_of(lambda: checkpoint.load(CorrugationEstimator(site, cfg, tables), path), 5)
         print(f"checkpoint write (fsync) / read:            {t_s * 1e3:10.2f} / {t_l * 1e3:.2f} ms "
               f"({path.stat().st_size / 1e3:.0f} kB)")
 

@@ -71,11 +71,25 @@ def band_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: A
             rough = rough + power(impact_db)
         return at_band_frequencies(level(rough) + np.asarray(contact_filter_db, float), speed_mps, band_hz, rule)
 
-    def at(table: ArrayLike) -> FloatArray:
-        return at_band_frequencies(table, speed_mps, band_hz, rule, edition)
+    return level(band_roughness_power(rail_db, wheel_db, contact_filter_db, speed_mps, band_hz, rule, impact_db,
+                                      edition))
 
-    total = level(power(at(rail_db)) + power(at(wheel_db))) + at(contact_filter_db)
-    return total if impact_db is None else level(power(total) + power(at(impact_db)))
+
+def band_roughness_power(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike,
+                         speed_mps: ArrayLike, band_hz: ArrayLike | None = None, rule: str = "reference",
+                         impact_db: ArrayLike | None = None, edition: str = DEFAULT_EDITION) -> FloatArray:
+    """band_roughness as a power ratio re (1 um)^2, summed in energy without a round trip through
+    decibels (the ``reference`` rule; the ``noisemodelling`` rule's is 10^(L/10) of its level)."""
+    if check_rule(rule, edition) == "noisemodelling":
+        return power(band_roughness(rail_db, wheel_db, contact_filter_db, speed_mps, band_hz, rule, impact_db,
+                                    edition))
+
+    def at(table: ArrayLike) -> FloatArray:
+        return power(at_band_frequencies(table, speed_mps, band_hz, rule, edition))
+
+    filtered = (at(rail_db) + at(wheel_db)) * (power(contact_filter_db) if np.ndim(contact_filter_db) == 0
+                                               else at(contact_filter_db))
+    return filtered if impact_db is None else filtered + at(impact_db)
 
 
 def contact_filter_at_patch(filter_db: ArrayLike, speed_mps: ArrayLike, table_patch_m: float,

@@ -43,6 +43,7 @@ from rail_monitor.models.passby import (
     a_weighted_paths,
     f_weighted_peaks,
     pass_by_levels,
+    pass_by_lpaeq,
     pass_geometry,
     power_paths,
 )
@@ -176,7 +177,6 @@ class RollingNoiseModel:
         for model in models:
             filter_db = self._filter_db(passes, model)
             roughness, components = self._sources(rail, passes, model, filter_db)
-            components = {c: power(lw) for c, lw in components.items()}  # energy from here on
             lines = self._paths(components, geometry)
             pb = pass_by_levels(geometry[0], lines)
             paths.append(a_weighted_paths(geometry[0], lines))
@@ -184,7 +184,7 @@ class RollingNoiseModel:
             growth = np.zeros(len(passes))
             if corrugation is not None:
                 _, ground = self._sources(self.baseline_db, passes, model, filter_db)
-                growth = pb.lpaeq_tp_dba - self._levels({c: power(lw) for c, lw in ground.items()}, geometry)
+                growth = pb.lpaeq_tp_dba - self._levels(ground, geometry)
             out[model] = NoisePrediction(
                 model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
                 lp_db=pb.lp_db, lw_db=level(sum(components.values())), roughness_db=roughness,
@@ -202,8 +202,8 @@ class RollingNoiseModel:
         Directive's L_W,0 of eqs. 2.3.7-2.3.9 and 2.3.14, to compare with another implementation."""
         _, components = self._sources(self.rail_roughness_db(corrugation), passes, model,
                                       self._filter_db(passes, model))
-        per_vehicle = 10.0 * np.log10(passes.train_length_m / passes.vehicle_count)[:, None]
-        return {c: lw + per_vehicle for c, lw in components.items()}
+        per_vehicle = (passes.train_length_m / passes.vehicle_count)[:, None]
+        return {c: level(w * per_vehicle) for c, w in components.items()}
 
     def _axles(self, passes: PassTable) -> AxleLayout:
         """The axles of each pass's train (a point source each): its counts and length, the class's
@@ -233,37 +233,37 @@ class RollingNoiseModel:
     def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str,
                  filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness [dB re 1 um] and sound power per metre of train per component
-        [dB re 1 pW/m] (passes x bands) on a rail roughness spectrum. filter_db: the mechanics
-        model's contact filter level per pass (passes x bands; None for CNOSSOS)."""
+        (power ratio re 1 pW/m) (passes x bands) on a rail roughness spectrum. filter_db: the
+        mechanics model's contact filter level per pass (passes x bands; None for CNOSSOS)."""
         n, nb = len(passes), len(self.band)
-        per_metre = 10.0 * np.log10(passes.axle_count / passes.train_length_m)[:, None]
+        per_metre = (passes.axle_count / passes.train_length_m)[:, None]
         roughness = np.empty((n, nb))
         # Every component of the model, even with no passes (an empty history gives empty arrays);
-        # one a class lacks stays -inf on its passes (NoisePrediction.components).
-        components = {c: np.full((n, nb), -np.inf) for c in self.component_names(model)}
+        # one a class lacks stays 0 (-inf dB) on its passes (NoisePrediction.components).
+        components = {c: np.zeros((n, nb)) for c in self.component_names(model)}
         for name, rows in _class_rows(passes):
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
-            lr, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
-                                            None if filter_db is None else filter_db[rows])
-            roughness[rows] = lr
+            energy, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
+                                                None if filter_db is None else filter_db[rows])
+            roughness[rows] = level(energy)
             for comp, lh in transfers.items():
-                components[comp][rows] = lr + lh + per_metre[rows]
+                components[comp][rows] = energy * power(lh) * per_metre[rows]
             if model == "cnossos":
                 self._vehicle_sources(components, rows, self.classes[name], passes)
         return roughness, components
 
     def _vehicle_sources(self, components: dict[str, np.ndarray], rows: np.ndarray, terms: ClassTerms,
                          passes: PassTable) -> None:
-        """CNOSSOS-EU's traction and aerodynamic power per metre of train [dB re 1 pW/m] on the rows
-        of one class: L_W,0 per vehicle + 10 lg(vehicles / train length)."""
-        per_metre = 10.0 * np.log10(passes.vehicle_count[rows] / passes.train_length_m[rows])[:, None]
+        """CNOSSOS-EU's traction and aerodynamic power per metre of train (power ratio re 1 pW/m)
+        on the rows of one class: L_W,0 per vehicle times vehicles / train length."""
+        per_metre = (passes.vehicle_count[rows] / passes.train_length_m[rows])[:, None]
         for comp, lw0 in terms.traction.items():
-            components[comp][rows] = lw0 + per_metre
+            components[comp][rows] = power(lw0) * per_metre
         if self.cfg.aerodynamic:
             speed_kmh = passes.speed_mps[rows] * KMH_PER_MPS
             for src in cn.SOURCE_HEIGHTS:
                 components[source_component("aerodynamic", src)][rows] = \
-                    cn.aerodynamic_sound_power(speed_kmh, src, self.tables) + per_metre
+                    power(cn.aerodynamic_sound_power(speed_kmh, src, self.tables)) * per_metre
 
     def _geometries(self, passes: PassTable, models: Sequence[str]) -> tuple[PassGeometry, PassGeometry | None]:
         """The pass geometry of source A, and of source B (4 m) where a model has components there."""
@@ -288,21 +288,23 @@ class RollingNoiseModel:
     def _levels(self, components: dict[str, np.ndarray],
                 geometries: tuple[PassGeometry, PassGeometry | None]) -> np.ndarray:
         """LpAeq,Tp of the components (power ratios) alone [dB(A)] (passes,)."""
-        return pass_by_levels(geometries[0], self._paths(components, geometries)).lpaeq_tp_dba
+        return pass_by_lpaeq(geometries[0], self._paths(components, geometries))
 
     def _roughness(self, rail_db: np.ndarray, terms: ClassTerms, speed: np.ndarray, model: str,
                    filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-        """Effective roughness at the band frequencies [dB re 1 um] (passes x bands) and the transfers."""
+        """Effective roughness at the band frequencies as a power ratio re (1 um)^2 (passes x
+        bands) and the transfers [dB]."""
         rule = self.cfg.interpolation
         if model == "cnossos":
-            return cb.band_roughness(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
-                                     self.impact_db, self.edition), terms.cnossos
+            return cb.band_roughness_power(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
+                                           self.impact_db, self.edition), terms.cnossos
         if self.cfg.contact_filter == "cnossos":  # each table read on its own, as CNOSSOS-EU's total
-            both = cb.band_roughness(rail_db, terms.wheel_db, 0.0, speed, self.band_hz, rule, None, self.edition)
-            return both + filter_db, terms.mechanics
+            both = cb.band_roughness_power(rail_db, terms.wheel_db, 0.0, speed, self.band_hz, rule, None,
+                                           self.edition)
+            return both * power(filter_db), terms.mechanics
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
-        return lr, terms.mechanics
+        return power(lr), terms.mechanics
 
 
 def _class_rows(passes: PassTable) -> Iterator[tuple[str, np.ndarray]]:
