@@ -69,12 +69,14 @@ def graph_rows(source: str, site: str, keep: Path) -> list[Row]:
     ]
 
 
-def batch_rows(values: dict, sizes: list[int]) -> list[Row]:
+def batch_rows(values: dict, site: str, sizes: list[int]) -> list[Row]:
     rows: list[Row] = [("batch set-up (site tables, once per process)", f"{bb.set_up_s(values):.2f} s", "")]
     for size in sizes:
         n, t, _ = bb.timed(values, size)
         rows.append((f"batch, {n:,} simulated passes", rate(n, t),
                      f"{t:.1f} s; peak RSS so far {bb.peak_rss_mb():,.0f} MB"))
+    n, t = bb.on_cores_in_subprocess(site, sizes[1], 1)
+    rows.append((f"batch, {n:,} simulated passes, one core", rate(n, t), f"{t:.1f} s; a process held to one CPU"))
     return rows
 
 
@@ -192,7 +194,7 @@ def main() -> None:
                                                                      else [1.0, 100.0], 2.0 if ns.quick else 10.0,
                                                                      2.0 if ns.quick else 10.0)))
         eq = bb.live_equality(str(live_bag), values)
-        sections.append(("batch", [*batch_rows(values, sizes), (
+        sections.append(("batch", [*batch_rows(values, ns.site, sizes), (
             "batch against the live graph (same passes)", f"{eq['corrugation_rel']:.1e}",
             f"largest relative difference of corrugation; levels {max(eq['noise_db'], eq['squeal_db']):.1e} dB; "
             f"state count {eq['states']:+.0f}, alert count {eq['alerts']:+.0f}")]))

@@ -51,10 +51,10 @@ def set_up_s(values: Mapping[str, Any]) -> float:
     return time.perf_counter() - t
 
 
-def timed(values: Mapping[str, Any], passes: int) -> tuple[int, float, BatchResult]:
+def timed(values: Mapping[str, Any], passes: int, threads: int = 0) -> tuple[int, float, BatchResult]:
     table = busy_history(values, passes)
     t = time.perf_counter()
-    r = run_models(table, values)
+    r = run_models(table, values, threads=threads)
     return len(table), time.perf_counter() - t, r
 
 
@@ -105,24 +105,38 @@ def streamed_in_subprocess(site: str, passes: int) -> tuple[int, float, float]:
     return int(n), float(t), float(mb)
 
 
+def on_cores_in_subprocess(site: str, passes: int, cores: int) -> tuple[int, float]:
+    """timed() in a fresh interpreter held to the first ``cores`` of this process's CPUs, with as
+    many threads: (passes, seconds)."""
+    done = subprocess.run([sys.executable, "-m", "bench.batch", "--site", site, "--sizes", str(passes), "--cores",
+                           str(cores)], capture_output=True, text=True, check=True)
+    line = done.stdout.strip().splitlines()[-1].split()
+    return int(line[0].replace(",", "")), float(line[2])
+
+
 def main() -> None:
     import argparse
+    import os
 
     from rail_monitor.site_file import load_parameter_file
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
     ap.add_argument("--sizes", default="1e4,1e5,1e6")
+    ap.add_argument("--cores", type=int, default=0, help="hold the process to this many CPUs and use as many "
+                    "threads (default: every CPU)")
     ap.add_argument("--streamed", type=float, help="only the streamed run of this many passes; prints passes, "
                     "seconds and peak RSS [MB]")
     ns = ap.parse_args()
     values = load_parameter_file(ns.site)
+    if ns.cores:
+        os.sched_setaffinity(0, sorted(os.sched_getaffinity(0))[:ns.cores])
     if ns.streamed:
         print(*streamed(values, int(ns.streamed)))
         return
     print(f"set-up (site tables, once per process): {set_up_s(values):.2f} s")
     for size in (int(float(x)) for x in ns.sizes.split(",")):
-        n, t, _ = timed(values, size)
+        n, t, _ = timed(values, size, ns.cores)
         print(f"{n:>9,} passes: {t:8.2f} s = {n / t:9.0f} passes/s (peak RSS so far {peak_rss_mb():.0f} MB)")
 
 

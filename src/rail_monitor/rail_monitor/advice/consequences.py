@@ -48,8 +48,8 @@ class Consequences:
         for j, name in enumerate(classes):
             cls = self.site.vehicle(name)
             table = synthetic_passes(self.site, cls, np.asarray(speeds, float), round(cls.mean_vehicles))
-            for i, model in enumerate(self.noise.models):
-                out[i, j] = getattr(self.noise.predict(table, model, corrugation), NOISE_METRIC)
+            for i, p in enumerate(self.noise.predict_models(table, (), corrugation).values()):
+                out[i, j] = getattr(p, NOISE_METRIC)
         return out
 
     def squeal_share(self, kept: KeptPasses, name: str, class_idx: int, speeds: np.ndarray | None) -> np.ndarray:
