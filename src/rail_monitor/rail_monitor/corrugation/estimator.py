@@ -64,7 +64,6 @@ class CorrugationEstimator:
         self.level_var = self.post_grinding_var.copy()
         self.kept = KeptPasses()
         self.season = DailyGrowth(self.log_components.shape)  # the last year day by day (forecast interval)
-        self.threads: fcst.Threads | None = None  # threads a history's forecasts may use (batch: its pool)
         self.engine = "numpy"  # of a history's per-band reductions (batch: numba, forecast.band_kernels)
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
         # (B, P). A window's growth is a difference of two, so it is the same however the passes
@@ -285,5 +284,5 @@ class CorrugationEstimator:
     def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
                    newest_ns: np.ndarray, log_amplitude: np.ndarray | None = None) -> Forecast:
         return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
-                              self.cfg.lead_time_days, self.site.mean_axles_per_train, self.threads, self.engine,
-                              log_amplitude)
+                              self.cfg.lead_time_days, self.site.mean_axles_per_train, engine=self.engine,
+                              log_amplitude=log_amplitude)

@@ -18,6 +18,7 @@ from rail_monitor.corrugation.history import KeptPasses
 from rail_monitor.corrugation.records import Forecast, ForecastInterval
 from rail_monitor.models import calibration
 from rail_monitor.models import corrugation as cg
+from rail_monitor.models.engine import check_engine
 
 # Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
 # passes nearly balancing the others) can be 1e12 days away, past any 64-bit time stamp.
@@ -67,12 +68,10 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
 
 def band_kernels(engine: str) -> ModuleType:
     """The module of the per-band reductions (band_log_amplitude, passes_to_band_level) of an engine."""
-    if engine == "numba":
+    if check_engine(engine) == "numba":
         from rail_monitor.models import corrugation_jit
 
         return corrugation_jit
-    if engine != "numpy":
-        raise ValueError(f"unknown engine {engine!r}: numpy or numba")
     return cg
 
 

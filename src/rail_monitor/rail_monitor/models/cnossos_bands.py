@@ -139,19 +139,23 @@ def _noisemodelling_fill(out: FloatArray, inside: NDArray[np.bool_]) -> FloatArr
 
 @functools.lru_cache(maxsize=16)
 def _positions(speed: bytes, shape: tuple[int, ...], band_hz: bytes, edition: str) -> tuple[FloatArray, FloatArray]:
-    """Where lambda = v / f_i falls on the edition's wavelength grid: the interval j and the
-    weight w of _interp_rows, per pass and band (cached: every table of a prediction, every model
-    and the baseline are read at the same passes' speeds)."""
+    """_grid_positions of lambda = v / f_i on the edition's wavelength grid, per pass and band
+    (cached: every table of a prediction, every model and the baseline are read at the same
+    passes' speeds)."""
     x = np.frombuffer(speed, float).reshape(shape)[..., None] / np.frombuffer(band_hz, float)
-    xp = tables(edition).wavelength_m
-    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
-    w = np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
+    j, w = _grid_positions(x, tables(edition).wavelength_m)
     j.flags.writeable = w.flags.writeable = False  # shared by every caller
     return j, w
 
 
-def _interp_at(at: tuple[FloatArray, FloatArray], fp: FloatArray) -> FloatArray:
-    """_interp_rows at cached positions: fp one table (n,) or one per pass (..., n)."""
+def _grid_positions(x: FloatArray, xp: FloatArray) -> tuple[NDArray[np.int64], FloatArray]:
+    """Where x falls on one ascending grid xp: the interval j and the weight w in it, ends held."""
+    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
+    return j, np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
+
+
+def _interp_at(at: tuple[NDArray[np.int64], FloatArray], fp: FloatArray) -> FloatArray:
+    """Linear interpolation at grid positions (j, w): fp one table (n,) or one per row (..., n)."""
     j, w = at
     if fp.ndim == 1:
         lo, hi = fp[j], fp[j + 1]
@@ -163,8 +167,4 @@ def _interp_at(at: tuple[FloatArray, FloatArray], fp: FloatArray) -> FloatArray:
 
 def _interp_rows(x: FloatArray, xp: FloatArray, fp: FloatArray) -> FloatArray:
     """np.interp per row: x (..., m), fp (..., n) on one ascending xp (n,); ends held."""
-    j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 2)
-    w = np.clip((x - xp[j]) / (xp[j + 1] - xp[j]), 0.0, 1.0)
-    lo = np.take_along_axis(fp, j, axis=-1)
-    hi = np.take_along_axis(fp, j + 1, axis=-1)
-    return lo + w * (hi - lo)
+    return _interp_at(_grid_positions(x, xp), fp)

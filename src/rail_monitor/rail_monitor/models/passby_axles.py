@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rail_monitor.models.engine import check_engine
 from rail_monitor.models.passby import (
     _BROADSIDE,
     _OMNI,
@@ -72,6 +73,11 @@ class AxleLayout:
     @property
     def axles_per_vehicle(self) -> FloatArray:
         return np.sum(np.isfinite(self.offsets_m), axis=1).astype(float)
+
+    @property
+    def length_per_axle_m(self) -> FloatArray:
+        """P / k: the length of train whose power each axle radiates [m] (passes,)."""
+        return self.pitch_m / self.axles_per_vehicle
 
 
 def axle_layout(length_m: ArrayLike, vehicle_count: ArrayLike, axle_count: ArrayLike, bogie_centre_ratio: ArrayLike,
@@ -142,13 +148,10 @@ def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Seq
                    engine: str = "numpy") -> FloatArray:
     """window_kernel for each path distance R [m] (radii x passes); engine as f_weighted_peaks's."""
     length = np.atleast_1d(np.asarray(length_m, float))
-    if engine == "numba":
+    if check_engine(engine) == "numba":
         from rail_monitor.models.passby_axles_jit import window_sums
 
-        both = window_sums(layout, length, d, list(radii))
-        return (layout.pitch_m / layout.axles_per_vehicle) * both / length
-    if engine != "numpy":
-        raise ValueError(f"unknown engine {engine!r}: numpy or numba")
+        return layout.length_per_axle_m * window_sums(layout, length, d, list(radii)) / length
     out = np.empty((len(radii), len(length)))
     order = np.argsort(layout.vehicles, kind="stable")   # blocks alike in vehicles: few idle columns
     for lo in range(0, len(length), PASS_CHUNK):
@@ -159,7 +162,7 @@ def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Seq
             both = _sum_over_axles(sub, np.zeros(len(part), np.int64), sub.vehicles,
                                    lambda s, ell=ell, r=r: kernel_antiderivative(ell - s, d, r)
                                    + kernel_antiderivative(s, d, r), max(1, HISTORY_ELEMENTS // len(part)))
-            out[k, part] = (sub.pitch_m / sub.axles_per_vehicle) * both / length[part]
+            out[k, part] = sub.length_per_axle_m * both / length[part]
     return out
 
 
@@ -199,13 +202,11 @@ def f_weighted_peaks(paths_of: Sequence[Paths], layout: AxleLayout, length_m: Ar
     lo = np.maximum(middle - half, 0)
     hi = np.minimum(middle + half, layout.vehicles - 1)
     decay = np.exp(-dt / tau)
-    weight = (layout.pitch_m / layout.axles_per_vehicle) / (4.0 * np.pi)
-    if engine == "numba":
+    weight = layout.length_per_axle_m / (4.0 * np.pi)
+    if check_engine(engine) == "numba":
         from rail_monitor.models.passby_axles_jit import f_weighted_peaks as compiled
 
         return compiled(length, speed, dt, decay, before, samples, lo, hi, layout, weight, d, radii, use, c)
-    if engine != "numpy":
-        raise ValueError(f"unknown engine {engine!r}: numpy or numba")
     out = np.empty((len(paths_of), len(length)))
     order = np.lexsort((hi - lo, samples))   # blocks of passes alike, so that little of a block is idle
     start = 0
