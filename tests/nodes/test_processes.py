@@ -190,11 +190,19 @@ def test_a_signal_mid_replay_stops_the_source_and_the_graph_cleanly(tmp_path):
     for argv, sig, bag in cases:
         p = subprocess.Popen([_exe(argv[0]), *argv[1:]], cwd=TOP, text=True, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE)
-        time.sleep(6.0)  # past the set-up; the replay at 1e5 x pass time takes 77 s
+        lines: list[str] = []
+        reader = threading.Thread(target=lines.extend, args=(p.stderr,), daemon=True)
+        reader.start()
+        # Past the set-up (its site tables may be built cold: seconds), then 1 s into the replay,
+        # which at 1e5 x pass time takes 77 s.
+        assert wait_until(lambda seen=lines: any("[pass_replayer]: started:" in line for line in seen), 60), lines
+        time.sleep(1.0)
         assert p.poll() is None, f"{argv[0]} ended before the signal"
         p.send_signal(sig)
         t0 = time.monotonic()
-        _, err = p.communicate(timeout=30)
+        p.wait(timeout=30)
+        reader.join(timeout=10)
+        err = "".join(lines)
         assert time.monotonic() - t0 < 5.0 and p.returncode == 0 and "Traceback" not in err, (argv[0], err[-1500:])
         if bag is not None:
             assert 0 < len(read_bag_passes(bag)) < 8638
@@ -249,3 +257,45 @@ def test_the_executables_executor_answers_at_once_when_idle_and_takes_a_burst_in
     finally:
         ex.shutdown()
         node.destroy_node()
+
+
+STUCK_TEARDOWN = """
+import sys, time
+from pathlib import Path
+from rclpy.node import Node
+from rail_monitor.nodes import process
+
+class Stuck(Node):
+    def __init__(self):
+        super().__init__("teardown_probe")
+        print("started", flush=True)
+
+    def close(self):
+        Path(sys.argv[1]).write_text("closed")
+
+    def destroy_node(self):  # as rcl's participant deletion that never returned
+        time.sleep(600)
+
+process.TEARDOWN_HANG_S = 1.0
+sys.exit(process.run_node(Stuck, ["teardown_probe"]))
+"""
+
+
+def test_a_teardown_that_hangs_after_the_outputs_are_closed_ends_the_process(tmp_path):
+    """A node whose destroy_node never returns (seen once in rcl under load, after SIGINT): the
+    process still closes its outputs, then ends within the teardown deadline with exit code 1 and
+    every thread's stack on stderr, instead of running until a supervisor kills it."""
+    marker = tmp_path / "closed"
+    p = subprocess.Popen([sys.executable, "-c", STUCK_TEARDOWN, str(marker)], cwd=TOP, text=True,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        assert p.stdout.readline().strip() == "started"
+        p.send_signal(signal.SIGINT)
+        t0 = time.monotonic()
+        _, err = p.communicate(timeout=60)
+        took = time.monotonic() - t0
+    finally:
+        p.kill()
+    assert marker.read_text() == "closed"
+    assert p.returncode == 1 and took < 15.0, (p.returncode, took, err[-1500:])
+    assert "Timeout" in err and "in destroy_node" in err, err[-1500:]

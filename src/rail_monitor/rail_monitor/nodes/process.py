@@ -38,6 +38,7 @@ def help_text(executable: str, doc: str | None, groups: ParamGroups) -> str:
 
 
 STOP_HANG_S = 20.0  # a process still stopping after this long prints its threads' stacks
+TEARDOWN_HANG_S = 10.0  # outputs closed, a teardown (nodes destroyed, rclpy shut down) this long ends the process
 
 # Exceptions that escaped a callback in this process, by cause: rclpy's own handlers raise on some
 # messages (its /clock subscription on a negative time), and no single message may stop a node.
@@ -95,6 +96,20 @@ def shut_down(executor: Any, timeout_sec: float) -> None:
     after SIGINT: 94 % of a core for 18 minutes). Collecting first closes the generator."""
     executor.shutdown(timeout_sec=timeout_sec)
     gc.collect()
+
+
+def destroy_nodes(nodes: Sequence[Node]) -> None:
+    """Destroy the nodes once their outputs are closed, with a deadline on the rest of the teardown.
+
+    Node.destroy_node can block for good inside rcl or the DDS implementation (seen on a loaded
+    machine: a node's participant deletion never returning after SIGINT, its spinner already
+    stopped). From here to the end of the ROS session, a teardown still under way after
+    TEARDOWN_HANG_S prints every thread's stack and ends the process with exit code 1.
+    faulthandler's watchdog is a C thread, so it fires even when the hang holds the interpreter
+    lock. Nothing is lost: every output was closed before this call."""
+    faulthandler.dump_traceback_later(TEARDOWN_HANG_S, exit=True)
+    for n in nodes:
+        n.destroy_node()
 
 
 def spin_guarded(executor: Any, ok: Callable[[], bool], timeout_sec: float = 0.1) -> None:
@@ -259,7 +274,7 @@ def run_node(make: Callable[[], Node], args: list[str] | None = None, flow_contr
                     if close is not None:
                         close()
                 finally:
-                    node.destroy_node()
+                    destroy_nodes([node])
         return 0
 
     return exit_code(main)

@@ -29,7 +29,15 @@ from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.pass_replayer import PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
-from rail_monitor.nodes.process import asked_for_help, exit_code, help_text, ros_session, shut_down, spin_guarded
+from rail_monitor.nodes.process import (
+    asked_for_help,
+    destroy_nodes,
+    exit_code,
+    help_text,
+    ros_session,
+    shut_down,
+    spin_guarded,
+)
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 
@@ -98,7 +106,7 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
                 if close is not None:
                     with contextlib.suppress(RailMonitorError):  # already raised (a failed bag)
                         close()
-                n.destroy_node()
+            destroy_nodes(list(reversed(nodes)))
 
 
 def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode], recorder: McapRecorder | None,
