@@ -69,3 +69,23 @@ def test_a_history_at_once_equals_the_states_published_pass_by_pass(site_, table
         np.testing.assert_allclose(fc.growth_per_axle_pass, one.growth_per_axle_pass, rtol=1e-9, atol=1e-18)
         assert fc.days_to_threshold == pytest.approx(one.days_to_threshold, rel=1e-9)
         assert (fc.worst_band, fc.grinding_due) == (one.worst_band, one.grinding_due)
+
+
+def test_the_compiled_engine_keeps_the_numpy_engines_state(site_, tables, sample):
+    # Batch mode's engine (numba: models.corrugation_jit) against the live nodes' (numpy), over a
+    # history in chunks with a replayed stretch: the sums (additions in the same order) bit for
+    # bit; the band r.m.s. and forecast to the last bits of exp and log and the Newton stop.
+    engines = {e: _estimator(site_, tables) for e in ("numpy", "numba")}
+    trajs = {}
+    for engine, est in engines.items():
+        est.engine = engine
+        trajs[engine] = [est.advance_history(sample.take(s)) for s in (slice(0, 700), slice(650, 1500))]
+    want, got = engines["numpy"], engines["numba"]
+    for name in ("log_components", "growth_by_state", "_growth_before", "_growth_total"):
+        assert np.array_equal(getattr(want, name), getattr(got, name)), name
+    assert np.array_equal(want.season.growth, got.season.growth) and np.abs(got.season.growth).sum() > 0
+    for w, g in zip(trajs["numpy"], trajs["numba"], strict=True):
+        assert np.array_equal(w.index, g.index)
+        np.testing.assert_allclose(g.amplitude, w.amplitude, rtol=1e-13)
+        assert np.array_equal(g.forecast.growth_per_axle_pass, w.forecast.growth_per_axle_pass)
+        np.testing.assert_allclose(g.forecast.days_to_threshold, w.forecast.days_to_threshold, rtol=1e-11)

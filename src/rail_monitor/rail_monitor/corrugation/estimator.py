@@ -30,6 +30,7 @@ from rail_monitor.corrugation.records import Forecast, ForecastInterval, StateSn
 from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
 from rail_monitor.models import corrugation as cg
+from rail_monitor.models.engine import corrugation_kernels
 
 
 class CorrugationEstimator:
@@ -64,7 +65,7 @@ class CorrugationEstimator:
         self.level_var = self.post_grinding_var.copy()
         self.kept = KeptPasses()
         self.season = DailyGrowth(self.log_components.shape)  # the last year day by day (forecast interval)
-        self.engine = "numpy"  # of a history's per-band reductions (batch: numba, forecast.band_kernels)
+        self.engine = "numpy"  # of the state's array kernels (batch: numba; models.engine.corrugation_kernels)
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
         # (B, P). A window's growth is a difference of two, so it is the same however the passes
         # were split into calls (live backlogs, batch chunks).
@@ -84,36 +85,24 @@ class CorrugationEstimator:
     def _growth(self, class_idx: np.ndarray, friction: np.ndarray, regime: np.ndarray, speed: np.ndarray,
                 axles: np.ndarray) -> np.ndarray:
         """Log growth of each component (N, B, P) over the axles of N passes."""
-        return self.tables.at(class_idx, friction, regime, speed) * axles[:, None, None]
+        return self.tables.at(class_idx, friction, regime, speed, axles, self.engine)
 
     def _advance(self, passes: PassTable) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
         """advance(), also returning ln Z after each counted pass (counted, B, P) and the log growth
         summed in counting order before each counted pass and after the last (counted + 1, B, P)."""
-        counted = np.zeros(len(passes), bool)
-        horizon = self.newest_ns - self.history_ns
-        seen = self.kept.seen
-        for i, (stamp, tid) in enumerate(zip(passes.stamp_ns.tolist(), passes.train_id, strict=True)):
-            key = (stamp, tid)
-            if key in seen or stamp < horizon:
-                continue
-            seen.add(key)
-            counted[i] = True
-            horizon = max(horizon, stamp - self.history_ns)
+        counted = self._first_sight(passes)
         if not counted.any():
             return counted, (np.zeros((0, *self.log_components.shape)), self._growth_total[None].copy())
         new = passes.take(counted)
         cls = self.tables.class_index(new.vehicle_class)
         contact = contact_state(self.site, new)
         growth = self._growth(cls, new.friction_state, contact.regime, new.speed_mps, new.axle_count)
-        # Sequential sums (cumsum), so a batch adds as the same passes one by one would.
-        steps = np.cumsum(np.concatenate([self.log_components[None], growth]), axis=0)[1:]
-        self.log_components = steps[-1].copy()
+        kernels = corrugation_kernels(self.engine)
         friction = np.asarray(new.friction_state)
-        for f in np.unique(friction).tolist():  # cumsum: sequential, as the passes one by one
-            self.growth_by_state[f - 1] = np.cumsum(
-                np.concatenate([self.growth_by_state[f - 1][None], growth[friction == f]]), axis=0)[-1]
-        self.season.add(new.stamp_ns, friction, growth, self.k_b)
-        summed = np.cumsum(np.concatenate([self._growth_total[None], growth]), axis=0)
+        steps, summed = kernels.history_sums(self.log_components, self._growth_total, self.growth_by_state, growth,
+                                             friction)
+        self.log_components = steps[-1].copy()
+        self.season.add(new.stamp_ns, friction, growth, self.k_b, kernels.add_by_day)
         self._growth_before = np.concatenate([self._growth_before, summed[:-1]])
         self._growth_total = summed[-1].copy()
         self._axle_sum += int(new.axle_count.sum())
@@ -129,6 +118,27 @@ class CorrugationEstimator:
                          load=contact.load_n, creepage=contact.creepage)
         self._prune()
         return counted, (steps, summed)
+
+    def _first_sight(self, passes: PassTable) -> np.ndarray:
+        """Mark the passes to count (keys not seen, not older than the kept history as it moves
+        on pass by pass) and add their keys to the seen set."""
+        horizon = self.newest_ns - self.history_ns
+        seen = self.kept.seen
+        stamps = passes.stamp_ns.tolist()
+        keys = list(zip(stamps, passes.train_id.tolist(), strict=True))
+        # In time order from the horizon on, no pass falls behind it: only a repeated key is left out.
+        if (not stamps or (stamps[0] >= horizon and bool(np.all(np.diff(passes.stamp_ns) >= 0)))) \
+                and seen.isdisjoint(keys) and len(set(keys)) == len(keys):
+            seen.update(keys)
+            return np.ones(len(keys), bool)
+        counted = np.zeros(len(keys), bool)
+        for i, (stamp, key) in enumerate(zip(stamps, keys, strict=True)):
+            if key in seen or stamp < horizon:
+                continue
+            seen.add(key)
+            counted[i] = True
+            horizon = max(horizon, stamp - self.history_ns)
+        return counted
 
     def advance_history(self, passes: PassTable) -> Trajectory:
         """advance() over one pass or a history, returning the state and forecast after every
@@ -153,13 +163,14 @@ class CorrugationEstimator:
         end = k0 + np.arange(1, m + 1)                                   # one past pass k
         start = np.searchsorted(all_stamps, new.stamp_ns - self.history_ns, side="left")
         axles = (a_prefix[end] - a_prefix[start]).astype(float)
-        growth = (g_prefix[end] - g_prefix[start]) / axles[:, None, None]
+        kernels = corrugation_kernels(self.engine)
+        growth, growth_max = kernels.window_growth(g_prefix, start, end, axles)
         span_days = (new.stamp_ns - all_stamps[start]) / NS_PER_DAY
         with np.errstate(divide="ignore", invalid="ignore"):
             rate = np.where((span_days > 0) & (span_days >= self.cfg.min_traffic_days),
                             (end - start - 1) / span_days, np.nan)
-        log_amplitude = fcst.band_kernels(self.engine).band_log_amplitude(steps)
-        fc = self._forecasts(steps, growth, rate, axles / (end - start), new.stamp_ns, log_amplitude)
+        log_amplitude = kernels.band_log_amplitude(steps)
+        fc = self._forecasts(steps, growth, rate, axles / (end - start), new.stamp_ns, log_amplitude, growth_max)
         ordinal = np.arange(1, m + 1)
         return Trajectory(
             index=np.flatnonzero(counted), stamp_ns=new.stamp_ns.copy(), train_id=new.train_id.copy(),
@@ -282,7 +293,8 @@ class CorrugationEstimator:
                                            np.array([self.newest_ns])))
 
     def _forecasts(self, log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
-                   newest_ns: np.ndarray, log_amplitude: np.ndarray | None = None) -> Forecast:
+                   newest_ns: np.ndarray, log_amplitude: np.ndarray | None = None,
+                   growth_max: np.ndarray | None = None) -> Forecast:
         return fcst.forecasts(log_components, growth, rate, axles, newest_ns, self.threshold,
                               self.cfg.lead_time_days, self.site.mean_axles_per_train, engine=self.engine,
-                              log_amplitude=log_amplitude)
+                              log_amplitude=log_amplitude, growth_max=growth_max)

@@ -18,7 +18,7 @@ from rail_monitor.corrugation.history import KeptPasses
 from rail_monitor.corrugation.records import Forecast, ForecastInterval
 from rail_monitor.models import calibration
 from rail_monitor.models import corrugation as cg
-from rail_monitor.models.engine import check_engine
+from rail_monitor.models.engine import corrugation_kernels
 
 # Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
 # passes nearly balancing the others) can be 1e12 days away, past any 64-bit time stamp.
@@ -38,15 +38,15 @@ class Threads(NamedTuple):
 def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
               newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
               fallback_axles: float, threads: Threads | None = None, engine: str = "numpy",
-              log_amplitude: np.ndarray | None = None) -> Forecast:
+              log_amplitude: np.ndarray | None = None, growth_max: np.ndarray | None = None) -> Forecast:
     """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
     day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
     band thresholds (B,) [m]; a Forecast of arrays (grinding_due_ns 0: no date, the forecast
     being infinite or beyond MAX_DATED_DAYS). threads: to split the states' root finding over
     (each band's root is found on its own, so the split changes no bit). engine: of the per-band
     reductions (numpy, or numba: models.corrugation_jit); log_amplitude: ln of each band's r.m.s.
-    (N, B) when the caller has it."""
-    kernels = band_kernels(engine)
+    (N, B), and growth_max: g's largest component per band (N, B), when the caller has them."""
+    kernels = corrugation_kernels(engine)
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
     log_threshold = np.log(threshold)
     if log_amplitude is None:
@@ -61,18 +61,10 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
         days = np.where(np.isfinite(rate) & (rate > 0), passes / rate, np.inf)
     days = np.where(passes == 0.0, 0.0, days)
     due = (margin.min(axis=1) <= 0) | (days <= lead_time_days)
-    due_ns = np.array([int(t) + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0
-                       for t, d in zip(newest_ns.tolist(), days.tolist(), strict=True)], np.int64)
-    return Forecast(growth.max(axis=2), worst, passes, days, rate, due, due_ns)
-
-
-def band_kernels(engine: str) -> ModuleType:
-    """The module of the per-band reductions (band_log_amplitude, passes_to_band_level) of an engine."""
-    if check_engine(engine) == "numba":
-        from rail_monitor.models import corrugation_jit
-
-        return corrugation_jit
-    return cg
+    dated = days <= MAX_DATED_DAYS  # the cast truncates toward zero, as int() does
+    due_ns = np.where(dated, np.asarray(newest_ns, np.int64) + (np.where(dated, days, 0.0) * NS_PER_DAY).astype(np.int64),
+                      0)
+    return Forecast(growth.max(axis=2) if growth_max is None else growth_max, worst, passes, days, rate, due, due_ns)
 
 
 def _passes_to_level_split(kernels: ModuleType, log_components: np.ndarray, growth: np.ndarray,

@@ -26,6 +26,7 @@ from rail_monitor.corrugation.config import SPEED_STEP_MPS, CorrugationConfig
 from rail_monitor.models import corrugation as cg
 from rail_monitor.models import track as tr
 from rail_monitor.models.contact_filter import hertzian_line_filter
+from rail_monitor.models.engine import corrugation_kernels
 
 # Positions in the bay (fraction of the sleeper spacing from a support): the midpoints of eight
 # equal slices of a bay; the receptance is symmetric about mid-span, so the four of the first half
@@ -136,15 +137,17 @@ class GrowthTables:
 
     def class_index(self, names: np.ndarray) -> np.ndarray:
         lookup = {n: i for i, n in enumerate(self.classes)}
-        return np.array([lookup[n] for n in names], dtype=np.int64)
+        return np.array(list(map(lookup.__getitem__, names)), dtype=np.int64)
 
-    def at(self, class_idx: np.ndarray, friction: np.ndarray, regime: np.ndarray, speed: np.ndarray) -> np.ndarray:
+    def at(self, class_idx: np.ndarray, friction: np.ndarray, regime: np.ndarray, speed: np.ndarray,
+           axles: np.ndarray | None = None, engine: str = "numpy") -> np.ndarray:
         """Per-axle-pass log growth (N, B, P) for passes of class index, friction state (1-4), contact
-        regime (rail_monitor.core.contact.REGIME_*) and speed [m/s]."""
+        regime (rail_monitor.core.contact.REGIME_*) and speed [m/s]; with axles (N,), each pass's
+        log growth over its axles. engine: of the lookup (models.engine)."""
         x = np.clip(np.asarray(speed, float) / SPEED_STEP_MPS - 1.0, 0.0, len(self.speeds) - 1.0)
         j = np.minimum(x.astype(np.int64), len(self.speeds) - 2)
-        w = (x - j)[:, None, None]
-        fi = np.asarray(friction, np.int64) - 1
-        ri = np.asarray(regime, np.int64)
-        t = self._by_speed  # one contiguous (B, P) block per pass and speed
-        return (1.0 - w) * t[class_idx, fi, ri, j] + w * t[class_idx, fi, ri, j + 1]
+        scale = np.ones(len(x)) if axles is None else np.asarray(axles, float)  # x 1.0 is exact
+        # One contiguous (B, P) block per pass and speed.
+        return corrugation_kernels(engine).table_growth(self._by_speed, np.asarray(class_idx, np.int64),
+                                                        np.asarray(friction, np.int64) - 1,
+                                                        np.asarray(regime, np.int64), j, x - j, scale)

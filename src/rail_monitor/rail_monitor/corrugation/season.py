@@ -3,15 +3,18 @@ earlier" once the history spans a year (rail_monitor.corrugation.forecast.interv
 
 Each day keeps the log growth of its passes per friction state per unit K_b (growth at the K_b in
 use over that K_b: the growth law is first order in K_b, so a later re-fit scales it), and its
-pass count. Passes are added in counting order with sequential sums (np.add.at), so one pass at a
-time or a batch give the same bits.
+pass count. Passes are added in counting order with sequential sums, so one pass at a time or a
+batch give the same bits.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from rail_monitor.core.timeutil import NS_PER_DAY
+from rail_monitor.models.corrugation import add_by_day
 
 SEASON_DAYS = 365  # the profile a forecast follows: the year before the newest pass
 KEPT_DAYS = SEASON_DAYS + 1
@@ -27,8 +30,10 @@ class DailyGrowth:
         self.growth = np.zeros((0, 4, *shape))
         self.passes = np.zeros(0, np.int64)
 
-    def add(self, stamp_ns: np.ndarray, friction: np.ndarray, growth: np.ndarray, k_b: np.ndarray) -> None:
-        """Passes' stamps [ns], friction states (1-4), log growth (N, B, P) at K_b (4,)."""
+    def add(self, stamp_ns: np.ndarray, friction: np.ndarray, growth: np.ndarray, k_b: np.ndarray,
+            add_by_day: Callable[..., None] = add_by_day) -> None:
+        """Passes' stamps [ns], friction states (1-4), log growth (N, B, P) at K_b (4,); add_by_day:
+        an engine's (models.corrugation.add_by_day or its compiled twin)."""
         if not len(stamp_ns):
             return
         day = np.asarray(stamp_ns, np.int64) // NS_PER_DAY
@@ -43,7 +48,7 @@ class DailyGrowth:
             self.growth, self.passes, self.first_day = grown, count, lo
         f = np.asarray(friction, np.int64) - 1
         scale = np.divide(1.0, k_b, out=np.zeros(4), where=k_b > 0)[f]
-        np.add.at(self.growth, (day - self.first_day, f), growth * scale[:, None, None])
+        add_by_day(self.growth, day - self.first_day, f, growth, scale)
         np.add.at(self.passes, day - self.first_day, 1)
         drop = len(self.passes) - KEPT_DAYS
         if drop > 0:

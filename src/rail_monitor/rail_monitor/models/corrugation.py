@@ -215,6 +215,44 @@ def _passes_to_level(xs: FloatArray, gs: FloatArray, target: FloatArray) -> Floa
     return np.where(at_level, 0.0, np.where(grows, n, np.inf))
 
 
+def table_growth(table: FloatArray, class_idx: NDArray[np.int64], friction: NDArray[np.int64],
+                 regime: NDArray[np.int64], j: NDArray[np.int64], w: FloatArray, scale: FloatArray) -> FloatArray:
+    """Rows of a growth table (C, F, R, V, B, P) at N passes, linear between speed points j and
+    j + 1 with weight w, times scale (N,): (N, B, P). friction: as an index 0-3."""
+    w = w[:, None, None]
+    rows = (class_idx, friction, regime)
+    return ((1.0 - w) * table[(*rows, j)] + w * table[(*rows, j + 1)]) * scale[:, None, None]
+
+
+def history_sums(log_components: FloatArray, total: FloatArray, by_state: FloatArray, growth: FloatArray,
+                 friction: NDArray[np.int64]) -> tuple[FloatArray, FloatArray]:
+    """A history's sums over passes in counting order, each sequential (so a batch adds as the same
+    passes one by one would): ln Z after each pass (N, B, P) from ``log_components`` (B, P); the
+    log growth summed before each pass and after the last (N + 1, B, P) from ``total`` (B, P);
+    and ``by_state`` (4, B, P), the growth summed per friction state, updated in place. growth:
+    the passes' log growth (N, B, P) [-]; friction: their friction states (N,) (1-4)."""
+    steps = np.cumsum(np.concatenate([log_components[None], growth]), axis=0)[1:]
+    for f in np.unique(friction).tolist():
+        by_state[f - 1] = np.cumsum(np.concatenate([by_state[f - 1][None], growth[friction == f]]), axis=0)[-1]
+    return steps, np.cumsum(np.concatenate([total[None], growth]), axis=0)
+
+
+def window_growth(prefix: FloatArray, start: NDArray[np.int64], end: NDArray[np.int64],
+                  axles: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Growth per axle pass over windows of passes (N, B, P): the log growth summed over passes
+    start to end - 1 of a prefix sum (K, B, P) over their axles (N,); and its largest component
+    per band (N, B) [1/axle pass]."""
+    growth = (prefix[end] - prefix[start]) / axles[:, None, None]
+    return growth, growth.max(axis=2)
+
+
+def add_by_day(daily: FloatArray, day: NDArray[np.int64], friction: NDArray[np.int64], growth: FloatArray,
+               scale: FloatArray) -> None:
+    """daily[day_i, friction_i] += growth_i scale_i for each pass i in order (daily (D, 4, B, P);
+    friction as an index 0-3)."""
+    np.add.at(daily, (day, friction), growth * scale[:, None, None])
+
+
 # Post-grinding acceptance limits of Grassie, Saxon & Smith (1999), r.m.s. roughness per
 # wavelength range: ((shortest [m], longest [m]), limit [m]).
 GRASSIE_1999_LIMITS: tuple[tuple[tuple[float, float], float], ...] = (

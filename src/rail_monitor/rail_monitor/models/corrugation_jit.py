@@ -1,6 +1,6 @@
-"""The corrugation model's per-band reductions compiled by numba: a band's r.m.s. from its
-components and the passes until it reaches a level (models.corrugation's numpy functions of the
-same names, whose docstrings give the equations).
+"""The corrugation model's array kernels compiled by numba: a band's r.m.s. from its components,
+the passes until it reaches a level, and a history's sums (models.corrugation's numpy functions
+of the same names, whose docstrings give the equations).
 
 The same operations in the same order, one band at a time, without fast-math: the results agree
 with the numpy engine but for the last bit of exp and log (numba takes them from the C library,
@@ -89,3 +89,81 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
     out = np.empty(target.shape)
     _passes_to_level(np.ascontiguousarray(x.reshape(-1, p)), np.ascontiguousarray(g.reshape(-1, p)), target, out)
     return out.reshape(shape)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _history_sums(log_components, total, by_state, growth, friction, steps, summed):  # pragma: no cover
+    summed[0] = total
+    for m in range(growth.shape[0]):
+        f = friction[m] - 1
+        for b in range(growth.shape[1]):
+            for p in range(growth.shape[2]):
+                g = growth[m, b, p]
+                steps[m, b, p] = (log_components[b, p] if m == 0 else steps[m - 1, b, p]) + g
+                summed[m + 1, b, p] = summed[m, b, p] + g
+                by_state[f, b, p] += g
+
+
+def history_sums(log_components: FloatArray, total: FloatArray, by_state: FloatArray, growth: FloatArray,
+                 friction: NDArray[np.int64]) -> tuple[FloatArray, FloatArray]:
+    """models.corrugation.history_sums, compiled: one pass over the passes for the three sums."""
+    growth = np.ascontiguousarray(growth, float)
+    steps = np.empty_like(growth)
+    summed = np.empty((len(growth) + 1, *growth.shape[1:]))
+    _history_sums(log_components, total, by_state, growth, np.asarray(friction, np.int64), steps, summed)
+    return steps, summed
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _window_growth(prefix, start, end, axles, growth, top):  # pragma: no cover
+    for m in range(growth.shape[0]):
+        for b in range(growth.shape[1]):
+            most = -np.inf
+            for p in range(growth.shape[2]):
+                g = (prefix[end[m], b, p] - prefix[start[m], b, p]) / axles[m]
+                growth[m, b, p] = g
+                most = max(most, g)
+            top[m, b] = most
+
+
+def window_growth(prefix: FloatArray, start: NDArray[np.int64], end: NDArray[np.int64],
+                  axles: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """models.corrugation.window_growth, compiled: no gathered copies of the prefix sum."""
+    n, (_, b, p) = len(end), prefix.shape
+    growth, top = np.empty((n, b, p)), np.empty((n, b))
+    _window_growth(np.ascontiguousarray(prefix), np.asarray(start, np.int64), np.asarray(end, np.int64),
+                   np.asarray(axles, float), growth, top)
+    return growth, top
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _add_by_day(daily, day, friction, growth, scale):  # pragma: no cover
+    for m in range(growth.shape[0]):
+        for b in range(growth.shape[1]):
+            for p in range(growth.shape[2]):
+                daily[day[m], friction[m], b, p] += growth[m, b, p] * scale[m]
+
+
+def add_by_day(daily: FloatArray, day: NDArray[np.int64], friction: NDArray[np.int64], growth: FloatArray,
+               scale: FloatArray) -> None:
+    """models.corrugation.add_by_day, compiled."""
+    _add_by_day(daily, np.asarray(day, np.int64), np.asarray(friction, np.int64),
+                np.ascontiguousarray(growth, float), np.asarray(scale, float))
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _table_growth(table, class_idx, friction, regime, j, w, scale, out):  # pragma: no cover
+    for m in range(out.shape[0]):
+        lo = table[class_idx[m], friction[m], regime[m], j[m]]
+        hi = table[class_idx[m], friction[m], regime[m], j[m] + 1]
+        for b in range(out.shape[1]):
+            for p in range(out.shape[2]):
+                out[m, b, p] = ((1.0 - w[m]) * lo[b, p] + w[m] * hi[b, p]) * scale[m]
+
+
+def table_growth(table: FloatArray, class_idx: NDArray[np.int64], friction: NDArray[np.int64],
+                 regime: NDArray[np.int64], j: NDArray[np.int64], w: FloatArray, scale: FloatArray) -> FloatArray:
+    """models.corrugation.table_growth, compiled: no gathered copies of the table's rows."""
+    out = np.empty((len(j), *table.shape[-2:]))
+    _table_growth(table, class_idx, friction, regime, j, np.asarray(w, float), np.asarray(scale, float), out)
+    return out
