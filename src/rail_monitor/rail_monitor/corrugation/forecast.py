@@ -61,9 +61,9 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
         days = np.where(np.isfinite(rate) & (rate > 0), passes / rate, np.inf)
     days = np.where(passes == 0.0, 0.0, days)
     due = (margin.min(axis=1) <= 0) | (days <= lead_time_days)
-    dated = days <= MAX_DATED_DAYS  # the cast truncates toward zero, as int() does
-    due_ns = np.where(dated, np.asarray(newest_ns, np.int64) + (np.where(dated, days, 0.0) * NS_PER_DAY).astype(np.int64),
-                      0)
+    dated = days <= MAX_DATED_DAYS
+    ahead_ns = (np.where(dated, days, 0.0) * NS_PER_DAY).astype(np.int64)  # truncated toward zero, as int() does
+    due_ns = np.where(dated, np.asarray(newest_ns, np.int64) + ahead_ns, 0)
     return Forecast(growth.max(axis=2) if growth_max is None else growth_max, worst, passes, days, rate, due, due_ns)
 
 
