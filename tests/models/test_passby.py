@@ -41,6 +41,20 @@ def test_a_long_train_approaches_the_infinite_line_and_tel_exceeds_the_window_le
     assert short.lpaeq_tp_dba[0] < short.lpafmax_dba[0] < short.tel_dba[0]
 
 
+def test_lpaeq_weights_give_the_pass_bys_lpaeq_for_any_spectrum():
+    # LpAeq,Tp is linear in the power per metre: the weights of a line times a spectrum, summed
+    # over bands, against pass_by's path-by-path sum (the same numbers but for rounding).
+    rng = np.random.default_rng(2)
+    band = np.arange(-10, 11)
+    lw = rng.uniform(60.0, 100.0, (50, len(band)))
+    length, speed = rng.uniform(20.0, 600.0, 50), rng.uniform(5.0, 40.0, 50)
+    gain_db = rng.uniform(-3.0, 3.0, len(band))
+    g = passby.pass_geometry(band, length, speed, RECEIVER)
+    want = passby.pass_by(lw, band, length, speed, RECEIVER, gain_db, time_weighted=False, geometry=g).lpaeq_tp_dba
+    got = levels.level(np.sum(levels.power(lw) * passby.lpaeq_weights(g, levels.power(gain_db)), axis=-1))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
+
+
 def test_f_time_weighting_matches_a_time_integration():
     """LpAFmax against solve_ivp of tau dy/dt = x - y on the same time history (IEC 61672-1 F), 0.05 dB."""
     d = RECEIVER.distance_m

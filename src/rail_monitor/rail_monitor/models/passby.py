@@ -244,9 +244,12 @@ def pass_by_levels(g: PassGeometry, paths: BandPaths, lpafmax_dba: FloatArray | 
     )
 
 
-def pass_by_lpaeq(g: PassGeometry, paths: BandPaths) -> FloatArray:
-    """pass_by_levels's LpAeq,Tp alone [dB(A)] (passes,)."""
-    return _lpaeq(_window_mean(paths), g.a_weight)
+def lpaeq_weights(g: PassGeometry, direct_gain: ArrayLike = 1.0) -> FloatArray:
+    """Per pass and band, the A-weighted window mean of a unit power per metre on the source line
+    of g (its direct path times direct_gain, and its image path): a spectrum W of power per metre
+    on that line gives LpAeq,Tp = 10 lg(sum over bands of W Q) (passes x bands) [1/m]. Being linear
+    in W, one Q serves every component and every model on the line."""
+    return (direct_gain * g.k1 + g.ground_reflection * g.k2) * g.a_weight
 
 
 def _window_mean(paths: BandPaths) -> FloatArray:

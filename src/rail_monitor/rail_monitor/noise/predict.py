@@ -42,8 +42,8 @@ from rail_monitor.models.passby import (
     PassGeometry,
     a_weighted_paths,
     f_weighted_peaks,
+    lpaeq_weights,
     pass_by_levels,
-    pass_by_lpaeq,
     pass_geometry,
     power_paths,
 )
@@ -172,6 +172,7 @@ class RollingNoiseModel:
         if unknown := [m for m in models if m not in MODELS]:
             raise ValueError(f"unknown noise model {unknown[0]!r}; use one of {MODELS}")
         geometry = self._geometries(passes, models)
+        weights = self._lpaeq_weights(geometry)
         rail = self.rail_roughness_db(corrugation)
         out, paths = {}, []
         for model in models:
@@ -184,13 +185,13 @@ class RollingNoiseModel:
             growth = np.zeros(len(passes))
             if corrugation is not None:
                 _, ground = self._sources(self.baseline_db, passes, model, filter_db)
-                growth = pb.lpaeq_tp_dba - self._levels(ground, geometry)
+                growth = pb.lpaeq_tp_dba - self._lpaeq(ground, weights)
             out[model] = NoisePrediction(
                 model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
                 lp_db=pb.lp_db, lw_db=level(sum(components.values())), roughness_db=roughness,
                 pass_by_time_s=pb.pass_by_time_s,
                 lpaeq_tp_dba=pb.lpaeq_tp_dba, lpafmax_dba=pb.lpafmax_dba, tel_dba=pb.tel_dba,
-                component_lpaeq_dba=np.stack([self._levels({c: components[c]}, geometry) for c in names], axis=-1),
+                component_lpaeq_dba=np.stack([self._lpaeq({c: components[c]}, weights) for c in names], axis=-1),
                 roughness_growth_increase_db=growth)
         peaks = level(f_weighted_peaks(geometry[0], paths, self.engine))
         return {m: dataclasses.replace(p, lpafmax_dba=peak) for (m, p), peak in zip(out.items(), peaks, strict=True)}
@@ -285,10 +286,19 @@ class RollingNoiseModel:
         total = sum(low) if low else np.zeros_like(high[0])
         return power_paths(total, geometry, self.vertical_gain, (sum(high), geometry_b) if high else None)
 
-    def _levels(self, components: dict[str, np.ndarray],
-                geometries: tuple[PassGeometry, PassGeometry | None]) -> np.ndarray:
-        """LpAeq,Tp of the components (power ratios) alone [dB(A)] (passes,)."""
-        return pass_by_lpaeq(geometries[0], self._paths(components, geometries))
+    def _lpaeq_weights(self, geometries: tuple[PassGeometry, PassGeometry | None]) -> dict[bool, np.ndarray]:
+        """models.passby.lpaeq_weights of source A's line (with the vertical directivity) and of
+        source B's where the passes have one, keyed by whether the line is B's."""
+        low, high = geometries
+        out = {False: lpaeq_weights(low, self.vertical_gain)}
+        if high is not None:
+            out[True] = lpaeq_weights(high)
+        return out
+
+    @staticmethod
+    def _lpaeq(components: dict[str, np.ndarray], weights: dict[bool, np.ndarray]) -> np.ndarray:
+        """LpAeq,Tp of the components (power ratios) alone [dB(A)] (passes,), by their lines' weights."""
+        return level(sum(np.sum(w * weights[c in SOURCE_B_COMPONENTS], axis=-1) for c, w in components.items()))
 
     def _roughness(self, rail_db: np.ndarray, terms: ClassTerms, speed: np.ndarray, model: str,
                    filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
