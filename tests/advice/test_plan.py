@@ -119,3 +119,17 @@ def test_the_what_if_side_effects_follow_the_speed(world):
     assert np.all(fast.noise_change_dba > 0.5) and np.all(slow.noise_change_dba < -0.5)
     assert slow.squeal_share < fast.squeal_share_current < fast.squeal_share
     assert fast.squeal_share_current == slow.squeal_share_current
+
+
+def test_the_advice_on_threads_is_the_advice_in_one(world):
+    # Batch mode spreads the classes' what-ifs over a pool: each class is computed alone, so the
+    # plan is the same to the bit.
+    from concurrent.futures import ThreadPoolExecutor
+
+    _, _, cons, est = world
+    alone = plan.advise(est, cons)
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        threaded = plan.advise(est, cons, pool)
+    for f in dataclasses.fields(alone):
+        want, got = getattr(alone, f.name), getattr(threaded, f.name)
+        assert np.array_equal(np.asarray(want), np.asarray(got)), f.name

@@ -14,6 +14,7 @@ are evaluated by the same band model, so the cut and the interval factor compare
 
 from __future__ import annotations
 
+from concurrent.futures import Executor
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -132,8 +133,10 @@ def _points(low: np.ndarray, high: np.ndarray) -> np.ndarray:
     return low[..., None] + (high - low)[..., None] * u
 
 
-def advise(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice:
-    """The plan for the kept passes (ValueError when there are none, or no plan fits the limits)."""
+def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor | None = None) -> SpeedAdvice:
+    """The plan for the kept passes (ValueError when there are none, or no plan fits the limits);
+    pool: threads for the classes' growth, noise and squeal on their speed points (independent,
+    so the split changes no number)."""
     k = est.kept
     if not len(k):
         raise ValueError("no recent passes to advise on")
@@ -144,21 +147,24 @@ def advise(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice
     allowed = high > low + 1e-9
     pts = _points(low, high)
     nc, ns = low.shape
-    growth, noise, squeal_share = [], [], []
     state = Corrugation(est.bands, est.amplitude, est.grinding_amplitude)
+
+    def on_points(c: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Class c's growth (R, S), noise (M, S) and squeal share (S,), each the mean over its points."""
+        speeds = pts[c].ravel()
+        mixed = growth_at_speeds(est, speeds, vehicle_class=classes[c])                 # (B, P, S x points)
+        return (mixed.reshape(-1, ns, POINTS_PER_BAND).mean(axis=2),
+                consequences.noise_dba([classes[c]], speeds, state)[:, 0].reshape(-1, ns, POINTS_PER_BAND)
+                .mean(axis=2),
+                consequences.squeal_share(k, classes[c], present[c], speeds).reshape(ns, POINTS_PER_BAND).mean(axis=1))
+
+    growth, noise, squeal_share = zip(*(pool.map if pool is not None else map)(on_points, range(nc)), strict=True)
     passes = np.zeros(nc)
     axles = np.zeros(nc)
     current = np.zeros((nc, ns))
     for c, ci in enumerate(present):
         rows = k.class_idx == ci
         passes[c], axles[c] = rows.sum(), k.axles[rows].sum()
-        speeds = pts[c].ravel()
-        mixed = growth_at_speeds(est, speeds, vehicle_class=classes[c])                 # (B, P, S x points)
-        growth.append(mixed.reshape(-1, ns, POINTS_PER_BAND).mean(axis=2))              # (R, S)
-        noise.append(consequences.noise_dba([classes[c]], speeds, state)[:, 0].reshape(-1, ns, POINTS_PER_BAND)
-                     .mean(axis=2))                                                    # (M, S)
-        squeal_share.append(consequences.squeal_share(k, classes[c], ci, speeds)
-                            .reshape(ns, POINTS_PER_BAND).mean(axis=1))                 # (S,)
         used = np.flatnonzero(allowed[c])
         v = np.clip(k.speed[rows], low[c, used[0]], high[c, used[-1]])
         band = used[np.clip(np.searchsorted(low[c, used], v, side="right") - 1, 0, len(used) - 1)]
@@ -192,10 +198,11 @@ def advise(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice
         [classes[c] for c in ci_rows], low[show], high[show], current[show], rec[show])
 
 
-def advise_or_none(est: CorrugationEstimator, consequences: Consequences) -> SpeedAdvice | None:
+def advise_or_none(est: CorrugationEstimator, consequences: Consequences,
+                   pool: Executor | None = None) -> SpeedAdvice | None:
     """The advice on the kept passes, or None when there is nothing to advise on or no plan fits."""
     try:
-        return advise(est, consequences)
+        return advise(est, consequences, pool)
     except ValueError:
         return None
 

@@ -282,7 +282,9 @@ class BatchRun:
             self.tracker.add_measurement(m)
         self.tracker.finish()
         held, self._held = self._held, []
-        return held, advise_or_none(self.estimator, Consequences(self.site, self.model, squeal_config(self.values)))
+        with ThreadPoolExecutor(max_workers=self.threads) as pool:
+            return held, advise_or_none(self.estimator, Consequences(self.site, self.model,
+                                                                     squeal_config(self.values)), pool)
 
 
 def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
