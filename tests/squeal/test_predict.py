@@ -82,3 +82,18 @@ def test_batch_prediction_of_the_sample_is_fast_and_complete(site, site_values, 
     assert 6.3 <= reduction <= 22.8
     assert np.all(pred["friction_modifier_benefit_db"] <= -10.0 * np.log10(1.0 - cfg.friction_modifier_effectiveness)
                   + 1e-9)
+
+
+def test_the_risk_at_other_speeds_is_the_prediction_of_the_passes_run_at_them(site, site_values, sample_passes):
+    # The advice's what-if (risk_at_speeds: each pass's contact once, then V0, Vc and u_s per speed)
+    # against predict on copies of the passes at each speed, bit for bit.
+    from dataclasses import replace
+
+    from rail_monitor.squeal.predict import risk_at_speeds
+
+    table = with_class_defaults(sample_passes.take(rejection_reasons(sample_passes, site) == ""), site)
+    table = table.take(slice(0, 300))
+    cfg, speeds = squeal_config(site_values), np.array([8.0, 14.0, 22.0, 31.0])
+    got = risk_at_speeds(cfg, site, table, speeds[:, None])
+    want = np.stack([predict(cfg, site, replace(table, speed_mps=np.full(len(table), v)))["risk"] for v in speeds])
+    assert np.array_equal(got, want) and len(np.unique(want)) > 1

@@ -24,7 +24,7 @@ from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation
 from rail_monitor.noise.whatif import synthetic_passes
 from rail_monitor.squeal.config import RISK_MEDIUM, SquealConfig, squeal_config
-from rail_monitor.squeal.predict import predict as predict_squeal
+from rail_monitor.squeal.predict import risk_at_speeds
 
 NOISE_METRIC = "lpafmax_dba"
 
@@ -56,16 +56,13 @@ class Consequences:
         """Share of a class's kept passes at squeal risk medium or above (G,) if run at each speed
         [m/s]; with speeds None, (1,) at their own speeds. 0 for a class without kept passes."""
         rows = np.flatnonzero(kept.class_idx == class_idx)
-        g = 1 if speeds is None else len(speeds)
         if not len(rows):
-            return np.zeros(g)
+            return np.zeros(1 if speeds is None else len(speeds))
         n = len(rows)
-        v = kept.speed[rows] if speeds is None else np.repeat(np.asarray(speeds, float), n)
         table = with_class_defaults(PassTable(
-            stamp_ns=np.arange(n * g, dtype=np.int64) + 1, train_id=[""] * (n * g), vehicle_class=[name] * (n * g),
-            vehicle_count=[1] * (n * g), axle_count=[0] * (n * g), speed_mps=v,
-            angle_of_attack_rad=np.tile(np.arcsin(np.clip(kept.creepage[rows], 0.0, 1.0)), g),
-            wheel_load_n=np.tile(kept.load[rows], g), friction_state=np.tile(kept.friction[rows], g),
-            train_length_m=[0.0] * (n * g)), self.site)
-        risk = predict_squeal(self.squeal, self.site, table)["risk"]
-        return (risk >= RISK_MEDIUM).reshape(g, n).mean(axis=1)
+            stamp_ns=np.arange(n, dtype=np.int64) + 1, train_id=[""] * n, vehicle_class=[name] * n,
+            vehicle_count=[1] * n, axle_count=[0] * n, speed_mps=kept.speed[rows],
+            angle_of_attack_rad=np.arcsin(np.clip(kept.creepage[rows], 0.0, 1.0)), wheel_load_n=kept.load[rows],
+            friction_state=kept.friction[rows], train_length_m=[0.0] * n), self.site)
+        v = table.speed_mps[None, :] if speeds is None else np.asarray(speeds, float)[:, None]
+        return (risk_at_speeds(self.squeal, self.site, table, v) >= RISK_MEDIUM).mean(axis=1)

@@ -50,6 +50,17 @@ class ContactState(NamedTuple):
     def full_sliding(self) -> np.ndarray:
         return self.regime == REGIME_FULL_SLIDING
 
+    def at_speed(self, speed_mps: np.ndarray) -> ContactState:
+        """The same contacts at other speeds [m/s] (any shape broadcasting with the passes'): Vc and
+        u_s scale with V0, nothing else depends on it (the advice's what-if speeds)."""
+        return self._replace(**_speed_terms(speed_mps, self.creepage, self.load_n, self.k3_n))
+
+
+def _speed_terms(speed_mps: np.ndarray, creepage: np.ndarray, load_n: np.ndarray, k3_n: np.ndarray) -> dict:
+    """The fields of a ContactState proportional to V0: Vc = V0 zeta and u_s = V0 W / k3 [m/s]."""
+    return {"crabbing_mps": speed_mps * creepage, "critical_slip_mps": squeal.critical_slip_velocity(speed_mps, load_n,
+                                                                                                      k3_n)}
+
 
 def wheel_radius(site: Site, vehicle_class: np.ndarray) -> np.ndarray:
     """Rolling radius [m] of each pass's class (half its nominal wheel diameter)."""
@@ -86,5 +97,6 @@ def contact_state_of(site: Site, vehicle_class: np.ndarray, friction_state: np.n
     k3 = creep_stiffness(site, patch, k1)
     saturation = load_n / k3
     regime = np.where(creepage > saturation, REGIME_FULL_SLIDING, REGIME_PARTIAL_SLIP).astype(np.int8)
-    return ContactState(load_n, patch, k1, k2, k3, creepage, saturation, speed_mps * creepage,
-                        squeal.critical_slip_velocity(speed_mps, load_n, k3), regime)
+    return ContactState(load_n=load_n, patch=patch, k1=k1, k2=k2, k3_n=k3, creepage=creepage,
+                        saturation_creepage=saturation, regime=regime,
+                        **_speed_terms(speed_mps, creepage, load_n, k3))

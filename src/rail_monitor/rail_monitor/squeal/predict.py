@@ -88,6 +88,16 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
     }
 
 
+def risk_at_speeds(cfg: SquealConfig, site: Site, passes: PassTable, speed_mps: np.ndarray) -> np.ndarray:
+    """The risk class (RISK_*) of each pass were it run at other speeds [m/s], an array (G, N) or
+    broadcasting to it: the pass's contact and wheel mode, computed once, at each speed (the
+    advice's what-if; ``passes`` as for :func:`predict`)."""
+    cs = contact_state(site, passes)
+    mode = wheel_mode(site, passes.vehicle_class)
+    lc = _limit_cycle(mode, speed_mps, cs.at_speed(speed_mps))
+    return level_and_risk(cfg, mode, lc.amplitude, lc.unstable)[1]
+
+
 def _limit_cycle(mode: WheelMode, speed: np.ndarray, cs: ContactState) -> squeal.LimitCycle:
     return squeal.limit_cycle_amplitude(speed, cs.crabbing_mps, cs.load_n, mode.damping_nspm, cs.k1, cs.k2, cs.k3_n)
 
