@@ -142,3 +142,18 @@ def test_the_reference_rule_maps_each_table_before_combining():
 def test_an_unknown_rule_is_refused():
     with pytest.raises(ValueError, match="unknown interpolation rule"):
         cb.at_band_frequencies(np.zeros(35), 20.0, rule="energy_log_frequency")
+
+
+def test_a_shared_spectrums_power_is_read_once_and_cannot_be_changed_by_a_caller():
+    # band_roughness_power reads a 1-D spectrum (wheel, contact filter, baseline rail) through a
+    # cache shared by the models and the baseline: the same numbers as a fresh reading, read-only.
+    speed = np.linspace(8.0, 40.0, 37)
+    rail, wheel, a3 = cn.rail_roughness("E"), cn.wheel_roughness("cast_iron"), next(iter(T.contact_filters.values()))
+    fresh = ((power(cb.at_band_frequencies(rail, speed)) + power(cb.at_band_frequencies(wheel, speed)))
+             * power(cb.at_band_frequencies(a3, speed)))
+    for _ in range(2):
+        assert np.array_equal(cb.band_roughness_power(rail, wheel, a3, speed), fresh)
+    shared = cb._power_at(np.asarray(wheel, float).tobytes(), speed.tobytes(), speed.shape, T.band_hz.tobytes(),
+                          cn.DEFAULT_EDITION)
+    with pytest.raises(ValueError, match="read-only"):
+        shared += 1.0

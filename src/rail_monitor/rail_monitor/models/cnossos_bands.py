@@ -85,6 +85,10 @@ def band_roughness_power(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter
                                     edition))
 
     def at(table: ArrayLike) -> FloatArray:
+        if np.ndim(table) == 1:  # a class's or the site's spectrum: shared by the models and the baseline
+            speed, f = np.asarray(speed_mps, float), tables(edition).band_hz if band_hz is None else band_hz
+            return _power_at(np.asarray(table, float).tobytes(), speed.tobytes(), speed.shape,
+                             np.asarray(f, float).tobytes(), edition)
         return power(at_band_frequencies(table, speed_mps, band_hz, rule, edition))
 
     filtered = (at(rail_db) + at(wheel_db)) * (power(contact_filter_db) if np.ndim(contact_filter_db) == 0
@@ -146,6 +150,16 @@ def _positions(speed: bytes, shape: tuple[int, ...], band_hz: bytes, edition: st
     j, w = _grid_positions(x, tables(edition).wavelength_m)
     j.flags.writeable = w.flags.writeable = False  # shared by every caller
     return j, w
+
+
+@functools.lru_cache(maxsize=16)
+def _power_at(table: bytes, speed: bytes, shape: tuple[int, ...], band_hz: bytes, edition: str) -> FloatArray:
+    """10^(L/10) of one spectrum on the edition's grid (table: its dB values) read at lambda = v / f_i
+    by the reference rule (cached and read-only: the same wheel, contact filter and baseline spectra
+    are read at the same passes' speeds by every model and by the baseline of the increase)."""
+    out = power(_interp_at(_positions(speed, shape, band_hz, edition), np.frombuffer(table, float)))
+    out.flags.writeable = False
+    return out
 
 
 def _grid_positions(x: FloatArray, xp: FloatArray) -> tuple[NDArray[np.int64], FloatArray]:
