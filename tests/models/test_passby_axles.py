@@ -187,3 +187,16 @@ def test_the_compiled_window_kernel_gives_the_numpy_engines():
     got = passby_axles.window_kernels(layout, length, D, [R1, R2], "numba")
     np.testing.assert_allclose(got, want, rtol=1e-13, atol=0.0)
     np.testing.assert_array_equal(want[1], passby_axles.window_kernel(layout, length, D, R2))
+
+
+def test_near_axle_terms_over_a_common_denominator_are_the_direct_quotients():
+    # One division per pair of path distances against the direct directivity / (x^2 + R^2) of
+    # each: the same numbers to a few ulps, for a pair and for an odd last radius.
+    from rail_monitor.models.passby import _BROADSIDE, _OMNI
+
+    x2 = np.random.default_rng(6).uniform(0.0, 1e5, 2000) ** 2 / 1e3
+    r2 = [R1 * R1, R2 * R2, float(np.hypot(D, 2.8)) ** 2]
+    broad = _BROADSIDE * D * D
+    direct = (broad / (x2 + D * D) + _OMNI)
+    for got, rk in zip(passby_axles.near_axle_terms(x2, D, r2, broad), r2, strict=True):
+        np.testing.assert_allclose(got, direct / (x2 + rk), rtol=2e-15, atol=0.0)

@@ -1,8 +1,9 @@
 """The per-axle pass-by's F-weighted peak compiled by numba: the arithmetic of
 models.passby_axles (its numpy engine), fused into one loop per pass so no time history is held.
 
-Every operation is that of the numpy engine in the same order (sum over axles vehicle by vehicle,
-then the far line segments, then the paths, then IEC 61672-1's exponential average), without
+Every operation is that of the numpy engine in the same order (each axle's term over one common
+denominator, models.passby_axles.near_axle_terms; the sum over axles vehicle by vehicle, then the
+far line segments, then the paths, then IEC 61672-1's exponential average), without
 fast-math, so the two agree to the bit but for the arctangent, which numba takes from the C
 library and numpy from its own SIMD routines (they differ in the last bit for some arguments).
 Compiled once per machine (numba's cache, next to this file or in NUMBA_CACHE_DIR) and releasing
@@ -45,8 +46,6 @@ def _peaks(length, speed, dt, decay, before, samples, lo, hi, vehicles, pitch, o
     broad = _BROADSIDE * d * d
     longest = samples.max() if len(samples) else 0
     front = np.empty(longest)
-    x2 = np.empty(longest)
-    directivity = np.empty(longest)
     x = np.empty((n_r, longest))
     for i in range(len(length)):
         n_t = samples[i]
@@ -61,14 +60,23 @@ def _peaks(length, speed, dt, decay, before, samples, lo, hi, vehicles, pitch, o
                 if np.isnan(off):
                     continue
                 s = j * pitch[i] + off
-                for n in range(n_t):
-                    xa = front[n] - s
-                    x2[n] = xa * xa
-                    directivity[n] = broad / (x2[n] + d * d) + _OMNI
-                for k in range(n_r):
-                    rk = r2[k]
+                for a in range(0, n_r, 2):  # the path distances in pairs (near_axle_terms)
+                    ra = r2[a]
+                    if a + 1 == n_r:
+                        for n in range(n_t):
+                            xa = front[n] - s
+                            x2 = xa * xa
+                            d0 = x2 + d * d
+                            x[a, n] += (broad + _OMNI * d0) / (d0 * (x2 + ra))
+                        continue
+                    rb = r2[a + 1]
                     for n in range(n_t):
-                        x[k, n] += directivity[n] / (x2[n] + rk)
+                        xa = front[n] - s
+                        x2 = xa * xa
+                        d0, da, db = x2 + d * d, x2 + ra, x2 + rb
+                        q = (broad + _OMNI * d0) / (d0 * da * db)
+                        x[a, n] += q * db
+                        x[a + 1, n] += q * da
         for k in range(n_r):
             for n in range(n_t):
                 x[k, n] = weight[i] * x[k, n]
