@@ -14,7 +14,7 @@ from __future__ import annotations
 import bisect
 import os
 from collections import Counter
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -41,7 +41,7 @@ from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual, ResidualTracker, predictions_of
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
-from rail_monitor.noise.records import Corrugation, NoisePrediction
+from rail_monitor.noise.records import Corrugation, NoisePrediction, NoiseRows
 from rail_monitor.noise.state_of_pass import state_index
 from rail_monitor.squeal.config import squeal_config
 from rail_monitor.squeal.predict import predict as predict_squeal
@@ -215,7 +215,7 @@ class BatchRun:
             # The corrugation history in chunks on this thread, each chunk's noise on the pool while
             # the next is advanced (the estimator carries the kept passes, _Tail the states a later
             # pass may be predicted on: the chunks give one call's states and predictions).
-            trajs, noise_parts = [], []
+            trajs, noise_jobs, rows = [], [], NoiseRows(len(accepted))
             for lo in range(0, max(len(accepted), 1), HISTORY_CHUNK):
                 part = accepted.take(slice(lo, lo + HISTORY_CHUNK))
                 traj = self.estimator.advance_history(part)
@@ -223,12 +223,13 @@ class BatchRun:
                     self.observer.add_counted(part, traj)
                 states = self._tail.then(traj)
                 on = state_index(states.stamp_ns, states.train_id, part.stamp_ns, part.train_id.tolist())
-                noise_parts.append(_noise_on_states(pool, self.model, part, states.amplitude, traj.constants, on))
+                noise_jobs += _noise_on_states(pool, self.model, part, states.amplitude, traj.constants, on, rows, lo)
                 self._tail = states.last_stamp()
                 trajs.append((lo, traj))
             traj = trajs[0][1] if len(trajs) == 1 else Trajectory.concat(trajs)
-            chunks = [chunk for part in noise_parts for chunk in part()]
-            noise = {name: NoisePrediction.concat([c[name] for c in chunks]) for name in self.model.models}
+            for job in noise_jobs:
+                job.result()
+            noise = rows.predictions()
             squeal = squeal_job.result()
         measured, residuals = self._measured(table, accepted, noise, squeal["risk"])
         self.alerts.on_residuals(residuals)
@@ -300,34 +301,31 @@ def run_models(passes: PassTable, values: Mapping[str, Any], estimator: Corrugat
 
 
 def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable,
-                     amplitude: np.ndarray, constants: StateSnapshot, state_of_pass: np.ndarray
-                     ) -> Callable[[], list[dict[str, NoisePrediction]]]:
+                     amplitude: np.ndarray, constants: StateSnapshot, state_of_pass: np.ndarray, out: NoiseRows,
+                     first_row: int) -> list[Future]:
     """Every model's noise of every accepted pass, each on its state (row of amplitude; -1: passes
-    before any state, on none), submitted as tasks of pool: the call that waits for them and gives
-    the predictions of consecutive runs of the passes, in order."""
+    before any state, on none), as tasks of pool that put their rows into out (the passes being
+    its rows from first_row on)."""
     have = state_of_pass >= 0
     state = Corrugation(constants.bands, amplitude[state_of_pass[have]], constants.grinding_amplitude)
-    with_state = _noise_chunks(pool, model, accepted.take(have), state)
-    without = None if have.all() else _noise_chunks(pool, model, accepted.take(~have))
-
-    def result() -> list[dict[str, NoisePrediction]]:
-        if without is None:
-            return [f.result() for f in with_state]
-        return [{name: NoisePrediction.concat([f.result()[name] for f in with_state]).merged(
-            have, NoisePrediction.concat([f.result()[name] for f in without])) for name in model.models}]
-
-    return result
+    jobs = _noise_chunks(pool, model, accepted.take(have), out, first_row + np.flatnonzero(have), state)
+    return jobs if have.all() else jobs + _noise_chunks(pool, model, accepted.take(~have), out,
+                                                        first_row + np.flatnonzero(~have))
 
 
-def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable,
-                  corrugation: Corrugation | None = None) -> list[Future]:
-    """model.predict_models over chunks of NOISE_CHUNK passes (each pass is independent), one task each."""
+def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable, out: NoiseRows,
+                  rows: np.ndarray, corrugation: Corrugation | None = None) -> list[Future]:
+    """model.predict_models over chunks of NOISE_CHUNK passes (each pass is independent), one task
+    each, putting the passes' predictions at rows of out."""
+    def task(part: slice, state: Corrugation | None) -> None:
+        out.put(rows[part], model.predict_models(passes.take(part), (), state))
+
     jobs = []
     for i in range(0, max(len(passes), 1), NOISE_CHUNK):
-        rows = slice(i, i + NOISE_CHUNK)
+        part = slice(i, i + NOISE_CHUNK)
         state = corrugation if corrugation is None or corrugation.amplitude_m.ndim == 1 else Corrugation(
-            corrugation.wavelength_m, corrugation.amplitude_m[rows], corrugation.post_grinding_m)
-        jobs.append(pool.submit(model.predict_models, passes.take(rows), (), state))
+            corrugation.wavelength_m, corrugation.amplitude_m[part], corrugation.post_grinding_m)
+        jobs.append(pool.submit(task, part, state))
     return jobs
 
 

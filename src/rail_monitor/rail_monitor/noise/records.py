@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, fields, replace
 
@@ -61,11 +62,30 @@ class NoisePrediction:
         return replace(parts[0], **{k: np.concatenate([p.per_pass()[k] for p in parts])
                                     for k in parts[0].per_pass()})
 
-    def merged(self, mask: np.ndarray, other: NoisePrediction) -> NoisePrediction:
-        """These rows where mask is true and other's where it is false, in pass order."""
-        out = {}
-        for k, mine in self.per_pass().items():
-            col = np.empty((len(mask), *mine.shape[1:]), mine.dtype)
-            col[mask], col[~mask] = mine, other.per_pass()[k]
-            out[k] = col
-        return replace(self, **out)
+
+
+class NoiseRows:
+    """Every model's predictions of n passes, filled part by part from any thread (batch mode's
+    noise tasks write their rows as they finish, so no part is copied again at the end)."""
+
+    def __init__(self, n: int) -> None:
+        self.n = n
+        self._columns: dict[str, NoisePrediction] = {}
+        self._lock = threading.Lock()
+
+    def put(self, rows: np.ndarray | slice, predictions: dict[str, NoisePrediction]) -> None:
+        """The predictions of the passes at rows (an index array or a slice of the n)."""
+        if not isinstance(rows, slice) and len(rows) and rows[-1] - rows[0] == len(rows) - 1:
+            rows = slice(int(rows[0]), int(rows[-1]) + 1)  # ascending and contiguous: a block copy
+        for name, p in predictions.items():
+            with self._lock:  # the first part of a model sets its columns' shapes
+                if name not in self._columns:
+                    self._columns[name] = replace(p, **{k: np.empty((self.n, *v.shape[1:]), v.dtype)
+                                                        for k, v in p.per_pass().items()})
+            column = self._columns[name].per_pass()
+            for k, v in p.per_pass().items():
+                column[k][rows] = v
+
+    def predictions(self) -> dict[str, NoisePrediction]:
+        """By model, once every row is put."""
+        return dict(self._columns)
