@@ -64,7 +64,12 @@ def _passes_to_level(x, g, target, out):  # pragma: no cover
             if gm[p] > 0:
                 grows = True
                 alone = min(alone, (target[m] - xm[p]) / gm[p])
-        if _excess(xm, gm, target[m], 0.0)[0] >= 0:
+        # At the level already: f(0) >= 0. Decided without f(0) where its bounds decide it (the band's
+        # r.m.s. lies between its largest component and sqrt(P) times that), which gives the same
+        # branch as evaluating it: f(0) >= x_max - level exactly, as the largest term is exp(0) = 1.
+        top = xm.max()
+        if top >= target[m] or (top + 0.5 * np.log(len(xm)) + 1e-9 >= target[m]
+                                and _excess(xm, gm, target[m], 0.0)[0] >= 0):
             out[m] = 0.0
             continue
         if not grows:
