@@ -58,8 +58,8 @@ class ContactState(NamedTuple):
 
 def _speed_terms(speed_mps: np.ndarray, creepage: np.ndarray, load_n: np.ndarray, k3_n: np.ndarray) -> dict:
     """The fields of a ContactState proportional to V0: Vc = V0 zeta and u_s = V0 W / k3 [m/s]."""
-    return {"crabbing_mps": speed_mps * creepage, "critical_slip_mps": squeal.critical_slip_velocity(speed_mps, load_n,
-                                                                                                      k3_n)}
+    critical = squeal.critical_slip_velocity(speed_mps, load_n, k3_n)
+    return {"crabbing_mps": speed_mps * creepage, "critical_slip_mps": critical}
 
 
 def wheel_radius(site: Site, vehicle_class: np.ndarray) -> np.ndarray:
