@@ -107,9 +107,16 @@ def destroy_nodes(nodes: Sequence[Node]) -> None:
     TEARDOWN_HANG_S prints every thread's stack and ends the process with exit code 1.
     faulthandler's watchdog is a C thread, so it fires even when the hang holds the interpreter
     lock. Nothing is lost: every output was closed before this call."""
-    faulthandler.dump_traceback_later(TEARDOWN_HANG_S, exit=True)
+    _watchdog(TEARDOWN_HANG_S, exit_after=True)
     for n in nodes:
         n.destroy_node()
+
+
+def _watchdog(seconds: float, exit_after: bool) -> None:
+    """After seconds, every thread's stack to the process's standard error (the file descriptor,
+    whatever sys.stderr was replaced by), and with exit_after the process ends (exit code 1)."""
+    with contextlib.suppress(AttributeError, ValueError, OSError):  # no standard error: no watchdog
+        faulthandler.dump_traceback_later(seconds, exit=exit_after, file=sys.__stderr__)
 
 
 def spin_guarded(executor: Any, ok: Callable[[], bool], timeout_sec: float = 0.1) -> None:
@@ -192,7 +199,7 @@ def ros_session(args: list[str] | None = None, flow_control: bool = False,
             wake()
         # A stop still under way after STOP_HANG_S is a hang in rcl or a node: every thread's stack
         # goes to stderr, to say where (the process goes on; a supervisor's kill ends it).
-        faulthandler.dump_traceback_later(STOP_HANG_S, exit=False)
+        _watchdog(STOP_HANG_S, exit_after=False)
 
     previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
