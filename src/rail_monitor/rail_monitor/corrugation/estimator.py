@@ -102,7 +102,7 @@ class CorrugationEstimator:
         steps, summed = kernels.history_sums(self.log_components, self._growth_total, self.growth_by_state, growth,
                                              friction)
         self.log_components = steps[-1].copy()
-        self.season.add(new.stamp_ns, friction, growth, self.k_b, kernels.add_by_day)
+        self.season.add(new.stamp_ns, friction, growth, self.k_b, self.engine)
         self._growth_before = np.concatenate([self._growth_before, summed[:-1]])
         self._growth_total = summed[-1].copy()
         self._axle_sum += int(new.axle_count.sum())

@@ -9,12 +9,10 @@ batch give the same bits.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from rail_monitor.core.timeutil import NS_PER_DAY
-from rail_monitor.models.corrugation import add_by_day
+from rail_monitor.models.engine import corrugation_kernels
 
 SEASON_DAYS = 365  # the profile a forecast follows: the year before the newest pass
 KEPT_DAYS = SEASON_DAYS + 1
@@ -31,9 +29,9 @@ class DailyGrowth:
         self.passes = np.zeros(0, np.int64)
 
     def add(self, stamp_ns: np.ndarray, friction: np.ndarray, growth: np.ndarray, k_b: np.ndarray,
-            add_by_day: Callable[..., None] = add_by_day) -> None:
-        """Passes' stamps [ns], friction states (1-4), log growth (N, B, P) at K_b (4,); add_by_day:
-        an engine's (models.corrugation.add_by_day or its compiled twin)."""
+            engine: str = "numpy") -> None:
+        """Passes' stamps [ns], friction states (1-4), log growth (N, B, P) at K_b (4,); engine: of
+        the sums (models.engine)."""
         if not len(stamp_ns):
             return
         day = np.asarray(stamp_ns, np.int64) // NS_PER_DAY
@@ -48,7 +46,7 @@ class DailyGrowth:
             self.growth, self.passes, self.first_day = grown, count, lo
         f = np.asarray(friction, np.int64) - 1
         scale = np.divide(1.0, k_b, out=np.zeros(4), where=k_b > 0)[f]
-        add_by_day(self.growth, day - self.first_day, f, growth, scale)
+        corrugation_kernels(engine).add_by_day(self.growth, day - self.first_day, f, growth, scale)
         np.add.at(self.passes, day - self.first_day, 1)
         drop = len(self.passes) - KEPT_DAYS
         if drop > 0:

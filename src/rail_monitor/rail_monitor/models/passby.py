@@ -232,12 +232,12 @@ def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, sp
 def pass_by_levels(g: PassGeometry, paths: BandPaths, lpafmax_dba: FloatArray | None = None) -> PassBy:
     """pass_by of the band paths (band_paths) on their geometry, given LpAFmax (None: NaN); the
     A-weighted totals summed in energy, without a round trip through decibels."""
-    mean = _window_mean(paths)
+    mean = _per_line(w * k for w, k, _, _ in paths)   # mean squared pressure over the pass-by time
     exposure = _per_line(w * total for w, _, total, _ in paths)
     a = g.a_weight
     return PassBy(
         lp_db=level(mean),
-        lpaeq_tp_dba=_lpaeq(mean, a),
+        lpaeq_tp_dba=level(np.sum(mean * a, axis=-1)),
         tel_dba=level(np.sum(exposure * a, axis=-1)),
         lpafmax_dba=np.full(len(g.length), np.nan) if lpafmax_dba is None else lpafmax_dba,
         pass_by_time_s=g.length / g.speed,
@@ -250,15 +250,6 @@ def lpaeq_weights(g: PassGeometry, direct_gain: ArrayLike = 1.0) -> FloatArray:
     on that line gives LpAeq,Tp = 10 lg(sum over bands of W Q) (passes x bands) [1/m]. Being linear
     in W, one Q serves every component and every model on the line."""
     return (direct_gain * g.k1 + g.ground_reflection * g.k2) * g.a_weight
-
-
-def _window_mean(paths: BandPaths) -> FloatArray:
-    """Mean squared pressure over the pass-by time per band (passes x bands) [re (20 uPa)^2]."""
-    return _per_line(w * k for w, k, _, _ in paths)
-
-
-def _lpaeq(mean: FloatArray, a_weight: FloatArray) -> FloatArray:
-    return level(np.sum(mean * a_weight, axis=-1))
 
 
 def _per_line(terms: Iterator[FloatArray]) -> FloatArray:
