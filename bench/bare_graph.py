@@ -2,7 +2,8 @@
 
 Each stand-in subscribes and publishes what its real node does (train_pass in; per pass one
 corrugation state, one rolling-noise message per source model, one squeal prediction), but its
-callbacks only publish ready-made messages of a real run's sizes. The recorder is the real
+callbacks only publish ready-made messages of a real run's sizes (CDR bytes, as the real nodes
+publish them). The recorder is the real
 mcap_recorder (discovery, QoS adaptation, raw subscriptions) whose callback only counts. Passed
 to ``wayside_monitor.run_graph``, so the pass source, executor and flow control are the real ones.
 """
@@ -19,7 +20,7 @@ from rail_monitor.app.batch import run_models
 from rail_monitor.bagio import messages as fields
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
-from rail_monitor.nodes.convert import to_msg
+from rail_monitor.nodes.convert import to_cdr
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
 from rail_monitor.nodes.topic_tap import TAKE_AT_ONCE
@@ -35,7 +36,7 @@ from rail_msgs.msg import (
 
 class _StandIn(Node):
     """Takes train_pass (as the model nodes do: the queued passes with each, up to max_batch) and
-    publishes ``outputs`` (publisher, message) per pass."""
+    publishes ``outputs`` (publisher, CDR bytes) per pass."""
 
     def __init__(self, name: str, max_batch: int) -> None:
         super().__init__(name)
@@ -50,12 +51,13 @@ class _StandIn(Node):
     def _on_train_passes(self, msgs: list[TrainPass]) -> None:
         for _ in msgs:
             for pub, out in self.outputs:
-                self.sent.publish(pub, out)
+                pub.publish(out)
+                self.sent[pub.topic_name] += 1
         self.taken += len(msgs)
 
 
 class _Estimator(_StandIn):
-    def __init__(self, state: CorrugationState, max_batch: int) -> None:
+    def __init__(self, state: bytes, max_batch: int) -> None:
         super().__init__("corrugation_estimator", max_batch)
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.outputs = [(self.state_pub, state)]
@@ -70,17 +72,17 @@ class _Models:
 
 
 class _Noise(_StandIn):
-    def __init__(self, noise: list[RollingNoise], max_batch: int) -> None:
+    def __init__(self, noise: dict[str, bytes], max_batch: int) -> None:
         super().__init__("rolling_noise_predictor", max_batch)
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)
-        self.model = _Models(tuple(m.model for m in noise))
+        self.model = _Models(tuple(noise))
         self.pending: list[Any] = []
-        self.outputs = [(self.pub, m) for m in noise]
+        self.outputs = [(self.pub, m) for m in noise.values()]
         subscribe_batched(self, CorrugationState, "corrugation/state", lambda _: None, STATE_SUB_QOS, max_batch)
 
 
 class _Squeal(_StandIn):
-    def __init__(self, squeal: SquealPrediction, max_batch: int) -> None:
+    def __init__(self, squeal: bytes, max_batch: int) -> None:
         super().__init__("squeal_risk_model", max_batch)
         self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
         self.outputs = [(self.pub, squeal)]
@@ -116,10 +118,11 @@ def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
     frame = r.site.site_id
     first = fields.train_pass_fields(r.accepted.row(0), frame)
     snap, fc = r.trajectory.state(0)
-    state = to_msg(CorrugationState, fields.corrugation_state_fields(snap, fc, frame))
-    noise = [to_msg(RollingNoise, fields.rolling_noise_fields(out, 0, first["header"], first["train_id"], r.receiver))
-             for out in r.noise.values()]
-    squeal = to_msg(SquealPrediction, fields.squeal_prediction_fields(r.squeal, 0, first["header"], first["train_id"]))
+    state = to_cdr(CorrugationState, fields.corrugation_state_fields(snap, fc, frame))
+    header, train = first["header"], first["train_id"]
+    noise = {m: to_cdr(RollingNoise, fields.rolling_noise_fields(out, 0, header, train, r.receiver))
+             for m, out in r.noise.items()}
+    squeal = to_cdr(SquealPrediction, fields.squeal_prediction_fields(r.squeal, 0, header, train))
     recorder = type("CountingRecorder", (_CountingRecorder,),
                     {"take_at_once": TAKE_AT_ONCE if max_batch > 1 else 1})
     return (lambda: [_Estimator(state, max_batch), _Noise(noise, max_batch), _Squeal(squeal, max_batch),

@@ -14,12 +14,45 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
+from rosbags.interfaces import Nodetype
 
 TOP = Path(__file__).resolve().parents[1]
 SAMPLE = TOP / "bags" / "sample"
 EXAMPLE_CSV = TOP / "bags" / "example_passes.csv"
 SITE_FILE = TOP / "src" / "rail_monitor" / "config" / "curve_250.yaml"
+
+
+_INTS = {"int8": 7, "uint8": 8, "byte": 8, "char": 8, "int16": 15, "uint16": 16, "int32": 31, "uint32": 32,
+         "int64": 63, "uint64": 64}
+
+
+def _random_value(rng: np.random.Generator, node) -> object:
+    kind, detail = node
+    if kind == Nodetype.BASE:
+        name = detail[0]
+        if name == "string":
+            return "".join(rng.choice(list("ab_Zé€ 0")) for _ in range(int(rng.integers(0, 12))))
+        if name == "bool":
+            return bool(rng.integers(2))
+        if name.startswith("float"):
+            return float(np.float32(rng.normal(0, 1e3))) if name == "float32" else float(rng.normal(0, 1e6))
+        bits = _INTS[name]
+        lo = -(2 ** bits) if name.startswith("int") else 0
+        return int(rng.integers(lo, 2 ** bits, dtype=np.uint64 if bits == 64 and lo == 0 else np.int64))
+    if kind == Nodetype.NAME:
+        return random_fields(rng, detail)
+    length = detail[1] if kind == Nodetype.ARRAY else int(rng.integers(0, 5))
+    return [_random_value(rng, detail[0]) for _ in range(length)]
+
+
+def random_fields(rng: np.random.Generator, typename: str) -> dict:
+    """Random plain fields of every field of a message type (bagio.cdr's input): random string
+    lengths, sequence lengths and values, over each type's whole range."""
+    from rail_monitor.bagio.typestore import typestore
+
+    return {name: _random_value(rng, node) for name, node in typestore().fielddefs[typename][1]}
 
 
 def _claim_domain_group() -> tuple[int, object]:

@@ -17,31 +17,7 @@ from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.bagio.typestore import typestore
 from rail_monitor.nodes.convert import TOPICS
 
-_INTS = {"int8": 7, "uint8": 8, "byte": 8, "char": 8, "int16": 15, "uint16": 16, "int32": 31, "uint32": 32,
-         "int64": 63, "uint64": 64}
-
-
-def _random_value(rng: np.random.Generator, node) -> object:
-    kind, detail = node
-    if kind == Nodetype.BASE:
-        name = detail[0]
-        if name == "string":
-            return "".join(rng.choice(list("ab_Zé€ 0")) for _ in range(int(rng.integers(0, 12))))
-        if name == "bool":
-            return bool(rng.integers(2))
-        if name.startswith("float"):
-            return float(np.float32(rng.normal(0, 1e3))) if name == "float32" else float(rng.normal(0, 1e6))
-        bits = _INTS[name]
-        lo = -(2 ** bits) if name.startswith("int") else 0
-        return int(rng.integers(lo, 2 ** bits, dtype=np.uint64 if bits == 64 and lo == 0 else np.int64))
-    if kind == Nodetype.NAME:
-        return _random_fields(rng, detail)
-    length = detail[1] if kind == Nodetype.ARRAY else int(rng.integers(0, 5))
-    return [_random_value(rng, detail[0]) for _ in range(length)]
-
-
-def _random_fields(rng: np.random.Generator, typename: str) -> dict:
-    return {name: _random_value(rng, node) for name, node in typestore().fielddefs[typename][1]}
+from conftest import random_fields
 
 
 def _rosbags_message(typename: str, fields: dict):
@@ -67,7 +43,7 @@ def test_bytes_equal_rosbags_and_decode_with_rclpy(topic):
     typename = GRAPH_TOPICS[topic][0]
     rng = np.random.default_rng(zlib.crc32(topic.encode()))
     for _ in range(60):
-        data = _random_fields(rng, typename)
+        data = random_fields(rng, typename)
         ours = serialize(typename, data)
         assert ours == bytes(typestore().serialize_cdr(_rosbags_message(typename, data), typename))
         deserialize_message(ours, TOPICS[topic][0])  # rclpy reads it whole
@@ -75,7 +51,7 @@ def test_bytes_equal_rosbags_and_decode_with_rclpy(topic):
 
 def test_missing_fields_are_zero_and_wrong_lengths_are_refused():
     typename = "rail_msgs/msg/CorrugationState"
-    full = _random_fields(np.random.default_rng(1), typename)
+    full = random_fields(np.random.default_rng(1), typename)
     # Fixed-length arrays left out are zeros, as rclpy and rosbags construct them.
     def zero_of(k, v):
         if k == "k_b_by_friction":
@@ -114,7 +90,7 @@ def test_the_decoder_reads_back_ours_and_rclpys_bytes(topic):
     typename = GRAPH_TOPICS[topic][0]
     rng = np.random.default_rng(zlib.crc32(topic.encode()) + 1)
     for _ in range(40):
-        data = _random_fields(rng, typename)
+        data = random_fields(rng, typename)
         assert _same_fields(deserialize(typename, serialize(typename, data)), data)
         # rclpy's bytes (its padding is not zeroed) decode to the fields rclpy itself reads back
         theirs = bytes(serialize_message(to_msg(TOPICS[topic][0], data)))
@@ -127,7 +103,7 @@ def test_cut_or_garbled_bytes_are_one_cdr_error(topic):
 
     typename = GRAPH_TOPICS[topic][0]
     rng = np.random.default_rng(11)
-    whole = serialize(typename, _random_fields(rng, typename))
+    whole = serialize(typename, random_fields(rng, typename))
     for cut in range(len(whole) - 4):  # every prefix short of the last padding bytes
         with pytest.raises(CdrError):
             deserialize(typename, whole[:cut])

@@ -45,7 +45,6 @@ from rail_monitor.corrugation.config import LEAD_TIME
 from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
 from rail_monitor.measured.residuals import Residual, ResidualTracker
 from rail_monitor.nodes.base import Sent, declare, read_views, runs, subscribe_batched, take_queued, wall_timer
-from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
@@ -157,7 +156,7 @@ class AlertManagerNode(PassConsumerNode):
 
     def _residuals(self, residuals: list[Residual]) -> None:
         for r in residuals:
-            self.sent.publish(self.residual_pub, to_msg(NoiseResidual, noise_residual_fields(r, self.site.site_id)))
+            self.sent.publish(self.residual_pub, noise_residual_fields(r, self.site.site_id))
         if residuals:
             self._emit(self.alerts.on_residuals(residuals))
 
@@ -191,15 +190,14 @@ class AlertManagerNode(PassConsumerNode):
 
     def _emit(self, events: list[Alert]) -> None:
         for e in events:
-            self.sent.publish(self.pub, to_msg(WaysideAlert, wayside_alert_fields(e, self.site.site_id)))
+            self.sent.publish(self.pub, wayside_alert_fields(e, self.site.site_id))
             self.get_logger().info(describe(e))
         if events:
             self._publish_standing(events[-1].stamp_ns)
 
     def _publish_standing(self, stamp_ns: int) -> None:
         alerts = sorted(self.alerts.standing.values(), key=lambda a: (a.kind, a.key))
-        self.sent.publish(self.standing_pub, to_msg(WaysideAlertArray, wayside_alert_array_fields(
-            alerts, stamp_ns, self.site.site_id)))
+        self.sent.publish(self.standing_pub, wayside_alert_array_fields(alerts, stamp_ns, self.site.site_id))
 
     def diagnostic_values(self) -> dict[str, Any]:
         events = self.alerts.events

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 import time
 from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -19,6 +19,7 @@ from rail_monitor.bagio.cdr import CdrError, message_view
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamGroups, ParamSpec
 from rail_monitor.core.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
+from rail_monitor.nodes.convert import to_cdr
 from rail_monitor.nodes.process import CALLBACK_ERRORS, SESSION_DEFAULT_SITE
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
 
@@ -224,8 +225,9 @@ class Diagnostics:
 class Sent(Counter):
     """Messages published per topic (resolved name): wayside_monitor drains the recorder against it."""
 
-    def publish(self, pub: Any, msg: Any) -> None:
-        pub.publish(msg)
+    def publish(self, pub: Any, fields: Mapping[str, Any]) -> None:
+        """Publish the message of these plain fields (bagio.messages) as its CDR bytes."""
+        pub.publish(to_cdr(pub.msg_type, fields))
         self[pub.topic_name] += 1
 
 

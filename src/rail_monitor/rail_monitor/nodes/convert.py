@@ -1,5 +1,6 @@
-"""rclpy messages of the plain fields of :mod:`rail_monitor.bagio.messages` (the one place each
-message's fields are written), and the graph's topic table with rclpy types and profiles."""
+"""rclpy messages, and the CDR bytes the nodes publish, of the plain fields of
+:mod:`rail_monitor.bagio.messages` (the one place each message's fields are written), and the
+graph's topic table with rclpy types and profiles."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from typing import Any
 from builtin_interfaces.msg import Time
 
 from rail_monitor.bagio import messages
+from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.nodes.qos import profile
 
@@ -56,6 +58,18 @@ def to_msg(cls: type, fields: Mapping[str, Any]) -> Any:
         else:
             kwargs[name] = how(value) if how is not None else value
     return cls(**kwargs)
+
+
+@functools.cache
+def typename_of(cls: type) -> str:
+    """'pkg/msg/Type' of a generated rclpy class (message_class's inverse)."""
+    return f"{cls.__module__.split('.')[0]}/msg/{cls.__name__}"
+
+
+def to_cdr(cls: type, fields: Mapping[str, Any]) -> bytes:
+    """The CDR bytes of to_msg(cls, fields), packed by bagio.cdr's compiled encoder: what the nodes
+    publish (rclpy sends bytes as they are), so no rclpy message is built and converted per output."""
+    return serialize(typename_of(cls), fields)
 
 
 def time_msg(ns: int) -> Time:

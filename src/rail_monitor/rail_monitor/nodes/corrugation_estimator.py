@@ -45,7 +45,6 @@ from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
 from rail_monitor.measured.observer import IndirectObserver, next_cut
 from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
-from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_SUB_QOS
@@ -144,8 +143,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         obs = self.observer.observe(self.est)
         if obs is None:
             return
-        msg = to_msg(IndirectRoughness, indirect_roughness_fields(obs, self.site.site_id))
-        self.sent.publish(self.indirect_pub, msg)
+        self.sent.publish(self.indirect_pub, indirect_roughness_fields(obs, self.site.site_id))
         if obs.event is not None:
             self._apply(obs.event)
 
@@ -165,15 +163,13 @@ class CorrugationEstimatorNode(PassConsumerNode):
         now = time.monotonic()
         if self.params.state_period_s == 0.0:
             for k in range(len(traj)):
-                self.sent.publish(self.state_pub, to_msg(CorrugationState, corrugation_state_fields(
-                    *traj.state(k), self.site.site_id)))
+                self.sent.publish(self.state_pub, corrugation_state_fields(*traj.state(k), self.site.site_id))
         elif now - self._last_state_t >= self.params.state_period_s:
             self.publish_state()
             self._last_state_t = now
 
     def publish_state(self) -> None:
-        self.sent.publish(self.state_pub, to_msg(CorrugationState, corrugation_state_fields(
-            self.est, self.est.forecast(), self.site.site_id)))
+        self.sent.publish(self.state_pub, corrugation_state_fields(self.est, self.est.forecast(), self.site.site_id))
 
     def noise_model(self) -> RollingNoiseModel:
         """The site's noise model (built at the first use: its tables are not needed until then)."""
@@ -195,8 +191,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         except ValueError as exc:
             self.get_logger().warning(f"no speed advice: {exc}", throttle_duration_sec=60.0)
             return
-        self.sent.publish(self.advisory_pub, to_msg(SpeedAdvisory, speed_advisory_fields(
-            advised, self.est.newest_ns, self.site.site_id)))
+        self.sent.publish(self.advisory_pub, speed_advisory_fields(advised, self.est.newest_ns, self.site.site_id))
 
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         event = event_from_msg(msg)

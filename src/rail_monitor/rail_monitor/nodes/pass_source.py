@@ -25,7 +25,7 @@ from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
 from rail_monitor.nodes.base import DIAGNOSTICS_PERIOD_S, Diagnostics, RailNode, RateMeter, announce, declare
-from rail_monitor.nodes.convert import time_msg, to_msg
+from rail_monitor.nodes.convert import time_msg, to_cdr
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STREAM_QOS
 from rail_msgs.msg import MeasuredPassNoise, RoughnessSurvey, TrainPass
 
@@ -107,7 +107,7 @@ class PassSourceNode(RailNode):
         """Publish a survey or grinding event. In other processes, wait until every subscriber holds
         it before the next pass goes out (the estimator takes queued surveys before passes); in
         this one, DDS has delivered it to the hosted subscribers when publish returns."""
-        self.event_pub.publish(to_msg(RoughnessSurvey, roughness_survey_fields(event, self.cfg.site_id)))
+        self.event_pub.publish(to_cdr(RoughnessSurvey, roughness_survey_fields(event, self.cfg.site_id)))
         self.events_sent += 1
         self._acknowledged(self.event_pub, ok)
 
@@ -115,7 +115,7 @@ class PassSourceNode(RailNode):
         """Publish a measured pass-by, held by every subscriber before the next pass goes out (the
         alert manager scores measurements in stamp order as long as each comes before any later
         pass's predictions)."""
-        self.measured_pub.publish(to_msg(MeasuredPassNoise, measured_pass_noise_fields(m, self.cfg.site_id)))
+        self.measured_pub.publish(to_cdr(MeasuredPassNoise, measured_pass_noise_fields(m, self.cfg.site_id)))
         self.measurements_sent += 1
         self._acknowledged(self.measured_pub, ok)
 
@@ -265,7 +265,7 @@ class PassSourceNode(RailNode):
                     self._send_event(events.pop(0), ok)
                 while measured and measured[0].stamp_ns < stamp:  # after its own pass
                     self._send_measurement(measured.pop(0), ok)
-                self.pub.publish(to_msg(TrainPass, train_pass_fields(table.row(i), frame)))
+                self.pub.publish(to_cdr(TrainPass, train_pass_fields(table.row(i), frame)))
                 self.meter.tick()
                 self.last_stamp_ns = stamp
                 bar.update()

@@ -32,7 +32,6 @@ from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.nodes.base import Sent, declare, isolate_failures, runs, subscribe_batched, wall_timer
-from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
@@ -159,8 +158,8 @@ class RollingNoisePredictor(PassConsumerNode):
             values = self.model.predict_models(_rows(passes), (), corrugation).values()
             for k, p in enumerate(passes):
                 for v in values:
-                    self.sent.publish(self.pub, to_msg(RollingNoise, rolling_noise_fields(
-                        v, k, header_of(p.msg), p.msg.train_id, self.model.receiver)))
+                    self.sent.publish(self.pub, rolling_noise_fields(
+                        v, k, header_of(p.msg), p.msg.train_id, self.model.receiver))
 
         isolate_failures(len(ready), predict, lambda i, exc: self.model_error(ready[i].msg, exc))
 

@@ -14,7 +14,6 @@ from typing import Any
 from rail_monitor.bagio.messages import header_of, squeal_prediction_fields
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Sent, declare
-from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STREAM_QOS
@@ -40,8 +39,8 @@ class SquealRiskNode(PassConsumerNode):
     def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
         values = predict(self.cfg, self.site, table)
         for i, msg in enumerate(msgs):
-            self.sent.publish(self.pub, to_msg(SquealPrediction, squeal_prediction_fields(
-                values, i, header_of(msg), msg.train_id)))
+            self.sent.publish(self.pub, squeal_prediction_fields(
+                values, i, header_of(msg), msg.train_id))
 
     def diagnostic_values(self) -> dict[str, Any]:
         return {**super().diagnostic_values(), "published": sum(self.sent.values())}
