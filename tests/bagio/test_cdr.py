@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import contextlib
 import zlib
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -113,3 +114,22 @@ def test_cut_or_garbled_bytes_are_one_cdr_error(topic):
             garbled[i] = int(rng.integers(256))
         with contextlib.suppress(CdrError):  # any other exception fails the test
             deserialize(typename, bytes(garbled))
+
+
+def _as_dicts(value):
+    if isinstance(value, SimpleNamespace):
+        return {k: _as_dicts(v) for k, v in vars(value).items()}
+    return [_as_dicts(v) for v in value] if isinstance(value, list) else value
+
+
+@pytest.mark.parametrize("topic", sorted(GRAPH_TOPICS))
+def test_a_message_view_holds_the_decoded_fields_as_attributes(topic):
+    from rail_monitor.bagio.cdr import deserialize, message_view
+
+    typename = GRAPH_TOPICS[topic][0]
+    rng = np.random.default_rng(zlib.crc32(topic.encode()) + 3)
+    for _ in range(20):
+        data = random_fields(rng, typename)
+        view = message_view(typename, serialize(typename, data))
+        assert _same_fields(_as_dicts(view), deserialize(typename, serialize(typename, data)))
+        assert _same_fields(_as_dicts(view), data)

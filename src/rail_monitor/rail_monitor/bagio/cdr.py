@@ -209,7 +209,12 @@ def _read_string(data: memoryview, pos: int) -> tuple[str, int]:
     return bytes(data[pos:pos + n - 1]).decode(), pos + n
 
 
-def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Decoder:
+def _fields_of(container: Any) -> dict[str, Any]:
+    """Where a decoder writes a sub-message's fields: the dict itself, or a namespace's __dict__."""
+    return container if isinstance(container, dict) else container.__dict__
+
+
+def _array_decoder(name: str, item: tuple[Any, Any], length: int | None, make: type) -> Decoder:
     kind, detail = item
     if kind == Nodetype.BASE and detail[0] != "string":
         dtype = np.dtype(_BASE[detail[0]]).newbyteorder("<")
@@ -224,7 +229,7 @@ def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Deco
             out[name] = np.frombuffer(data, dtype, n, pos)
             return end
         return numeric
-    sub = None if kind == Nodetype.BASE else _decoder(detail)
+    sub = None if kind == Nodetype.BASE else _decoder(detail, make)
 
     def items(data: memoryview, pos: int, out: dict[str, Any]) -> int:
         n, pos = _read_count(data, pos, length)
@@ -235,8 +240,8 @@ def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Deco
             if sub is None:
                 value, pos = _read_string(data, pos)
             else:
-                value = {}
-                pos = sub(data, pos, value)
+                value = make()
+                pos = sub(data, pos, _fields_of(value))
             values.append(value)
         out[name] = values
         return pos
@@ -244,10 +249,12 @@ def _array_decoder(name: str, item: tuple[Any, Any], length: int | None) -> Deco
 
 
 @functools.cache
-def _decoder(typename: str) -> Decoder:
-    """The compiled decoder of a type: reads one message's fields from an offset, returns the next."""
+def _decoder(typename: str, make: type = dict) -> Decoder:
+    """The compiled decoder of a type: reads one message's fields from an offset into a dict,
+    returns the next; sub-messages are make() (dict, or SimpleNamespace: attributes)."""
     steps = _steps(typename, lambda run: run.decode, lambda name: functools.partial(_string_step, name),
-                   lambda name, sub: functools.partial(_nested_step, name, _decoder(sub)), _array_decoder)
+                   lambda name, sub: functools.partial(_nested_step, name, _decoder(sub, make), make),
+                   lambda name, item, length: _array_decoder(name, item, length, make))
 
     def decode(data: memoryview, pos: int, out: dict[str, Any]) -> int:
         for step in steps:
@@ -261,21 +268,22 @@ def _string_step(name: str, data: memoryview, pos: int, out: dict[str, Any]) -> 
     return pos
 
 
-def _nested_step(name: str, sub: Decoder, data: memoryview, pos: int, out: dict[str, Any]) -> int:
-    out[name] = {}
-    return sub(data, pos, out[name])
+def _nested_step(name: str, sub: Decoder, make: type, data: memoryview, pos: int, out: dict[str, Any]) -> int:
+    out[name] = value = make()
+    return sub(data, pos, _fields_of(value))
 
 
-def deserialize(typename: str, data: bytes) -> dict[str, Any]:
-    """The fields of a message of the type from its CDR bytes (sub-messages as dicts, numeric
-    sequences as read-only numpy arrays over the bytes, strings as str); CdrError for bytes too
-    short for the message they begin (bytes after it are ignored, as rclpy ignores them)."""
+def deserialize(typename: str, data: bytes, make: type = dict) -> Any:
+    """The fields of a message of the type from its CDR bytes as make() (a dict, or with
+    SimpleNamespace attributes; sub-messages alike), numeric sequences as read-only numpy arrays
+    over the bytes, strings as str; CdrError for bytes too short for the message they begin
+    (bytes after it are ignored, as rclpy ignores them)."""
     view = memoryview(data)
     if len(view) < 4 or bytes(view[:2]) != ENCAPSULATION[:2]:
         raise CdrError(f"not little-endian CDR (header {bytes(view[:4])!r})")
-    out: dict[str, Any] = {}
+    out = make()
     try:
-        _decoder(typename)(view, 4, out)
+        _decoder(typename, make)(view, 4, _fields_of(out))
     except (struct.error, UnicodeDecodeError) as exc:
         raise CdrError(f"{typename}: {exc}") from None
     return out
@@ -285,10 +293,4 @@ def message_view(typename: str, data: bytes) -> SimpleNamespace:
     """A message of the type read from CDR bytes with its fields as attributes (sub-messages too):
     what a node reads of a message, without rclpy's conversion to Python objects; CdrError as
     :func:`deserialize`."""
-    return _namespace(deserialize(typename, data))
-
-
-def _namespace(fields: dict[str, Any]) -> SimpleNamespace:
-    return SimpleNamespace(**{k: _namespace(v) if isinstance(v, dict) else
-                              [_namespace(x) if isinstance(x, dict) else x for x in v] if isinstance(v, list) else v
-                              for k, v in fields.items()})
+    return deserialize(typename, data, SimpleNamespace)
