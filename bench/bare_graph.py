@@ -3,9 +3,9 @@
 Each stand-in subscribes and publishes what its real node does (train_pass in; per pass one
 corrugation state, one rolling-noise message per source model, one squeal prediction), but its
 callbacks only publish ready-made messages of a real run's sizes (CDR bytes, as the real nodes
-publish them). The recorder is the real
-mcap_recorder (discovery, QoS adaptation, raw subscriptions) whose callback only counts. Passed
-to ``wayside_monitor.run_graph``, so the pass source, executor and flow control are the real ones.
+publish them). The recorder is the real mcap_recorder (discovery, QoS adaptation, raw
+subscriptions) whose callback only counts. Passed to ``wayside_monitor.run_graph``, so the pass
+source, executor and flow control are the real ones.
 """
 
 from __future__ import annotations
