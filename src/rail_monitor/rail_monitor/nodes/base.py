@@ -227,7 +227,11 @@ class Sent(Counter):
 
     def publish(self, pub: Any, fields: Mapping[str, Any]) -> None:
         """Publish the message of these plain fields (bagio.messages) as its CDR bytes."""
-        pub.publish(to_cdr(pub.msg_type, fields))
+        self.send(pub, to_cdr(pub.msg_type, fields))
+
+    def send(self, pub: Any, data: bytes) -> None:
+        """Publish a message's CDR bytes as they are."""
+        pub.publish(data)
         self[pub.topic_name] += 1
 
 
