@@ -159,6 +159,8 @@ def band_amplitude(log_components: ArrayLike) -> FloatArray:
 
 
 BAND_BLOCK = 16384  # bands evaluated together: (P, BAND_BLOCK) arrays stay in cache
+STEP_TOL = 1e-12  # a band's Newton iteration stops on a step this small relative to its n (or 1 pass)
+LEFT_TOL = 1e-13  # ... or when the error its step leaves is estimated this small, relative likewise
 
 
 def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level: ArrayLike) -> FloatArray:
@@ -171,9 +173,12 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
 
     Evaluated component-major ((P, bands) arrays, so the sums over components are row
     additions, not reductions over a short last axis), in blocks of BAND_BLOCK bands that stay in
-    cache, and only on the bands not yet converged. Each band stops on its own (its step no more
-    than 1e-12 of its n, or none), so a band's result does not depend on which bands it is
-    evaluated with: one state or a whole history, any chunking, give the same bits.
+    cache, and only on the bands not yet converged. Each band stops on its own, so a band's result
+    does not depend on which bands it is evaluated with (one state or a whole history, any
+    chunking, give the same bits): when its step s is no more than STEP_TOL of its n, or when the
+    error Newton's step leaves, about f''/(2 f') s^2 (quadratic convergence; f' is the energy-weighted
+    mean of g_p and f'' twice its variance), is no more than LEFT_TOL of its n, which saves the
+    last evaluation that only confirms convergence.
     """
     x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
     shape = x.shape[:-1]
@@ -188,13 +193,17 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
     return n.reshape(shape)
 
 
-def _excess(x: FloatArray, g: FloatArray, target: FloatArray, n: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """ln(band r.m.s.) - ln(level) after n passes, and its slope in n, for (P, M) components."""
+def _excess(x: FloatArray, g: FloatArray, target: FloatArray,
+            n: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """ln(band r.m.s.) - ln(level) after n passes, its slope and its curvature in n, for (P, M)
+    components."""
     e = 2.0 * (x + g * n)
     top = e.max(axis=0)
     w = np.exp(e - top)
     total = w.sum(axis=0)
-    return 0.5 * (top + np.log(total)) - target, (w * g).sum(axis=0) / total
+    wg = w * g
+    slope = wg.sum(axis=0) / total
+    return 0.5 * (top + np.log(total)) - target, slope, 2.0 * ((wg * g).sum(axis=0) / total - slope * slope)
 
 
 def _passes_to_level(xs: FloatArray, gs: FloatArray, target: FloatArray) -> FloatArray:
@@ -208,10 +217,12 @@ def _passes_to_level(xs: FloatArray, gs: FloatArray, target: FloatArray) -> Floa
     for _ in range(200):
         if not len(active):
             break
-        f, df = _excess(xs[:, active], gs[:, active], target[active], n[active])
-        step = np.where(f > 0, f / np.where(df > 0, df, np.inf), 0.0)
+        f, df, d2f = _excess(xs[:, active], gs[:, active], target[active], n[active])
+        slope = np.where(df > 0, df, np.inf)
+        step = np.where(f > 0, f / slope, 0.0)
         n[active] -= step
-        active = active[step > 1e-12 * np.maximum(n[active], 1.0)]
+        scale = np.maximum(n[active], 1.0)
+        active = active[(step > STEP_TOL * scale) & (0.5 * d2f / slope * step * step > LEFT_TOL * scale)]
     return np.where(at_level, 0.0, np.where(grows, n, np.inf))
 
 

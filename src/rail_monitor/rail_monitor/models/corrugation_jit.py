@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
 MAX_NEWTON_STEPS = 200  # as models.corrugation._passes_to_level
+STEP_TOL, LEFT_TOL = 1e-12, 1e-13  # as models.corrugation
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -41,17 +42,22 @@ def band_log_amplitude(log_components: ArrayLike) -> FloatArray:
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _excess(x, g, target, n):  # pragma: no cover
-    """(ln(band r.m.s.) - ln(level), its slope in n) of one band's components after n passes."""
+    """(ln(band r.m.s.) - ln(level), its slope, its curvature in n) of one band's components
+    after n passes."""
     top = -np.inf
     for p in range(len(x)):
         top = max(top, 2.0 * (x[p] + g[p] * n))
     total = 0.0
     slope = 0.0
+    second = 0.0
     for p in range(len(x)):
         w = np.exp(2.0 * (x[p] + g[p] * n) - top)
         total += w
-        slope += w * g[p]
-    return 0.5 * (top + np.log(total)) - target, slope / total
+        wg = w * g[p]
+        slope += wg
+        second += wg * g[p]
+    slope = slope / total
+    return 0.5 * (top + np.log(total)) - target, slope, 2.0 * (second / total - slope * slope)
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -77,10 +83,12 @@ def _passes_to_level(x, g, target, out):  # pragma: no cover
             continue
         n = alone
         for _ in range(MAX_NEWTON_STEPS):
-            f, df = _excess(xm, gm, target[m], n)
-            step = f / (df if df > 0 else np.inf) if f > 0 else 0.0
+            f, df, d2f = _excess(xm, gm, target[m], n)
+            slope = df if df > 0 else np.inf
+            step = f / slope if f > 0 else 0.0
             n -= step
-            if not step > 1e-12 * max(n, 1.0):
+            scale = max(n, 1.0)
+            if not (step > STEP_TOL * scale and 0.5 * d2f / slope * step * step > LEFT_TOL * scale):
                 break
         out[m] = n
 

@@ -184,8 +184,7 @@ class RollingNoiseModel:
             names = list(components)
             growth = np.zeros(len(passes))
             if corrugation is not None:
-                _, ground = self._sources(self.baseline_db, passes, model, filter_db)
-                growth = pb.lpaeq_tp_dba - self._lpaeq(ground, weights)
+                growth = pb.lpaeq_tp_dba - self._baseline_lpaeq(passes, model, filter_db, components, weights)
             out[model] = NoisePrediction(
                 model=model, band_centre_hz=self.band_hz, component_names=names, speed_mps=passes.speed_mps,
                 lp_db=pb.lp_db, lw_db=level(sum(components.values())), roughness_db=roughness,
@@ -298,7 +297,28 @@ class RollingNoiseModel:
     @staticmethod
     def _lpaeq(components: dict[str, np.ndarray], weights: dict[bool, np.ndarray]) -> np.ndarray:
         """LpAeq,Tp of the components (power ratios) alone [dB(A)] (passes,), by their lines' weights."""
-        return level(sum(np.sum(w * weights[c in SOURCE_B_COMPONENTS], axis=-1) for c, w in components.items()))
+        return level(_weighted(components, weights))
+
+    def _baseline_lpaeq(self, passes: PassTable, model: str, filter_db: np.ndarray | None,
+                        components: dict[str, np.ndarray], weights: dict[bool, np.ndarray]) -> np.ndarray:
+        """LpAeq,Tp [dB(A)] (passes,) on the baseline rail roughness: the roughness-driven
+        components share one effective roughness, so their transfers are summed per source line
+        before weighting; the other sources (traction, aerodynamic) are those of ``components``."""
+        per_metre = passes.axle_count / passes.train_length_m
+        total = np.zeros(len(passes))
+        rolling: set[str] = set()
+        for name, rows in _class_rows(passes):
+            energy, transfers = self._roughness(self.baseline_db, self.classes[name], passes.speed_mps[rows], model,
+                                                None if filter_db is None else filter_db[rows])
+            lines: dict[bool, np.ndarray] = {}
+            for comp, lh in transfers.items():
+                on_b = comp in SOURCE_B_COMPONENTS
+                lines[on_b] = lines.get(on_b, 0.0) + power(lh)
+                rolling.add(comp)
+            total[rows] = per_metre[rows] * sum(np.sum(energy * t * weights[b][rows], axis=-1)
+                                                for b, t in lines.items())
+        others = {c: w for c, w in components.items() if c not in rolling}
+        return level(total + _weighted(others, weights))
 
     def _roughness(self, rail_db: np.ndarray, terms: ClassTerms, speed: np.ndarray, model: str,
                    filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -315,6 +335,11 @@ class RollingNoiseModel:
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
         return power(lr), terms.mechanics
+
+
+def _weighted(components: dict[str, np.ndarray], weights: dict[bool, np.ndarray]) -> np.ndarray | float:
+    """The sum over components and bands of power times its line's LpAeq weight (passes,)."""
+    return sum((np.sum(w * weights[c in SOURCE_B_COMPONENTS], axis=-1) for c, w in components.items()), 0.0)
 
 
 def _class_rows(passes: PassTable) -> Iterator[tuple[str, np.ndarray]]:
