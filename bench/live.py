@@ -8,6 +8,8 @@ listens to the outputs. Latency of a pass: from its publication to the arrival o
 processes over the period, as a share of one core. Start-up: wayside_monitor (the one-process graph)
 on a one-pass history, from its spawn to the probe's receipt of its first output, with its
 resident memory then (its replayer waits for the probe's subscription, as for its own nodes').
+The same idle and rate measurements are then made of the one-process graph as a site would run it
+with its own detector driver: wayside_monitor with listen:=true, the probe publishing the passes.
 
 Run alone: ros2_ws/run python -m bench.live [--rate 100 --seconds 10]
 """
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import subprocess
 import tempfile
 import threading
@@ -89,7 +92,7 @@ class Probe:
         """Publish sample pass i stamped now, under a fresh train id."""
         row = self.passes.row(i % len(self.passes))
         row["stamp_ns"] = time.time_ns()
-        row["train_id"] = f"probe-{i}"
+        row["train_id"] = f"probe-{len(self.sent)}"
         msg = self._to_msg(self._cls, self._fields(row, "curve_250"))
         with self.lock:
             self.sent[row["train_id"]] = time.monotonic()
@@ -134,12 +137,18 @@ def start_up(site: str, probe: Probe, source: str, timeout_s: float = 60.0) -> d
     return {"seconds": seconds, "cpu_s": cpu, "rss_mb": mem}
 
 
-def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle_s: float) -> dict[str, Any]:
-    """The separate-process graph: idle CPU, then per rate CPU share and latency percentiles."""
+def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle_s: float,
+               one_process: bool = False) -> dict[str, Any]:
+    """The separate-process graph (or, one_process, wayside_monitor listening): idle CPU, then per
+    rate CPU share and latency percentiles."""
     with tempfile.TemporaryDirectory() as tmp:
-        procs = [_spawn(exe, site) for exe in MODEL_EXECUTABLES]
-        procs.append(_spawn("mcap_recorder", site, f"output:={Path(tmp) / 'bag'}"))
-        names = [*MODEL_EXECUTABLES, "mcap_recorder"]
+        bag = f"output:={Path(tmp) / 'bag'}"
+        if one_process:
+            procs, names = [_spawn("wayside_monitor", site, "listen:=true", bag)], ["wayside_monitor"]
+        else:
+            procs = [_spawn(exe, site) for exe in MODEL_EXECUTABLES]
+            procs.append(_spawn("mcap_recorder", site, bag))
+            names = [*MODEL_EXECUTABLES, "mcap_recorder"]
         try:
             t0 = time.monotonic()
             while probe.subscribers() < len(MODEL_EXECUTABLES) + 2 and time.monotonic() - t0 < 60:
@@ -175,7 +184,7 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
                 time.sleep(1.0)
         finally:
             for p in procs:
-                p.terminate()
+                p.send_signal(signal.SIGINT)  # wayside_monitor finishes its bag on SIGINT, as the others
             for p in procs:
                 p.wait(timeout=60)
     return out
@@ -194,6 +203,7 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             cold = start_up(site, probe, str(one))  # the site's tables built, unless cached before
             s = start_up(site, probe, str(one))
         g = live_graph(site, probe, rates, seconds, idle_s)
+        one = live_graph(site, probe, rates, seconds, idle_s, one_process=True)
     finally:
         probe.close()
     out = [("wayside_monitor start-up to first output", f"{s['seconds']:.2f} s",
@@ -205,11 +215,19 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             + ", ".join(f"{name} {100 * c:.1f} %" for name, c in g["idle_per_process"].items()))]
     for rate in rates:
         r = g[rate]
-        out.append((f"live graph, {rate:g} passes/s arriving one at a time", f"{100 * r['core']:.0f} % of a core",
-                    f"latency pass to last output p50 {r['p50_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms over "
-                    f"{r['passes']} passes" + (f"; {r['lost']} incomplete" if r["lost"] else "") + "; by process: "
-                    + ", ".join(f"{name} {100 * c:.0f} %" for name, c in r["per_process"].items())))
+        out.append(_rate_row(f"live graph, {rate:g} passes/s arriving one at a time", r, "; by process: "
+                             + ", ".join(f"{name} {100 * c:.0f} %" for name, c in r["per_process"].items())))
+    out.append(("one-process graph idle (wayside_monitor listen:=true)", f"{100 * one['idle_core']:.1f} % of a core",
+                f"over {idle_s:g} s with no passes"))
+    out += [_rate_row(f"one-process graph, {rate:g} passes/s arriving one at a time", one[rate],
+                      "; wayside_monitor listen:=true, the passes from the probe's process") for rate in rates]
     return out
+
+
+def _rate_row(what: str, r: dict[str, Any], detail: str) -> tuple[str, str, str]:
+    return (what, f"{100 * r['core']:.0f} % of a core",
+            f"latency pass to last output p50 {r['p50_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms over {r['passes']} passes"
+            + (f"; {r['lost']} incomplete" if r["lost"] else "") + detail)
 
 
 def main() -> None:

@@ -324,6 +324,35 @@ def test_separate_processes_equal_batch(runs, tmp_path):
     _assert_same_messages(tmp_path / "bag", runs["tmp"] / "batch")
 
 
+def test_wayside_monitor_listening_to_another_process_equals_batch(runs, tmp_path):
+    """listen:=true: the models and the recorder in one process, the passes (with the surveys and
+    measurements) from a replayer in another, as from a wayside detector's driver; SIGINT ends it
+    with the bag finished."""
+    ns = ["-r", "__ns:=/curve_250", "--params-file", str(runs["site"]), "-p", "use_sim_time:=true"]
+    with open(tmp_path / "monitor.log", "w") as log:
+        monitor = subprocess.Popen(["wayside_monitor", "--ros-args", *ns, "-p", "listen:=true",
+                                    "-p", f"output:={tmp_path / 'bag'}"], cwd=TOP, stdout=log, stderr=subprocess.STDOUT)
+    try:
+        r = run_cmd("pass_replayer", "--ros-args", "-r", "__ns:=/curve_250", "--params-file", str(runs["site"]),
+                    "-p", f"source:={runs['history']}", "-p", "rate:=0.0", "-p", "wait_for_subscribers:=5",
+                    "-p", f"end_offset_s:={DAYS * 86400}", "-p", "progress:=false", timeout=240)
+        assert r.returncode == 0, r.stderr[-2000:]
+    finally:
+        monitor.send_signal(signal.SIGINT)
+        code = monitor.wait(timeout=60)
+    out = (tmp_path / "monitor.log").read_text()
+    assert code == 0 and "Traceback" not in out, out[-2000:]
+    assert f"wayside_monitor: {len(_slice())} passes through the graph" in out and "of the listening" in out
+    _assert_equal_runs(load_run(tmp_path / "bag"), runs["batch"])
+    _assert_same_messages(tmp_path / "bag", runs["tmp"] / "batch")
+
+
+def test_wayside_monitor_refuses_a_source_while_listening():
+    r = run_cmd("wayside_monitor", "--ros-args", "-p", "listen:=true", "-p", f"source:={SAMPLE}", timeout=60)
+    assert r.returncode != 0 and "listen:=true takes the passes from other processes" in r.stderr
+    assert "Traceback" not in r.stderr
+
+
 @contextlib.contextmanager
 def _two_hosts() -> Iterator[tuple[str, str]]:
     """Two network namespaces joined by a veth pair (10.77.0.1 and .2/24), each with loopback up

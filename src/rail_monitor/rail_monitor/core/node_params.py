@@ -103,6 +103,8 @@ FOXGLOVE_SPECS: tuple[ParamSpec, ...] = (
 MONITOR_SPECS: tuple[ParamSpec, ...] = (
     STOP_TIMEOUT,
     ParamSpec("record", True, "Host an mcap_recorder for every output topic."),
+    ParamSpec("listen", False, "Take train_pass (and surveys, measured pass-bys) from other processes, a wayside "
+              "detector's driver, instead of replaying source or simulating; run until SIGINT or SIGTERM."),
     ParamSpec("drain_timeout_s", 60.0, "After the replay, wait at most this for the recorder to catch up [s].",
               0.0, 3600.0),
     ParamSpec("executor", "single_threaded", "Executor hosting the nodes: single_threaded, or multi_threaded "

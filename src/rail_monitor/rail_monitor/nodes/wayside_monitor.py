@@ -4,6 +4,11 @@ corrugation_estimator, rolling_noise_predictor, squeal_risk_model, alert_manager
 Runs on pass time; exits when the history has been replayed, every model has taken every pass and
 the recorder holds every message the nodes published (then a final speed advisory on the final
 state); prints a summary.
+
+With ``listen:=true`` it hosts no source: the passes come from other processes (a wayside
+detector's driver publishing train_pass), on their own stamps, until SIGINT or SIGTERM; then it
+takes what was already sent (``stop_timeout_s``), publishes the advice on the final state and
+finishes the bag.
 """
 
 from __future__ import annotations
@@ -49,7 +54,8 @@ class MonitorResult:
     bag: str | None
     wall_s: float                     # start to finish, set-up included [s]
     rejected: dict[str, int] = field(default_factory=dict)
-    replay_s: float = 0.0             # first pass published to the last output recorded [s]
+    replay_s: float = 0.0             # first pass published (or listening) to the last output recorded [s]
+    listened: bool = False            # the passes came from other processes (listen:=true)
 
 
 class _Settings(RailNode):
@@ -83,17 +89,24 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
             recorder = make_recorder() if settings.cfg.record else None
             models = make_models()
             nodes += ([recorder] if recorder is not None else []) + models
-            source = PassReplayer() if settings.cfg.source else PassSimulator()
-            nodes.append(source)
-            hosted = len(models) + (recorder is not None)
-            source.foreign_subscribers = source.cfg.wait_for_subscribers > hosted
-            source.cfg = replace(source.cfg, wait_for_subscribers=max(source.cfg.wait_for_subscribers, hosted))
-            source.consumed = _passes_through(models, recorder, source.pub.topic_name)
+            source = None
+            if settings.cfg.listen:
+                if settings.cfg.source:
+                    raise RailMonitorError("listen:=true takes the passes from other processes: leave source empty")
+            else:
+                source = PassReplayer() if settings.cfg.source else PassSimulator()
+                nodes.append(source)
+                hosted = len(models) + (recorder is not None)
+                source.foreign_subscribers = source.cfg.wait_for_subscribers > hosted
+                source.cfg = replace(source.cfg, wait_for_subscribers=max(source.cfg.wait_for_subscribers, hosted))
+                source.consumed = _passes_through(models, recorder, source.pub.topic_name)
             executor = _make_executor(settings.cfg.executor, settings.cfg.threads)
             for n in nodes:
                 executor.add_node(n)
             spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()), daemon=True)
             spinner.start()
+            if source is None:
+                return _listen(models, recorder, settings.cfg, stop, t0)
             return _replay(source, models, recorder, settings.cfg, stop, t0)
         finally:
             finished.set()
@@ -135,20 +148,45 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
          and alerts.inputs["noise/measured"] >= source.measurements_sent,
          lambda: f"alert_manager took {dict(alerts.inputs)}")
     estimator.publish_advisory()  # the advice on the final state
+    sent = {source.pub.topic_name: published}
+    for pub, n in ((source.event_pub, source.events_sent), (source.measured_pub, source.measurements_sent)):
+        if pub is not None:
+            sent[pub.topic_name] = n
+    return _finish(models, recorder, sent, wait, published, t0, t_replay)
+
+
+def _listen(models: list[PassConsumerNode], recorder: McapRecorder | None, cfg: MonitorParams,
+            stop: threading.Event, t0: float) -> MonitorResult:
+    """Take the passes other processes publish until SIGINT or SIGTERM; then, within
+    stop_timeout_s, the backlog, the advice on the final state and the recorder's catching up."""
+    t_listen = time.monotonic()
+    stop.wait()
+    estimator, predictor, _, _ = models
+    deadline = time.monotonic() + cfg.stop_timeout_s
+
+    def wait(done: Callable[[], bool], what: Callable[[], str]) -> None:
+        _wait(done, max(deadline - time.monotonic(), 0.0), what, raise_error=False)
+
+    wait(lambda: not predictor.pending, lambda: "rolling_noise_predictor still holds passes")
+    estimator.publish_advisory()
+    return replace(_finish(models, recorder, {}, wait, estimator.taken, t0, t_listen), listened=True)
+
+
+def _finish(models: list[PassConsumerNode], recorder: McapRecorder | None, sent: dict[str, int],
+            wait: Callable[[Callable[[], bool], Callable[[], str]], None], published: int, t0: float,
+            t_first: float) -> MonitorResult:
+    """Wait until the recorder holds every message sent (the models' and ``sent``), finish the bag."""
     recorded: dict[str, int] = {}
     bag = None
     if recorder is not None:
-        sent = {source.pub.topic_name: published}
-        for pub, n in ((source.event_pub, source.events_sent), (source.measured_pub, source.measurements_sent)):
-            if pub is not None:
-                sent[pub.topic_name] = n
+        sent = dict(sent)
         for m in models:
             sent.update(m.sent)
         wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
              lambda: f"recorder got {dict(recorder.counts)} of {sent}")
         if recorder.writer.error:  # e.g. a full disk: say so now, not after the drain timeout
             raise RailMonitorError(recorder.writer.error)
-    replay_s = time.monotonic() - t_replay
+    replay_s = time.monotonic() - t_first
     if recorder is not None:
         bag = str(recorder.close())
         recorded = dict(recorder.counts)
@@ -221,7 +259,8 @@ def main(args: list[str] | None = None) -> int:
     def run() -> int:
         r = run_graph(args)
         print(f"wayside_monitor: {r.published} passes through the graph in {r.wall_s:.1f} s "
-              f"({r.published / max(r.replay_s, 1e-9):.0f} passes/s over the {r.replay_s:.1f} s of the replay)")
+              f"({r.published / max(r.replay_s, 1e-9):.0f} passes/s over the {r.replay_s:.1f} s of the "
+              + ("listening)" if r.listened else "replay)"))
         if r.bag:
             print(f"recorded {sum(r.recorded.values())} messages to {r.bag}: "
                   + ", ".join(f"{t} {n}" for t, n in sorted(r.recorded.items())))
