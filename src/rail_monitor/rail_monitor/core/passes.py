@@ -134,10 +134,12 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     rolling-stock table. Checks are vectorised; the table is not modified.
     """
     n = len(table)
-    reasons = np.full(n, "", dtype=object)
+    whys = [""]
+    first = np.zeros(n, np.int16)  # index in whys of each pass's first failing check (0: none yet)
 
     def flag(bad: np.ndarray, why: str) -> None:
-        reasons[(reasons == "") & bad] = why
+        whys.append(why)
+        first[(first == 0) & bad] = len(whys) - 1
 
     ids = table.train_id.tolist()
     flag(table.stamp_ns == 0, "stamp not set")
@@ -175,13 +177,13 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
         known = np.array([c in site.vehicles for c in table.vehicle_class], dtype=bool)
         flag(~known, "vehicle_class unknown to the site")
         # A zero length is filled from the counts and the class: that length must be plausible too.
-        ok = reasons == ""
+        ok = first == 0
         filled = with_class_defaults(table.take(ok), site).train_length_m
         implied = np.zeros(n)
         implied[ok] = filled
         flag(implied > MAX_TRAIN_LENGTH_M,
              f"train length from vehicle_count and the class's vehicle length above {MAX_TRAIN_LENGTH_M:g} m")
-    return reasons
+    return np.array(whys, dtype=object)[first]
 
 
 def ahead_of_stream(stamp_ns: np.ndarray, usable: np.ndarray, newest_ns: int, margin_ns: int
