@@ -227,14 +227,17 @@ class BatchRun:
                 self._tail = states.last_stamp()
                 trajs.append((lo, traj))
             traj = trajs[0][1] if len(trajs) == 1 else Trajectory.concat(trajs)
+            squeal = squeal_job.result()
+            _feed_alerts(self.alerts, table, reasons, accepted, squeal, traj)  # while the noise is finishing
             for job in noise_jobs:
                 job.result()
             noise = rows.predictions()
-            squeal = squeal_job.result()
         measured, residuals = self._measured(table, accepted, noise, squeal["risk"])
         self.alerts.on_residuals(residuals)
-        events = sorted(self._held + _feed_alerts(self.alerts, table, reasons, accepted, squeal, traj, noise),
-                        key=_alert_key)
+        for name, out in noise.items():
+            self.alerts.on_noise(accepted.stamp_ns, name, out.per_pass())
+        events, self.alerts.events = self.alerts.events, []
+        events = sorted(self._held + events, key=_alert_key)
         later = int(table.stamp_ns[-1]) if len(table) else np.iinfo(np.int64).min
         self._held = [a for a in events if a.stamp_ns >= later]  # may tie with the next chunk's first pass
         return BatchResult(self.site, table, reasons, accepted, squeal, traj, noise,
@@ -334,15 +337,12 @@ def _alert_key(a: Alert) -> tuple[int, int, str, bool]:
 
 
 def _feed_alerts(alerts: AlertManager, table: PassTable, reasons: np.ndarray, accepted: PassTable,
-                 squeal: dict[str, np.ndarray], traj: Trajectory, noise: dict[str, NoisePrediction]) -> list[Alert]:
-    """The alert manager over each stream in its own order (streams do not interact), a stream at
-    once; the events."""
+                 squeal: dict[str, np.ndarray], traj: Trajectory) -> None:
+    """The alert manager over the input, squeal and state streams, a stream at once. Streams do not
+    interact and their events are put in one order afterwards, so the noise and the residuals may be
+    fed later."""
     alerts.on_train_passes(table.stamp_ns, reasons != "")
     alerts.on_squeal(accepted.stamp_ns, squeal["risk"])
-    for name, out in noise.items():
-        alerts.on_noise(accepted.stamp_ns, name, out.per_pass())
     c, f = traj.constants, traj.forecast
     alerts.on_states(traj.stamp_ns, c.bands, traj.amplitude, c.threshold, f.days_to_threshold, f.grinding_due,
                      f.grinding_due_ns)
-    events, alerts.events = alerts.events, []
-    return events
