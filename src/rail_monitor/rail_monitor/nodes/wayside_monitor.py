@@ -35,6 +35,8 @@ from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.pass_replayer import PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
 from rail_monitor.nodes.process import (
+    IDLE_SPIN_TIMEOUT_S,
+    CoalescingExecutor,
     asked_for_help,
     destroy_nodes,
     exit_code,
@@ -100,10 +102,12 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
                 source.foreign_subscribers = source.cfg.wait_for_subscribers > hosted
                 source.cfg = replace(source.cfg, wait_for_subscribers=max(source.cfg.wait_for_subscribers, hosted))
                 source.consumed = _passes_through(models, recorder, source.pub.topic_name)
-            executor = _make_executor(settings.cfg.executor, settings.cfg.threads)
+            executor = _make_executor(settings.cfg.executor, settings.cfg.threads, settings.cfg.listen)
             for n in nodes:
                 executor.add_node(n)
-            spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()), daemon=True)
+            # Woken for work or by shut_down(executor), not on a short timeout: idle, only the nodes' timers run.
+            spinner = threading.Thread(target=spin_guarded, args=(executor, lambda: not finished.is_set()),
+                                       kwargs={"timeout_sec": IDLE_SPIN_TIMEOUT_S}, daemon=True)
             spinner.start()
             if source is None:
                 return _listen(models, recorder, settings.cfg, stop, t0)
@@ -231,9 +235,11 @@ def _wait(done: Callable[[], bool], timeout_s: float, what: Callable[[], str], r
         time.sleep(0.02)
 
 
-def _make_executor(kind: str, threads: int) -> Executor:
+def _make_executor(kind: str, threads: int, listen: bool) -> Executor:
     if kind == "single_threaded":
-        return SingleThreadedExecutor()
+        # Listening, passes arrive one at a time: take each one's messages from one wait set. A
+        # replay is paced by what the nodes took, and a pause at each wake-up would slow it.
+        return CoalescingExecutor() if listen else SingleThreadedExecutor()
     return MultiThreadedExecutor(num_threads=threads)
 
 
