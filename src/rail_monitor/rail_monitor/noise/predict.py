@@ -17,8 +17,8 @@ for the class's brake type.
 
 Per pass: the class's wheel (diameter; the transfers use the Hertz contact stiffness at its
 nominal load, tabulated per class; the mechanics model's contact filter takes the pass's own
-patch from its contact state, rail_monitor.core.contact; CNOSSOS's is the Directive's table for
-the class's nominal load and diameter), axles and length from the pass (class defaults filled),
+Hertz patch, from its wheel and load as in its contact state; CNOSSOS's is the Directive's table
+for the class's nominal load and diameter), axles and length from the pass (class defaults filled),
 speed from the pass. Sound power per metre of train: L_W' = L_R,TOT + L_H + 10 lg(axles / length)
 per band.
 """
@@ -30,7 +30,7 @@ from collections.abc import Iterator, Sequence
 
 import numpy as np
 
-from rail_monitor.core.contact import contact_state
+from rail_monitor.core.contact import wheel_radius
 from rail_monitor.core.passes import KMH_PER_MPS, PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
@@ -220,7 +220,8 @@ class RollingNoiseModel:
         for CNOSSOS, whose filter is in its tables."""
         if model == "cnossos":
             return None
-        patch_a = np.asarray(contact_state(self.site, passes).patch.a)
+        patch = self.site.contact_patch(wheel_radius(self.site, passes.vehicle_class), passes.wheel_load_n)
+        patch_a = np.asarray(patch.a)
         if self.cfg.contact_filter == "hertz_line":
             return level(wrn.contact_filter_power(passes.speed_mps, self.band, patch_a, self.cfg.band_points))
         out = np.empty((len(passes), len(self.band)))
