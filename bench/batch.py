@@ -127,6 +127,8 @@ def main() -> None:
                     "threads (default: every CPU)")
     ap.add_argument("--streamed", type=float, help="only the streamed run of this many passes; prints passes, "
                     "seconds and peak RSS [MB]")
+    ap.add_argument("--repeat", type=int, default=1, help="run each size this many times in the process (the "
+                    "first run also pays the first touch of its memory)")
     ns = ap.parse_args()
     values = load_parameter_file(ns.site)
     if ns.cores:
@@ -136,8 +138,9 @@ def main() -> None:
         return
     print(f"set-up (site tables, once per process): {set_up_s(values):.2f} s")
     for size in (int(float(x)) for x in ns.sizes.split(",")):
-        n, t, _ = timed(values, size, ns.cores)
-        print(f"{n:>9,} passes: {t:8.2f} s = {n / t:9.0f} passes/s (peak RSS so far {peak_rss_mb():.0f} MB)")
+        for _ in range(ns.repeat):
+            n, t, _ = timed(values, size, ns.cores)
+            print(f"{n:>9,} passes: {t:8.2f} s = {n / t:9.0f} passes/s (peak RSS so far {peak_rss_mb():.0f} MB)")
 
 
 if __name__ == "__main__":
