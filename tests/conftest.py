@@ -153,7 +153,8 @@ def tmpfs(tmp_path: Path):
 def run_cmd(*args: str, timeout: float = 120.0, **kw) -> subprocess.CompletedProcess:
     """Run a workspace executable (PATH set by ros2_ws/run) and capture its output."""
     env = {**os.environ, **kw.pop("env", {})}
-    return subprocess.run(list(args), capture_output=True, text=True, timeout=timeout, env=env, cwd=TOP, **kw)
+    cwd = kw.pop("cwd", TOP)
+    return subprocess.run(list(args), capture_output=True, text=True, timeout=timeout, env=env, cwd=cwd, **kw)
 
 
 

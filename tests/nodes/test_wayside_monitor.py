@@ -347,10 +347,12 @@ def test_wayside_monitor_listening_to_another_process_equals_batch(runs, tmp_pat
     _assert_same_messages(tmp_path / "bag", runs["tmp"] / "batch")
 
 
-def test_wayside_monitor_refuses_a_source_while_listening():
-    r = run_cmd("wayside_monitor", "--ros-args", "-p", "listen:=true", "-p", f"source:={SAMPLE}", timeout=60)
+def test_wayside_monitor_refuses_a_source_while_listening(tmp_path):
+    r = run_cmd("wayside_monitor", "--ros-args", "-p", "listen:=true", "-p", f"source:={SAMPLE}", timeout=60,
+                cwd=tmp_path)
     assert r.returncode != 0 and "listen:=true takes the passes from other processes" in r.stderr
     assert "Traceback" not in r.stderr
+    assert not list(tmp_path.iterdir())  # refused before any bag was begun
 
 
 @contextlib.contextmanager

@@ -88,14 +88,13 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
         try:
             settings = _Settings()
             nodes.append(settings)
+            if settings.cfg.listen and settings.cfg.source:  # refused before a bag is begun
+                raise RailMonitorError("listen:=true takes the passes from other processes: leave source empty")
             recorder = make_recorder() if settings.cfg.record else None
             models = make_models()
             nodes += ([recorder] if recorder is not None else []) + models
             source = None
-            if settings.cfg.listen:
-                if settings.cfg.source:
-                    raise RailMonitorError("listen:=true takes the passes from other processes: leave source empty")
-            else:
+            if not settings.cfg.listen:
                 source = PassReplayer() if settings.cfg.source else PassSimulator()
                 nodes.append(source)
                 hosted = len(models) + (recorder is not None)
