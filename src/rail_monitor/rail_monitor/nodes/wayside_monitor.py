@@ -172,7 +172,8 @@ def _listen(models: list[PassConsumerNode], recorder: McapRecorder | None, cfg: 
 
     wait(lambda: not predictor.pending, lambda: "rolling_noise_predictor still holds passes")
     estimator.publish_advisory()
-    return replace(_finish(models, recorder, {}, wait, estimator.taken, t0, t_listen), listened=True)
+    taken = {estimator.resolve_topic_name("train_pass"): estimator.taken}  # the recorder takes them too
+    return replace(_finish(models, recorder, taken, wait, estimator.taken, t0, t_listen), listened=True)
 
 
 def _finish(models: list[PassConsumerNode], recorder: McapRecorder | None, sent: dict[str, int],
