@@ -21,3 +21,13 @@ def test_kalker_table_nodes_and_properties():
     assert np.all(np.diff(kalker.creep_coefficients(1.4, np.linspace(0, 0.5, 11)).c22) > 0)
     with pytest.raises(ValueError):
         kalker.creep_coefficients(20.0, 0.28)
+
+
+def test_the_lateral_coefficient_alone_is_the_tables_c22():
+    """lateral_creep_coefficient reads only C22's columns: the same numbers as creep_coefficients' C22
+    over the table's range of a/b and nu (exact at its nodes: Kalker 1990, Table E.3)."""
+    rng = np.random.default_rng(4)
+    ratios, nus = np.exp(rng.uniform(np.log(0.1), np.log(10.0), 500)), rng.uniform(0.0, 0.5, 500)
+    np.testing.assert_allclose(kalker.lateral_creep_coefficient(ratios, nus),
+                               kalker.creep_coefficients(ratios, nus).c22, rtol=1e-15, atol=0.0)
+    assert kalker.lateral_creep_coefficient(1.0, 0.25) == pytest.approx(3.67, abs=1e-12)

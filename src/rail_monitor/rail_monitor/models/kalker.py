@@ -76,6 +76,17 @@ def creep_coefficients(a_over_b: ArrayLike, nu: ArrayLike) -> CreepCoefficients:
     Kalker (1990) Table E.3, interpolated linearly in ln(a/b) and quadratically in nu
     (0 <= nu <= 0.5). Exact at the table's nodes.
     """
+    c = _interpolated(a_over_b, nu, (0, 1, 2))
+    return CreepCoefficients(c[..., 0], c[..., 1], c[..., 2])
+
+
+def lateral_creep_coefficient(a_over_b: ArrayLike, nu: ArrayLike) -> FloatArray:
+    """C22 [-] alone, as :func:`creep_coefficients` gives it (the other two columns not read)."""
+    return _interpolated(a_over_b, nu, (1,))[..., 0]
+
+
+def _interpolated(a_over_b: ArrayLike, nu: ArrayLike, coefficients: tuple[int, ...]) -> FloatArray:
+    """The table's coefficients (indices into C11, C22, C23) at (a/b, nu): shape (..., coefficients)."""
     ratio, nu = np.broadcast_arrays(np.asarray(a_over_b, float), np.asarray(nu, float))
     if np.any(~((ratio >= 0.1 - 1e-12) & (ratio <= 10.0 + 1e-9))):
         raise ValueError("Kalker's table covers 0.1 <= a/b <= 10")
@@ -83,9 +94,10 @@ def creep_coefficients(a_over_b: ArrayLike, nu: ArrayLike) -> CreepCoefficients:
         raise ValueError("Poisson's ratio must lie in [0, 0.5]")
     x = np.log(_A_OVER_B)
     lx = np.log(np.clip(ratio, 0.1, 10.0))
-    # Interpolate every (coefficient, nu) column in ln(a/b): shape (..., 3, 3).
-    cols = _TABLE.reshape(19, 9)
-    at_ratio = np.stack([np.interp(lx, x, cols[:, j]) for j in range(9)], axis=-1).reshape(*ratio.shape, 3, 3)
+    # Interpolate each wanted (coefficient, nu) column in ln(a/b): shape (..., coefficients, 3).
+    cols = _TABLE.reshape(19, 3, 3)
+    at_ratio = np.stack([np.interp(lx, x, cols[:, c, j]) for c in coefficients for j in range(3)],
+                        axis=-1).reshape(*ratio.shape, len(coefficients), 3)
     # Lagrange quadratic through nu = 0, 0.25, 0.5.
     n0, n1, n2 = TABLE_NU
     w = np.stack(
@@ -96,5 +108,4 @@ def creep_coefficients(a_over_b: ArrayLike, nu: ArrayLike) -> CreepCoefficients:
         ],
         axis=-1,
     )
-    c = np.einsum("...cn,...n->...c", at_ratio, w)
-    return CreepCoefficients(c[..., 0], c[..., 1], c[..., 2])
+    return np.einsum("...cn,...n->...c", at_ratio, w)

@@ -52,7 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rail_monitor.models.hertz import HertzContact
 from rail_monitor.models.iec61672 import a_weighting_db
-from rail_monitor.models.kalker import creep_coefficients
+from rail_monitor.models.kalker import lateral_creep_coefficient
 
 FloatArray = NDArray[np.float64]
 
@@ -82,8 +82,8 @@ def shear_modulus(young_pa: ArrayLike, poisson: ArrayLike) -> FloatArray:
 def kalker_lateral_stiffness(contact: HertzContact, young_pa: ArrayLike, poisson: ArrayLike) -> FloatArray:
     """G a b C22 [N]: Kalker's linear lateral creep force per unit creepage of a Hertz contact
     between two bodies of the same material (E [Pa], nu [-]); C22 from
-    :func:`rail_monitor.models.kalker.creep_coefficients` at the contact's a/b (a along rolling)."""
-    c22 = creep_coefficients(contact.a / contact.b, poisson).c22
+    :func:`rail_monitor.models.kalker.lateral_creep_coefficient` at the contact's a/b (a along rolling)."""
+    c22 = lateral_creep_coefficient(contact.a / contact.b, poisson)
     return shear_modulus(young_pa, poisson) * contact.a * contact.b * c22
 
 
