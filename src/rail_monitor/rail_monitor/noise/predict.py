@@ -242,16 +242,21 @@ class RollingNoiseModel:
         # Every component of the model, even with no passes (an empty history gives empty arrays);
         # one a class lacks stays 0 (-inf dB) on its passes (NoisePrediction.components).
         components = {c: np.zeros((n, nb)) for c in self.component_names(model)}
-        for name, rows in _class_rows(passes):
-            rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
-            energy, transfers = self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
-                                                None if filter_db is None else filter_db[rows])
+        for name, rows, energy, transfers in self._class_roughness(rail_db, passes, model, filter_db):
             roughness[rows] = level(energy)
             for comp, lh in transfers.items():
                 components[comp][rows] = energy * power(lh) * per_metre[rows]
             if model == "cnossos":
                 self._vehicle_sources(components, rows, self.classes[name], passes)
         return roughness, components
+
+    def _class_roughness(self, rail_db: np.ndarray, passes: PassTable, model: str, filter_db: np.ndarray | None
+                         ) -> Iterator[tuple[str, np.ndarray, np.ndarray, dict[str, np.ndarray]]]:
+        """(class, its rows' mask, and _roughness's energy and transfers there) per class among the passes."""
+        for name, rows in _class_rows(passes):
+            rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
+            yield name, rows, *self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
+                                               None if filter_db is None else filter_db[rows])
 
     def _vehicle_sources(self, components: dict[str, np.ndarray], rows: np.ndarray, terms: ClassTerms,
                          passes: PassTable) -> None:
@@ -305,12 +310,8 @@ class RollingNoiseModel:
         """LpAeq,Tp [dB(A)] (passes,) on the baseline rail roughness: the roughness-driven
         components share one effective roughness, so their transfers are summed per source line
         before weighting; the other sources (traction, aerodynamic) are those of ``components``."""
-        per_metre = passes.axle_count / passes.train_length_m
-        total = np.zeros(len(passes))
-        rolling: set[str] = set()
-        for name, rows in _class_rows(passes):
-            energy, transfers = self._roughness(self.baseline_db, self.classes[name], passes.speed_mps[rows], model,
-                                                None if filter_db is None else filter_db[rows])
+        per_metre, total, rolling = passes.axle_count / passes.train_length_m, np.zeros(len(passes)), set()
+        for _, rows, energy, transfers in self._class_roughness(self.baseline_db, passes, model, filter_db):
             lines: dict[bool, np.ndarray] = {}
             for comp, lh in transfers.items():
                 on_b = comp in SOURCE_B_COMPONENTS
