@@ -222,7 +222,7 @@ class BatchRun:
                 if self.observer is not None:
                     self.observer.add_counted(part, traj)
                 states = self._tail.then(traj)
-                on = state_index(states.stamp_ns, states.train_id, part.stamp_ns, part.train_id.tolist())
+                on = state_index(states.stamp_ns, states.train_id, part.stamp_ns, part.train_id)
                 noise_jobs += _noise_on_states(pool, self.model, part, states.amplitude, traj.constants, on, rows, lo)
                 self._tail = states.last_stamp()
                 trajs.append((lo, traj))

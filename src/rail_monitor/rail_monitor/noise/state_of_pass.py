@@ -16,8 +16,22 @@ from collections.abc import Sequence
 import numpy as np
 
 
-def _last_of_each(stamps: np.ndarray, trains: Sequence[str]) -> dict[tuple[int, str], int]:
-    return {key: k for k, key in enumerate(zip(stamps.tolist(), trains, strict=True))}
+def _own_state(state_train_id: Sequence[str], pass_train_id: Sequence[str], lo: np.ndarray,
+               hi: np.ndarray) -> np.ndarray:
+    """Per pass, the last state of its own stamp and train id, or -1 (states [lo, hi) are those of
+    its stamp). Most passes have at most one state of their stamp, compared at once; the few with
+    more are looked up one by one."""
+    own = np.full(len(lo), -1, np.int64)
+    width = hi - lo
+    one = np.flatnonzero(width == 1)
+    if len(one):
+        trains = np.asarray(pass_train_id, dtype=object)
+        states = np.asarray(state_train_id, dtype=object)
+        own[one] = np.where(states[lo[one]] == trains[one], lo[one], -1)
+    for i in np.flatnonzero(width > 1).tolist():
+        same = [k for k in range(int(lo[i]), int(hi[i])) if state_train_id[k] == pass_train_id[i]]
+        own[i] = same[-1] if same else -1
+    return own
 
 
 def state_index(state_stamp_ns: np.ndarray, state_train_id: Sequence[str], pass_stamp_ns: np.ndarray,
@@ -26,9 +40,8 @@ def state_index(state_stamp_ns: np.ndarray, state_train_id: Sequence[str], pass_
     time order)."""
     s = np.asarray(state_stamp_ns, np.int64)
     t = np.asarray(pass_stamp_ns, np.int64)
-    own = _last_of_each(s, list(state_train_id))
-    mine = np.array([own.get(key, -1) for key in zip(t.tolist(), pass_train_id, strict=True)], np.int64)
     lo, hi = np.searchsorted(s, t, side="left"), np.searchsorted(s, t, side="right")
+    mine = _own_state(state_train_id, pass_train_id, lo, hi)
     older = np.where(lo > 0, lo - 1, np.where(hi > lo, hi - 1, -1))
     return np.where(mine >= 0, mine, older)
 
@@ -38,9 +51,9 @@ def state_arrived(state_stamp_ns: np.ndarray, state_train_id: Sequence[str], pas
     """Per pass, whether the state that includes it, or a later one, has arrived."""
     s = np.asarray(state_stamp_ns, np.int64)
     t = np.asarray(pass_stamp_ns, np.int64)
-    own = _last_of_each(s, list(state_train_id))
+    lo, hi = np.searchsorted(s, t, side="left"), np.searchsorted(s, t, side="right")
     later = s.max(initial=np.iinfo(np.int64).min) > t
-    return later | np.array([key in own for key in zip(t.tolist(), pass_train_id, strict=True)], bool)
+    return later | (_own_state(state_train_id, pass_train_id, lo, hi) >= 0)
 
 
 def first_state_needed(state_stamp_ns: Sequence[int], earliest_pass_ns: int) -> int:
