@@ -25,7 +25,7 @@ from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation import forecast as fcst
 from rail_monitor.corrugation.config import CorrugationConfig
 from rail_monitor.corrugation.growth import GrowthTables
-from rail_monitor.corrugation.history import KeptPasses
+from rail_monitor.corrugation.history import KeptPasses, RowQueue
 from rail_monitor.corrugation.records import Forecast, ForecastInterval, StateSnapshot, Trajectory
 from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
@@ -69,7 +69,7 @@ class CorrugationEstimator:
         # Log growth summed in counting order: before each kept pass (K, B, P), and after the last
         # (B, P). A window's growth is a difference of two, so it is the same however the passes
         # were split into calls (live backlogs, batch chunks).
-        self._growth_before = np.zeros((0, *self.log_components.shape))
+        self._growth_before = RowQueue(np.zeros((0, *self.log_components.shape)))
         self._growth_total = np.zeros_like(self.log_components)
         self._axle_sum = 0
 
@@ -103,7 +103,7 @@ class CorrugationEstimator:
                                              friction)
         self.log_components = steps[-1].copy()
         self.season.add(new.stamp_ns, friction, growth, self.k_b, self.engine)
-        self._growth_before = np.concatenate([self._growth_before, summed[:-1]])
+        self._growth_before.append(summed[:-1])
         self._growth_total = summed[-1].copy()
         self._axle_sum += int(new.axle_count.sum())
         m = int(counted.sum())
@@ -152,19 +152,22 @@ class CorrugationEstimator:
         k = self.kept
         if len(stamps) and (np.any(np.diff(stamps) < 0) or stamps[0] < self.newest_ns):
             return self._history_one_by_one(passes)
-        kept_stamps, kept_axles, kept_before = k.stamp_ns.copy(), k.axles.copy(), self._growth_before
+        kept_stamps, kept_axles, kept_before = k.stamp_ns.copy(), k.axles.copy(), self._growth_before.rows
         before = self.snapshot()
         counted, (steps, summed) = self._advance(passes)
         new = passes.take(counted)
         m, k0 = len(new), len(kept_stamps)
         all_stamps = np.concatenate([kept_stamps, new.stamp_ns])
-        g_prefix = np.concatenate([kept_before, summed])
         a_prefix = np.concatenate([[0], np.cumsum(np.concatenate([kept_axles, new.axle_count]))])
         end = k0 + np.arange(1, m + 1)                                   # one past pass k
         start = np.searchsorted(all_stamps, new.stamp_ns - self.history_ns, side="left")
         axles = (a_prefix[end] - a_prefix[start]).astype(float)
         kernels = corrugation_kernels(self.engine)
-        growth, growth_max = kernels.window_growth(g_prefix, start, end, axles)
+        # Of the kept passes' prefix sums, only the rows where windows start (a live pass: one).
+        old = np.unique(start[start < k0])
+        g_prefix = np.concatenate([kept_before[old], summed])
+        at = np.where(start < k0, np.searchsorted(old, start), len(old) + start - k0)
+        growth, growth_max = kernels.window_growth(g_prefix, at, len(old) + end - k0, axles)
         span_days = (new.stamp_ns - all_stamps[start]) / NS_PER_DAY
         with np.errstate(divide="ignore", invalid="ignore"):
             rate = np.where((span_days > 0) & (span_days >= self.cfg.min_traffic_days),
@@ -196,7 +199,7 @@ class CorrugationEstimator:
         k = self.kept
         gone = k.stamp_ns < self.newest_ns - self.history_ns
         if gone.any():
-            self._growth_before = self._growth_before[~gone]
+            self._growth_before.keep(~gone)
             self._axle_sum -= int(k.axles[gone].sum())
             k.drop(gone)
 
@@ -210,7 +213,7 @@ class CorrugationEstimator:
         k = self.kept
         summed = np.cumsum(np.concatenate([np.zeros((1, *self.log_components.shape)), self._growth(
             k.class_idx, k.friction, k.regime, k.speed, k.axles)]), axis=0)
-        self._growth_before, self._growth_total = summed[:-1], summed[-1].copy()
+        self._growth_before, self._growth_total = RowQueue(summed[:-1]), summed[-1].copy()
         self._axle_sum = int(k.axles.sum())
 
     # -- state and forecast ---------------------------------------------------------------------
@@ -247,7 +250,7 @@ class CorrugationEstimator:
         """g per component (B, P) [1/axle pass]: the kept passes' growth, averaged per axle pass."""
         if self._axle_sum == 0:
             return np.zeros((len(self.bands), self.points))
-        return (self._growth_total - self._growth_before[0]) / self._axle_sum
+        return (self._growth_total - self._growth_before.rows[0]) / self._axle_sum
 
     def recent_growth_by_state(self) -> np.ndarray:
         """recent_growth() split by friction state (4, B, P) [1/axle pass of all kept passes]."""

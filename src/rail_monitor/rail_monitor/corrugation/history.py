@@ -44,3 +44,40 @@ class KeptPasses:
         self.seen.difference_update(zip(self.stamp_ns[gone].tolist(), self.train_id[gone].tolist(), strict=True))
         for name in COLUMNS:
             setattr(self, name, getattr(self, name)[~gone])
+
+
+class RowQueue:
+    """Rows of an array appended at the back and dropped from the front, each in amortised O(1)
+    per row: the live rows are a view of a buffer with room behind them, moved to a new buffer
+    only when that room is used up. Rows once written are never written again, so a view taken
+    earlier (``rows``) keeps its values whatever is appended or dropped later."""
+
+    def __init__(self, rows: np.ndarray) -> None:
+        self._buf, self._lo, self._hi = np.array(rows, float), 0, len(rows)
+
+    @property
+    def rows(self) -> np.ndarray:
+        return self._buf[self._lo:self._hi]
+
+    def __len__(self) -> int:
+        return self._hi - self._lo
+
+    def __array__(self, dtype: object = None, copy: bool | None = None) -> np.ndarray:
+        return np.array(self.rows, dtype) if copy else np.asarray(self.rows, dtype)
+
+    def append(self, rows: np.ndarray) -> None:
+        n, live = len(rows), len(self)
+        if self._hi + n > len(self._buf):
+            buf = np.empty((2 * live + n, *self._buf.shape[1:]))
+            buf[:live] = self.rows
+            self._buf, self._lo, self._hi = buf, 0, live
+        self._buf[self._hi:self._hi + n] = rows
+        self._hi += n
+
+    def keep(self, mask: np.ndarray) -> None:
+        """Keep the rows of a boolean mask (dropping a leading run costs nothing)."""
+        k = int(np.argmax(mask)) if mask.any() else len(mask)
+        if mask[k:].all():
+            self._lo += k
+        else:
+            self._buf, self._lo, self._hi = self.rows[mask], 0, int(mask.sum())
