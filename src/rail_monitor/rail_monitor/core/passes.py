@@ -122,6 +122,9 @@ class PassTable:
 _CONTROL = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 
 
+_FRICTION_CODES = np.array(sorted(FRICTION_NAMES))
+
+
 def _has_control(text: str) -> bool:
     """Whether text holds a control character (NUL, ESC, DEL, C1) or a line or paragraph separator."""
     return _CONTROL.search(text) is not None
@@ -135,11 +138,19 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     """
     n = len(table)
     whys = [""]
-    first = np.zeros(n, np.int16)  # index in whys of each pass's first failing check (0: none yet)
+    bad: list[np.ndarray] = []
 
-    def flag(bad: np.ndarray, why: str) -> None:
+    def flag(mask: np.ndarray, why: str) -> None:
         whys.append(why)
-        first[(first == 0) & bad] = len(whys) - 1
+        bad.append(mask)
+
+    def first_failing() -> np.ndarray:
+        """Per pass, the index in whys of its first failing check (0: none): one reduction over
+        the checks' masks, not an update per check (most of the cost for a live pass)."""
+        if not n:
+            return np.zeros(0, np.intp)
+        masks = np.array(bad)
+        return np.where(masks.any(axis=0), masks.argmax(axis=0) + 1, 0)
 
     ids = table.train_id.tolist()
     flag(table.stamp_ns == 0, "stamp not set")
@@ -164,7 +175,7 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     flag((table.wheel_load_n > 0.0) & (table.wheel_load_n < MIN_WHEEL_LOAD_N),
          f"wheel_load_n below {MIN_WHEEL_LOAD_N:g} N (0: the class's nominal load)")
     flag(table.wheel_load_n > MAX_WHEEL_LOAD_N, f"wheel_load_n above {MAX_WHEEL_LOAD_N:g} N")
-    flag(~np.isin(table.friction_state, list(FRICTION_NAMES)), "friction_state unknown")
+    flag(~(table.friction_state[:, None] == _FRICTION_CODES).any(axis=1), "friction_state unknown")
     flag((table.axle_count == 0) & (table.vehicle_count == 0), "neither axle_count nor vehicle_count set")
     flag(table.vehicle_count > MAX_VEHICLE_COUNT, f"vehicle_count above {MAX_VEHICLE_COUNT}")
     flag(table.axle_count > MAX_AXLE_COUNT, f"axle_count above {MAX_AXLE_COUNT}")
@@ -176,14 +187,15 @@ def rejection_reasons(table: PassTable, site: Site | None = None) -> np.ndarray:
     if site is not None:
         known = np.array([c in site.vehicles for c in table.vehicle_class], dtype=bool)
         flag(~known, "vehicle_class unknown to the site")
-        # A zero length is filled from the counts and the class: that length must be plausible too.
-        ok = first == 0
-        filled = with_class_defaults(table.take(ok), site).train_length_m
+        # A zero length is filled from the counts and the class: that length must be plausible too
+        # (a length given is checked above).
+        fill = (first_failing() == 0) & (table.train_length_m == 0.0)
         implied = np.zeros(n)
-        implied[ok] = filled
+        if fill.any():
+            implied[fill] = with_class_defaults(table.take(fill), site).train_length_m
         flag(implied > MAX_TRAIN_LENGTH_M,
              f"train length from vehicle_count and the class's vehicle length above {MAX_TRAIN_LENGTH_M:g} m")
-    return np.array(whys, dtype=object)[first]
+    return np.array(whys, dtype=object)[first_failing()]
 
 
 def ahead_of_stream(stamp_ns: np.ndarray, usable: np.ndarray, newest_ns: int, margin_ns: int
