@@ -99,6 +99,21 @@ def _k_minus_e_over_m(k: FloatArray) -> FloatArray:
     return np.where(m > 1e-10, (ellipkm1(p) - ellipe(m)) / safe, np.pi / 4.0)
 
 
+@lru_cache(maxsize=4096)
+def _shape_of(curvature_ratio: float) -> tuple[float, float, float]:
+    """What the ellipse's shape alone fixes, for a curvature ratio B_1/A_1: the axis ratio k,
+    (K - E)/e^2 and K (once per geometry)."""
+    k = np.array(_axis_ratio(curvature_ratio))
+    return float(k), float(_k_minus_e_over_m(k)), float(ellipkm1(k * k))
+
+
+def _shapes(ratio: FloatArray) -> FloatArray:
+    """_shape_of over an array of curvature ratios (shape + (3,)); a site has a few geometries."""
+    r = np.round(ratio, 12).ravel()
+    uniq, inverse = (r, np.zeros(1, np.intp)) if r.size == 1 else np.unique(r, return_inverse=True)
+    return np.array([_shape_of(x) for x in uniq.tolist()]).reshape(-1, 3)[inverse].reshape(*ratio.shape, 3)
+
+
 def contact_ellipse(
     r1x: ArrayLike,
     r1y: ArrayLike,
@@ -121,25 +136,23 @@ def contact_ellipse(
     HertzContact with a along x and b along y. The elliptic-integral solution is exact; the
     axis ratio depends on the geometry only, so it is solved once per distinct geometry.
     """
-    r1x, r1y, r2x, r2y, e_star, load = np.broadcast_arrays(
-        *(np.asarray(v, float) for v in (r1x, r1y, r2x, r2y, e_star, load))
-    )
+    r1x, r1y, r2x, r2y, e_star, load = (np.asarray(v, float) for v in (r1x, r1y, r2x, r2y, e_star, load))
     curv_x = 0.5 * (1.0 / r1x + 1.0 / r2x)
     curv_y = 0.5 * (1.0 / r1y + 1.0 / r2y)
-    if np.any(curv_x <= 0.0) or np.any(curv_y <= 0.0):
+    if (curv_x <= 0.0).any() or (curv_y <= 0.0).any():
         raise ValueError("relative curvature must be positive in x and y (the bodies must touch at a point)")
-    if np.any(~(load > 0.0)):
+    if (~(load > 0.0)).any():
         raise ValueError("normal load must be positive")
     c_major_axis = np.minimum(curv_x, curv_y)  # the longer semi-axis lies along the smaller curvature
-    ratio = np.maximum(curv_x, curv_y) / c_major_axis
-    uniq, inverse = np.unique(np.round(ratio, 12), return_inverse=True)
-    k = np.array([_axis_ratio(float(r)) for r in uniq])[inverse].reshape(ratio.shape)
+    shape = _shapes(np.maximum(curv_x, curv_y) / c_major_axis)
+    k, k_minus_e_over_m, k_integral = shape[..., 0], shape[..., 1], shape[..., 2]
 
-    major = np.cbrt(3.0 * load * _k_minus_e_over_m(k) / (2.0 * np.pi * e_star * c_major_axis))
+    major = np.cbrt(3.0 * load * k_minus_e_over_m / (2.0 * np.pi * e_star * c_major_axis))
     minor = k * major
     p0 = 3.0 * load / (2.0 * np.pi * major * minor)
-    approach = p0 * minor * ellipkm1(k * k) / e_star
+    approach = p0 * minor * k_integral / e_star
     along_x = curv_x <= curv_y
     a = np.where(along_x, major, minor)
     b = np.where(along_x, minor, major)
+    e_star = np.broadcast_to(e_star, a.shape)
     return HertzContact(a, b, p0, approach, 1.5 * load / approach, e_star)
