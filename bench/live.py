@@ -10,6 +10,9 @@ on a one-pass history, from its spawn to the probe's receipt of its first output
 resident memory then (its replayer waits for the probe's subscription, as for its own nodes').
 The same idle and rate measurements are then made of the one-process graph as a site would run it
 with its own detector driver: wayside_monitor with listen:=true, the probe publishing the passes.
+Both graphs' corrugation estimators resume from a checkpoint holding what a busy site's keeps
+(``--kept-days`` of its traffic up to now, default the site's corrugation.history_days), so a
+pass costs what it costs at a site that has run for a while; 0: an empty state.
 
 Run alone: ros2_ws/run python -m bench.live [--rate 100 --seconds 10]
 """
@@ -18,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import signal
 import subprocess
 import tempfile
@@ -33,6 +37,7 @@ from bench.timing import rss_mb
 
 MODEL_EXECUTABLES = ("corrugation_estimator", "rolling_noise_predictor", "squeal_risk_model", "alert_manager")
 TICKS = os.sysconf("SC_CLK_TCK")
+BUSY_YEAR_TEXT = "about 100,000 passes a year, bench.batch's busy site"
 
 
 def cpu_s(pid: int) -> float:
@@ -137,16 +142,40 @@ def start_up(site: str, probe: Probe, source: str, timeout_s: float = 60.0) -> d
     return {"seconds": seconds, "cpu_s": cpu, "rss_mb": mem}
 
 
+def busy_checkpoint(site: str, days: float, path: Path) -> int:
+    """Write to path the corrugation state of a busy site (bench.batch's) after ``days`` of traffic
+    ending a minute ago, as the estimator node checkpoints it; returns the passes it keeps."""
+    from bench.batch import BUSY_YEAR, busy_history
+    from rail_monitor.app.batch import run_models
+    from rail_monitor.core.timeutil import NS_PER_DAY, NS_PER_S, format_iso_ns
+    from rail_monitor.corrugation.checkpoint import save
+    from rail_monitor.site_file import load_parameter_file
+
+    values = load_parameter_file(site)
+    start_ns = time.time_ns() - round(days * NS_PER_DAY) - 60 * NS_PER_S
+    history = busy_history({**values, "simulator.start_time": format_iso_ns(start_ns)}, round(days * BUSY_YEAR / 365))
+    est = run_models(history, values).estimator
+    save(est, path)
+    return len(est.kept)
+
+
 def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle_s: float,
-               one_process: bool = False) -> dict[str, Any]:
+               one_process: bool = False, state: Path | None = None) -> dict[str, Any]:
     """The separate-process graph (or, one_process, wayside_monitor listening): idle CPU, then per
-    rate CPU share and latency percentiles."""
+    rate CPU share and latency percentiles. state: a checkpoint the estimator resumes from (copied:
+    the node writes its own)."""
     with tempfile.TemporaryDirectory() as tmp:
         bag = f"output:={Path(tmp) / 'bag'}"
+        resume = []
+        if state is not None:
+            shutil.copy(state, Path(tmp) / "state.npz")
+            # Named for the node: the site file's section for it wins over a parameter for every node.
+            resume = [f"corrugation_estimator:checkpoint_path:={Path(tmp) / 'state.npz'}"]
         if one_process:
-            procs, names = [_spawn("wayside_monitor", site, "listen:=true", bag)], ["wayside_monitor"]
+            procs, names = [_spawn("wayside_monitor", site, "listen:=true", bag, *resume)], ["wayside_monitor"]
         else:
-            procs = [_spawn(exe, site) for exe in MODEL_EXECUTABLES]
+            procs = [_spawn(exe, site, *(resume if exe == "corrugation_estimator" else []))
+                     for exe in MODEL_EXECUTABLES]
             procs.append(_spawn("mcap_recorder", site, bag))
             names = [*MODEL_EXECUTABLES, "mcap_recorder"]
         try:
@@ -190,10 +219,13 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
     return out
 
 
-def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: float) -> list[tuple[str, str, str]]:
+def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: float,
+         kept_days: float | None = None) -> list[tuple[str, str, str]]:
     from rail_monitor.bagio.passes_bag import write_passes_bag
     from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.nodes.pass_source import GRAPH_SETTLE_S
+    from rail_monitor.site_file import load_parameter_file
 
     passes = read_passes(source).sorted()
     probe = Probe(passes.take(slice(0, 2000)))
@@ -202,14 +234,22 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             one = write_passes_bag(passes.take(slice(0, 1)), Path(tmp) / "one", "curve_250")
             cold = start_up(site, probe, str(one))  # the site's tables built, unless cached before
             s = start_up(site, probe, str(one))
-        g = live_graph(site, probe, rates, seconds, idle_s)
-        one = live_graph(site, probe, rates, seconds, idle_s, one_process=True)
+            if kept_days is None:
+                kept_days = corrugation_config(load_parameter_file(site)).history_days
+            state, kept = None, 0
+            if kept_days > 0:
+                state = Path(tmp) / "busy.npz"
+                kept = busy_checkpoint(site, kept_days, state)
+            g = live_graph(site, probe, rates, seconds, idle_s, state=state)
+            one = live_graph(site, probe, rates, seconds, idle_s, one_process=True, state=state)
     finally:
         probe.close()
     out = [("wayside_monitor start-up to first output", f"{s['seconds']:.2f} s",
             f"{s['cpu_s']:.1f} CPU-s, {s['rss_mb']:.0f} MB resident then; a one-pass history, the site's tables "
             f"from the disk cache (the run before: {cold['seconds']:.2f} s); includes the {GRAPH_SETTLE_S:g} s its "
             "replayer lets the graph settle when another process listens (the probe)"),
+           ("corrugation state the graphs resume from", f"{kept:,} passes kept",
+            f"{kept_days:g} days of a busy site's traffic ({BUSY_YEAR_TEXT}) up to now" if kept else "empty"),
            (f"live graph idle ({g['processes']} processes)", f"{100 * g['idle_core']:.1f} % of a core",
             f"over {idle_s:g} s with no passes; by process: "
             + ", ".join(f"{name} {100 * c:.1f} %" for name, c in g["idle_per_process"].items()))]
@@ -237,8 +277,10 @@ def main() -> None:
     ap.add_argument("--rates", default="1,100", help="passes per second, comma-separated")
     ap.add_argument("--seconds", type=float, default=10.0, help="length of each rate's run [s]")
     ap.add_argument("--idle", type=float, default=10.0, help="length of the idle measurement [s]")
+    ap.add_argument("--kept-days", type=float, help="days of a busy site's traffic the estimators' state holds "
+                    "(default the site's corrugation.history_days; 0: an empty state)")
     ns = ap.parse_args()
-    for row in rows(ns.site, ns.source, [float(r) for r in ns.rates.split(",")], ns.seconds, ns.idle):
+    for row in rows(ns.site, ns.source, [float(r) for r in ns.rates.split(",")], ns.seconds, ns.idle, ns.kept_days):
         print(" | ".join(row))
 
 
