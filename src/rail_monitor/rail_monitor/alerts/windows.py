@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections import deque
+from itertools import islice
 
 import numpy as np
 
@@ -24,20 +25,22 @@ class Window:
 
     def push(self, over: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Add flag pairs in order; returns the over and near counts and the window's length after
-        each one (cumulative sums over the kept flags and the new ones)."""
-        n, m = self.flags.maxlen or 0, len(over)
-        kept = np.array(self.flags, dtype=np.int64).reshape(-1, 2)
-        o = np.concatenate([kept[:, 0], np.asarray(over, bool)]).astype(np.int64)
-        r = np.concatenate([kept[:, 1], np.asarray(near, bool)]).astype(np.int64)
-        end = np.arange(len(kept) + 1, len(o) + 1)
-        start = np.maximum(end - n, 0)
-        co, cr = np.concatenate([[0], np.cumsum(o)]), np.concatenate([[0], np.cumsum(r)])
-        over_counts, near_counts = co[end] - co[start], cr[end] - cr[start]
+        each one. The counts run on from the window's totals, less the flags that leave it (the
+        oldest kept, then new ones), so a push costs what it adds, not the window's length."""
+        n, m, k = self.flags.maxlen or 0, len(over), len(self.flags)
+        o, r = np.asarray(over, bool).astype(np.int64), np.asarray(near, bool).astype(np.int64)
+        first = max(0, n - k)      # the new flags taken before the window is full: none leaves
+        gone = max(0, m - first)   # one flag leaves for each of the others
+        head = np.array(list(islice(self.flags, min(gone, k))), np.int64).reshape(-1, 2)
+        leave_o, leave_r = np.zeros(m, np.int64), np.zeros(m, np.int64)
+        leave_o[first:] = np.concatenate([head[:, 0], o])[:gone]
+        leave_r[first:] = np.concatenate([head[:, 1], r])[:gone]
+        over_counts = self.over + np.cumsum(o) - np.cumsum(leave_o)
+        near_counts = self.near + np.cumsum(r) - np.cumsum(leave_r)
         if m:
-            self.flags = deque(zip(o[-n:].astype(bool).tolist(), r[-n:].astype(bool).tolist(), strict=True),
-                               maxlen=n)
+            self.flags.extend(zip(o.astype(bool).tolist(), r.astype(bool).tolist(), strict=True))
             self.over, self.near = int(over_counts[-1]), int(near_counts[-1])
-        return over_counts, near_counts, end - start
+        return over_counts, near_counts, np.minimum(k + np.arange(1, m + 1), n)
 
 
 def hysteresis_changes(standing: bool, can_raise: np.ndarray, can_clear: np.ndarray) -> list[tuple[int, bool]]:
