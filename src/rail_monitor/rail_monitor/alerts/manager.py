@@ -145,13 +145,14 @@ class AlertManager:
         over = amp >= thr
         under = ~over & (amp < self.cfg.grinding_clear_fraction * thr)
         changes: list[tuple[int, int, bool]] = []  # (state, band; len(keys) for the forecast, active)
-        up = np.empty(amp.shape, bool)  # band's alert standing after each state
-        for b, key in enumerate(keys):
-            was = (KIND_GRINDING_DUE, key) in self.standing
-            band = hysteresis_changes(was, over[:, b], under[:, b])
+        was = np.array([(KIND_GRINDING_DUE, key) in self.standing for key in keys], bool)
+        up = np.broadcast_to(was, amp.shape).copy()  # band's alert standing after each state
+        # Only a band over its threshold while down, or under its clear level while up, can change.
+        for b in np.flatnonzero(np.where(was, under.any(axis=0), over.any(axis=0))).tolist():
+            band = hysteresis_changes(bool(was[b]), over[:, b], under[:, b])
             flips = np.zeros(len(stamps), np.int64)
             flips[[i for i, _ in band]] = 1
-            up[:, b] = was ^ (np.cumsum(flips) % 2 == 1)
+            up[:, b] = was[b] ^ (np.cumsum(flips) % 2 == 1)
             changes += [(i, b, active) for i, active in band]
         others = any(kind == KIND_GRINDING_DUE and k not in keys for kind, k in self.standing)
         due_standing = up.any(axis=1) | others
