@@ -70,7 +70,8 @@ def graph_rows(source: str, site: str, keep: Path) -> list[Row]:
 
 
 def batch_rows(values: dict, site: str, sizes: list[int]) -> list[Row]:
-    rows: list[Row] = [("batch set-up (site tables, compiled kernels; once per process)", f"{bb.set_up_s(values):.2f} s", "")]
+    rows: list[Row] = [("batch set-up (site tables, compiled kernels; once per process)",
+                        f"{bb.set_up_s(values):.2f} s", "")]
     for size in sizes:
         n, t, _ = bb.timed(values, size)
         rows.append((f"batch, {n:,} simulated passes", rate(n, t),
