@@ -6,10 +6,15 @@ callbacks only publish ready-made messages of a real run's sizes (CDR bytes, as 
 publish them). The recorder is the real mcap_recorder (discovery, QoS adaptation, raw
 subscriptions) whose callback only counts. Passed to ``wayside_monitor.run_graph``, so the pass
 source, executor and flow control are the real ones.
+
+``python -m bench.bare_graph NODE --site SITE`` runs one stand-in as its own process, as the
+model's executable runs (its session, executor and flow control): the separate-process layout of
+the no-op graph for bench.live.
 """
 
 from __future__ import annotations
 
+import argparse
 from collections import Counter
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -108,11 +113,9 @@ class _CountingRecorder(McapRecorder):
         self.meter.tick()
 
 
-def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
-               ) -> tuple[Callable[[], list[Node]], Callable[[], Node]]:
-    """make_models and make_recorder for run_graph. The stand-ins publish the outputs the real
-    models give for the first of ``passes`` (so every message has a real run's size); every
-    callback takes up to max_batch queued messages (1: one per callback, rclpy's default)."""
+def _outputs(passes: PassTable, values: Mapping[str, Any]) -> tuple[bytes, dict[str, bytes], bytes]:
+    """CDR bytes of the corrugation state, rolling noise per model and squeal prediction the real
+    models give for the first of ``passes``."""
     r = run_models(passes.take(slice(0, 50)), values)
     frame = r.site.site_id
     first = fields.train_pass_fields(r.accepted.row(0), frame)
@@ -122,7 +125,45 @@ def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
     noise = {m: to_cdr(RollingNoise, fields.rolling_noise_fields(out, 0, header, train, r.receiver))
              for m, out in r.noise.items()}
     squeal = to_cdr(SquealPrediction, fields.squeal_prediction_fields(r.squeal, 0, header, train))
+    return state, noise, squeal
+
+
+def stand_ins(passes: PassTable, values: Mapping[str, Any], max_batch: int) -> dict[str, Callable[[], Node]]:
+    """Each model's stand-in by the name of the node it stands in for."""
+    state, noise, squeal = _outputs(passes, values)
+    return {"corrugation_estimator": lambda: _Estimator(state, max_batch),
+            "rolling_noise_predictor": lambda: _Noise(noise, max_batch),
+            "squeal_risk_model": lambda: _Squeal(squeal, max_batch),
+            "alert_manager": lambda: _Alerts(max_batch)}
+
+
+def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
+               ) -> tuple[Callable[[], list[Node]], Callable[[], Node]]:
+    """make_models and make_recorder for run_graph. The stand-ins publish the outputs the real
+    models give for the first of ``passes`` (so every message has a real run's size); every
+    callback takes up to max_batch queued messages (1: one per callback, rclpy's default)."""
+    makers = stand_ins(passes, values, max_batch)
     recorder = type("CountingRecorder", (_CountingRecorder,),
                     {"take_at_once": TAKE_AT_ONCE if max_batch > 1 else 1})
-    return (lambda: [_Estimator(state, max_batch), _Noise(noise, max_batch), _Squeal(squeal, max_batch),
-                     _Alerts(max_batch)]), recorder
+    return (lambda: [make() for make in makers.values()]), recorder
+
+
+def main() -> None:
+    from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.core.node_params import BATCH_SPECS
+    from rail_monitor.nodes.process import run_node
+    from rail_monitor.site_file import load_parameter_file
+
+    ap = argparse.ArgumentParser(description="Run one stand-in of the no-op graph as its own process.")
+    ap.add_argument("node", choices=("corrugation_estimator", "rolling_noise_predictor", "squeal_risk_model",
+                                     "alert_manager"))
+    ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
+    ap.add_argument("--source", default="bags/sample")
+    ns = ap.parse_args()
+    max_batch = next(s.default for s in BATCH_SPECS if s.name == "max_batch")
+    make = stand_ins(read_passes(ns.source), load_parameter_file(ns.site), max_batch)[ns.node]
+    raise SystemExit(run_node(make, ["bare_" + ns.node, "--ros-args", "--log-level", "warn"]))
+
+
+if __name__ == "__main__":
+    main()

@@ -24,6 +24,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -160,10 +161,11 @@ def busy_checkpoint(site: str, days: float, path: Path) -> int:
 
 
 def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle_s: float,
-               one_process: bool = False, state: Path | None = None) -> dict[str, Any]:
-    """The separate-process graph (or, one_process, wayside_monitor listening): idle CPU, then per
-    rate CPU share and latency percentiles. state: a checkpoint the estimator resumes from (copied:
-    the node writes its own)."""
+               layout: str = "separate", state: Path | None = None) -> dict[str, Any]:
+    """A graph's idle CPU, then per rate its CPU share and latency percentiles. layout: "separate"
+    (a process per node, as the launch file), "one" (wayside_monitor listening) or "bare" (the
+    separate layout with bench.bare_graph's no-op stand-ins for the models and the real recorder).
+    state: a checkpoint the estimator resumes from (copied: the node writes its own)."""
     with tempfile.TemporaryDirectory() as tmp:
         bag = f"output:={Path(tmp) / 'bag'}"
         resume = []
@@ -171,8 +173,14 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
             shutil.copy(state, Path(tmp) / "state.npz")
             # Named for the node: the site file's section for it wins over a parameter for every node.
             resume = [f"corrugation_estimator:checkpoint_path:={Path(tmp) / 'state.npz'}"]
-        if one_process:
+        if layout == "one":
             procs, names = [_spawn("wayside_monitor", site, "listen:=true", bag, *resume)], ["wayside_monitor"]
+        elif layout == "bare":
+            procs = [subprocess.Popen([sys.executable, "-m", "bench.bare_graph", exe, "--site", site],
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                     for exe in MODEL_EXECUTABLES]
+            procs.append(_spawn("mcap_recorder", site, bag))
+            names = [*MODEL_EXECUTABLES, "mcap_recorder"]
         else:
             procs = [_spawn(exe, site, *(resume if exe == "corrugation_estimator" else []))
                      for exe in MODEL_EXECUTABLES]
@@ -183,7 +191,8 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
             while probe.subscribers() < len(MODEL_EXECUTABLES) + 2 and time.monotonic() - t0 < 60:
                 time.sleep(0.05)
             warm = [probe.send(i) for i in range(3)]  # first outputs: lazy set-up paid before measuring
-            while np.isnan(probe.latencies_ms(warm)).any() and time.monotonic() - t0 < 120:
+            # The stand-ins' outputs carry a fixed train id: the no-op graph has no latency.
+            while layout != "bare" and np.isnan(probe.latencies_ms(warm)).any() and time.monotonic() - t0 < 120:
                 time.sleep(0.05)
             time.sleep(2.0)
             out: dict[str, Any] = {"processes": len(procs)}
@@ -201,11 +210,11 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
                         time.sleep(delay)
                     ids.append(probe.send(n))
                     n += 1
-                t_end = time.monotonic() + 10.0
-                while np.isnan(probe.latencies_ms(ids)).any() and time.monotonic() < t_end:
+                t_end = time.monotonic() + (10.0 if layout != "bare" else 0.03)  # no-op: a pass's few ms
+                while (layout == "bare" or np.isnan(probe.latencies_ms(ids)).any()) and time.monotonic() < t_end:
                     time.sleep(0.01)
                 wall = time.monotonic() - t_start
-                lat = probe.latencies_ms(ids)
+                lat = probe.latencies_ms(ids) if layout != "bare" else np.zeros(len(ids))
                 per = [(cpu_s(p.pid) - c) / wall for p, c in zip(procs, per0, strict=True)]
                 out[rate] = {"core": sum(per), "per_process": dict(zip(names, per, strict=True)), "passes": count,
                              "p50_ms": float(np.nanpercentile(lat, 50)), "p95_ms": float(np.nanpercentile(lat, 95)),
@@ -241,7 +250,8 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
                 state = Path(tmp) / "busy.npz"
                 kept = busy_checkpoint(site, kept_days, state)
             g = live_graph(site, probe, rates, seconds, idle_s, state=state)
-            one = live_graph(site, probe, rates, seconds, idle_s, one_process=True, state=state)
+            bare = live_graph(site, probe, rates, seconds, idle_s, layout="bare")
+            one = live_graph(site, probe, rates, seconds, idle_s, layout="one", state=state)
     finally:
         probe.close()
     out = [("wayside_monitor start-up to first output", f"{s['seconds']:.2f} s",
@@ -257,6 +267,11 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
         r = g[rate]
         out.append(_rate_row(f"live graph, {rate:g} passes/s arriving one at a time", r, "; by process: "
                              + ", ".join(f"{name} {100 * c:.0f} %" for name, c in r["per_process"].items())))
+    out += [_rate_row(f"no-op graph, {rate:g} passes/s arriving one at a time", bare[rate], "; the same "
+                      "processes, topics, message sizes, QoS, executor and recorder, the models' callbacks only "
+                      "publishing (bench.bare_graph); by process: "
+                      + ", ".join(f"{name} {100 * c:.0f} %" for name, c in bare[rate]["per_process"].items()),
+                      latency=False) for rate in rates]
     out.append(("one-process graph idle (wayside_monitor listen:=true)", f"{100 * one['idle_core']:.1f} % of a core",
                 f"over {idle_s:g} s with no passes"))
     out += [_rate_row(f"one-process graph, {rate:g} passes/s arriving one at a time", one[rate],
@@ -264,10 +279,10 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
     return out
 
 
-def _rate_row(what: str, r: dict[str, Any], detail: str) -> tuple[str, str, str]:
-    return (what, f"{100 * r['core']:.0f} % of a core",
-            f"latency pass to last output p50 {r['p50_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms over {r['passes']} passes"
-            + (f"; {r['lost']} incomplete" if r["lost"] else "") + detail)
+def _rate_row(what: str, r: dict[str, Any], detail: str, latency: bool = True) -> tuple[str, str, str]:
+    lat = (f"latency pass to last output p50 {r['p50_ms']:.0f} ms, p95 {r['p95_ms']:.0f} ms over {r['passes']} passes"
+           + (f"; {r['lost']} incomplete" if r["lost"] else "")) if latency else f"over {r['passes']} passes"
+    return (what, f"{100 * r['core']:.0f} % of a core", lat + detail)
 
 
 def main() -> None:
