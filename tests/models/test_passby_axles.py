@@ -180,6 +180,21 @@ def test_a_pass_gets_the_same_peak_alone_as_in_a_batch_with_either_engine():
             assert alone[0] == batch[i], engine
 
 
+@pytest.mark.parametrize("elements", [1, 5_000, 32_000, 10**7])
+def test_the_numpy_blocks_change_no_bit(monkeypatch, elements):
+    # HISTORY_ELEMENTS sizes the blocks for the cache only: passes are elementwise and the axles
+    # summed one at a time in a fixed order, so any block size gives the same bits.
+    layout, length, speed, rng = _mixed_trains(120, 8)
+    paths = [(rng.uniform(0.5, 2.0, 120), R1), (rng.uniform(0.5, 2.0, 120), R2)]
+    want = (passby_axles.f_weighted_peak(paths, layout, length, speed, D),
+            passby_axles.window_kernels(layout, length, D, [R1, R2]))
+    monkeypatch.setattr(passby_axles, "HISTORY_ELEMENTS", elements)
+    got = (passby_axles.f_weighted_peak(paths, layout, length, speed, D),
+           passby_axles.window_kernels(layout, length, D, [R1, R2]))
+    for w, g in zip(want, got, strict=True):
+        np.testing.assert_array_equal(g, w)
+
+
 def test_the_compiled_window_kernel_gives_the_numpy_engines():
     # LpAeq,Tp's exact sum over every axle: equal but for the arctangent's last bit.
     layout, length, _, _ = _mixed_trains(200, 4)
