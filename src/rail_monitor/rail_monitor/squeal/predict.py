@@ -18,7 +18,6 @@ from rail_monitor.core.contact import ContactState, contact_state
 from rail_monitor.core.passes import FRICTION_MODIFIER, PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import squeal
-from rail_monitor.models.hertz import HertzContact
 from rail_monitor.squeal.config import RISK_HIGH, RISK_LOW, RISK_MEDIUM, RISK_NONE, SquealConfig
 
 
@@ -83,7 +82,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
         "level_db": lev.level_db,
         "level_dba": lev.level_dba,
         "relative_level_db": squeal.relative_level(lc.amplitude, cfg.reference_amplitude_mps),
-        "friction_modifier_benefit_db": friction_modifier_benefit(cfg, site, passes, mode, lev.level_dba, cs.patch),
+        "friction_modifier_benefit_db": friction_modifier_benefit(cfg, site, passes, mode, lev.level_dba, cs),
         "risk": risk,
     }
 
@@ -103,17 +102,17 @@ def _limit_cycle(mode: WheelMode, speed: np.ndarray, cs: ContactState) -> squeal
 
 
 def friction_modifier_benefit(cfg: SquealConfig, site: Site, passes: PassTable, mode: WheelMode,
-                              level_dba: np.ndarray, patch: HertzContact | None = None) -> np.ndarray:
+                              level_dba: np.ndarray, own: ContactState | None = None) -> np.ndarray:
     """What a friction modifier would take off each pass's noise [dB(A)], against the background.
 
     With the modifier a share e (friction_modifier_effectiveness) of the wheels meets the film
     (the friction-modifier creep curve) and the rest the rail as it is, so the conditioned pass's
     squeal energy is e 10^(L_fm / 10) + (1 - e) 10^(L / 10): at most -10 lg(1 - e) quieter, 13 dB(A)
     at e = 0.95 (Eadie & Santoro, J. Sound Vib. 293 (2006) 747-757, measured 6.3-22.8 dB(A), mean
-    12). 0 for a pass already conditioned. patch: the passes' Hertz patch, when at hand.
+    12). 0 for a pass already conditioned. own: the passes' contact state, when at hand.
     """
     fm = np.full_like(passes.friction_state, FRICTION_MODIFIER)
-    lc = _limit_cycle(mode, passes.speed_mps, contact_state(site, passes, fm, patch))
+    lc = _limit_cycle(mode, passes.speed_mps, contact_state(site, passes, fm, own))
     fm_dba = _levels(cfg, mode, lc.amplitude).level_dba
     e = cfg.friction_modifier_effectiveness
     with np.errstate(divide="ignore"):
