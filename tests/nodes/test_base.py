@@ -3,6 +3,7 @@ of a batch of passes, and the one main() of the executables."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from rclpy.parameter import Parameter
 
@@ -93,3 +94,34 @@ def test_a_recorder_budget_that_cannot_hold_is_one_line_at_start(tmp_path):
                 timeout=60)
     assert r.returncode == 2 and "needs files split by size" in r.stderr and "Traceback" not in r.stderr
     assert not (tmp_path / "bag").exists()
+
+
+def test_diagnostics_of_nodes_started_apart_fall_due_together(ros_context):
+    # Statuses are due at whole multiples of the period on the steady clock, which processes share:
+    # nodes started 0.3 s apart publish in the same wake-up (an idle process's CPU is its wake-ups).
+    import time
+
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    from rail_monitor.nodes.base import Diagnostics
+
+    period, beats, nodes = 0.5, {}, []
+    executor = SingleThreadedExecutor(context=ros_context)
+    for name in ("diag_early", "diag_late"):
+        node = rclpy.create_node(name, context=ros_context)
+        beats[name] = []
+        Diagnostics(node, lambda b=beats[name]: b.append(time.monotonic()) or {}, period_s=period)
+        executor.add_node(node)
+        nodes.append(node)
+        time.sleep(0.3)
+    end = time.monotonic() + 2.3
+    while time.monotonic() < end:
+        executor.spin_once(timeout_sec=0.05)
+    executor.shutdown()
+    for node in nodes:
+        node.destroy_node()
+    assert all(len(b) >= 3 for b in beats.values()), beats
+    for b in beats.values():  # the first beat of the early node waited for the executor to spin
+        phase = np.array(b[1:]) % period
+        assert np.all(np.minimum(phase, period - phase) < 0.05), phase  # executor latency allowed

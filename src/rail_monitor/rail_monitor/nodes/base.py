@@ -189,6 +189,7 @@ def wall_timer(node: Node, period_s: float, callback: Callable[[], None], **kwar
 
 
 DIAGNOSTICS_PERIOD_S = 1.0
+BEAT_TOLERANCE_S = 0.01  # a diagnostics beat this near a whole multiple of its period is on it
 
 
 class Diagnostics:
@@ -201,7 +202,23 @@ class Diagnostics:
         self._values = values
         self._level = level or (lambda: (DiagnosticStatus.OK, "ok"))
         self._pub = node.create_publisher(DiagnosticArray, "/diagnostics", DIAGNOSTICS_QOS)
-        self._timer = wall_timer(node, period_s, self.publish)
+        # Due at whole multiples of the period on the steady clock (CLOCK_MONOTONIC, which every
+        # process shares), so that the nodes of a process, and the recorder taking the statuses of
+        # every process, wake once a period instead of once per node: idle, wake-ups are the CPU.
+        self._period_s = period_s
+        self._timer = wall_timer(node, self._to_next_beat(), self._beat)
+
+    def _to_next_beat(self) -> float:
+        return self._period_s - time.monotonic() % self._period_s
+
+    def _beat(self) -> None:
+        # A beat off the phase (the first, or one delayed by a busy executor) sets the next on it.
+        to_next = self._to_next_beat()
+        period = to_next if BEAT_TOLERANCE_S < to_next < self._period_s - BEAT_TOLERANCE_S else self._period_s
+        if self._timer.timer_period_ns != round(period * 1e9):
+            self._timer.timer_period_ns = round(period * 1e9)
+            self._timer.reset()
+        self.publish()
 
     def publish(self) -> None:
         now = self._node.get_clock().now()
