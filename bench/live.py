@@ -8,8 +8,11 @@ listens to the outputs. Latency of a pass: from its publication to the arrival o
 processes over the period, as a share of one core. Start-up: wayside_monitor (the one-process graph)
 on a one-pass history, from its spawn to the probe's receipt of its first output, with its
 resident memory then (its replayer waits for the probe's subscription, as for its own nodes').
-The same idle and rate measurements are then made of the one-process graph as a site would run it
-with its own detector driver: wayside_monitor with listen:=true, the probe publishing the passes.
+The same idle and rate measurements are then made of the no-op graph in the separate-process layout
+(bench.bare_graph's stand-ins, each its own process, and the real recorder: what rclpy and DDS cost
+with no model; its outputs carry a fixed train id, so it has no latency), and of the one-process
+graph as a site would run it with its own detector driver: wayside_monitor with listen:=true, the
+probe publishing the passes.
 Both graphs' corrugation estimators resume from a checkpoint holding what a busy site's keeps
 (``--kept-days`` of its traffic up to now, default the site's corrugation.history_days), so a
 pass costs what it costs at a site that has run for a while; 0: an empty state.
