@@ -29,11 +29,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from itertools import pairwise
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import sparse
-from scipy.sparse.linalg import eigsh
+
+if TYPE_CHECKING:
+    from scipy import sparse
 
 FloatArray = NDArray[np.float64]
 
@@ -150,6 +152,8 @@ def _elasticity(young_pa: float, poisson: float) -> FloatArray:
 def _assemble(material: tuple[float, float, float], n: int, r: FloatArray, z: FloatArray,
               solid: NDArray[np.bool_]) -> tuple[sparse.csr_matrix, sparse.csr_matrix]:
     """Stiffness and mass of harmonic n over the whole wheel (theta integrated), 3 DOF per grid node."""
+    from scipy import sparse  # here: only a table build solves modes (0.09 s of every node's start-up)
+
     nz = len(z)
     young, poisson, density = material
     d = _elasticity(young, poisson)
@@ -222,6 +226,8 @@ def harmonic_modes(blocks: tuple[tuple[float, float, float, float], ...], materi
     size_m [m]; contact (r, z) [m] is where the radial displacement is read; the nodes at
     clamp_radius_m are fixed (None: a free body, whose rigid-body modes come out near 0 Hz)."""
     r, z, solid = _mesh(blocks, size_m)
+    from scipy.sparse.linalg import eigsh
+
     k, m = _assemble(material, n, r, z, solid)
     nz = len(z)
     used = np.zeros(len(r) * nz, bool)
