@@ -149,19 +149,20 @@ def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
 
 
 def main() -> None:
+    from bench.live import MODEL_EXECUTABLES
     from rail_monitor.bagio.reader import read_passes
     from rail_monitor.core.node_params import BATCH_SPECS
+    from rail_monitor.core.params import resolve
     from rail_monitor.nodes.process import run_node
     from rail_monitor.site_file import load_parameter_file
 
     ap = argparse.ArgumentParser(description="Run one stand-in of the no-op graph as its own process.")
-    ap.add_argument("node", choices=("corrugation_estimator", "rolling_noise_predictor", "squeal_risk_model",
-                                     "alert_manager"))
+    ap.add_argument("node", choices=MODEL_EXECUTABLES)
     ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
     ap.add_argument("--source", default="bags/sample")
     ns = ap.parse_args()
-    max_batch = next(s.default for s in BATCH_SPECS if s.name == "max_batch")
-    make = stand_ins(read_passes(ns.source), load_parameter_file(ns.site), max_batch)[ns.node]
+    values = load_parameter_file(ns.site)
+    make = stand_ins(read_passes(ns.source), values, resolve(BATCH_SPECS, values)["max_batch"])[ns.node]
     raise SystemExit(run_node(make, ["bare_" + ns.node, "--ros-args", "--log-level", "warn"]))
 
 

@@ -169,6 +169,7 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
     (a process per node, as the launch file), "one" (wayside_monitor listening) or "bare" (the
     separate layout with bench.bare_graph's no-op stand-ins for the models and the real recorder).
     state: a checkpoint the estimator resumes from (copied: the node writes its own)."""
+    timed = layout != "bare"  # the stand-ins' outputs carry a fixed train id: no latency to time
     with tempfile.TemporaryDirectory() as tmp:
         bag = f"output:={Path(tmp) / 'bag'}"
         resume = []
@@ -194,8 +195,7 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
             while probe.subscribers() < len(MODEL_EXECUTABLES) + 2 and time.monotonic() - t0 < 60:
                 time.sleep(0.05)
             warm = [probe.send(i) for i in range(3)]  # first outputs: lazy set-up paid before measuring
-            # The stand-ins' outputs carry a fixed train id: the no-op graph has no latency.
-            while layout != "bare" and np.isnan(probe.latencies_ms(warm)).any() and time.monotonic() - t0 < 120:
+            while timed and np.isnan(probe.latencies_ms(warm)).any() and time.monotonic() - t0 < 120:
                 time.sleep(0.05)
             time.sleep(2.0)
             out: dict[str, Any] = {"processes": len(procs)}
@@ -213,11 +213,11 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
                         time.sleep(delay)
                     ids.append(probe.send(n))
                     n += 1
-                t_end = time.monotonic() + (10.0 if layout != "bare" else 0.03)  # no-op: a pass's few ms
-                while (layout == "bare" or np.isnan(probe.latencies_ms(ids)).any()) and time.monotonic() < t_end:
+                t_end = time.monotonic() + (10.0 if timed else 0.03)  # no-op: a pass's few ms
+                while (not timed or np.isnan(probe.latencies_ms(ids)).any()) and time.monotonic() < t_end:
                     time.sleep(0.01)
                 wall = time.monotonic() - t_start
-                lat = probe.latencies_ms(ids) if layout != "bare" else np.zeros(len(ids))
+                lat = probe.latencies_ms(ids) if timed else np.zeros(len(ids))
                 per = [(cpu_s(p.pid) - c) / wall for p, c in zip(procs, per0, strict=True)]
                 out[rate] = {"core": sum(per), "per_process": dict(zip(names, per, strict=True)), "passes": count,
                              "p50_ms": float(np.nanpercentile(lat, 50)), "p95_ms": float(np.nanpercentile(lat, 95)),

@@ -3,12 +3,16 @@ of a batch of passes, and the one main() of the executables."""
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.parameter import Parameter
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.nodes.base import isolate_failures
+from rail_monitor.nodes.base import Diagnostics, isolate_failures
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 
 from conftest import run_cmd
@@ -99,13 +103,6 @@ def test_a_recorder_budget_that_cannot_hold_is_one_line_at_start(tmp_path):
 def test_diagnostics_of_nodes_started_apart_fall_due_together(ros_context):
     # Statuses are due at whole multiples of the period on the steady clock, which processes share:
     # nodes started 0.3 s apart publish in the same wake-up (an idle process's CPU is its wake-ups).
-    import time
-
-    import rclpy
-    from rclpy.executors import SingleThreadedExecutor
-
-    from rail_monitor.nodes.base import Diagnostics
-
     period, beats, nodes = 0.5, {}, []
     executor = SingleThreadedExecutor(context=ros_context)
     for name in ("diag_early", "diag_late"):
