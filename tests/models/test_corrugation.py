@@ -156,3 +156,12 @@ def test_band_limits_share_each_range_equally():
     for (lo, hi), limit in cg.GRASSIE_1999_LIMITS[:4]:
         inside = (bands >= lo * (1 - 1e-9)) & (bands < hi * (1 - 1e-9))
         assert np.sqrt(np.sum(lim[inside] ** 2)) == pytest.approx(limit, rel=1e-12)
+
+
+def test_the_first_band_to_level_is_the_earliest_band_and_none_when_nothing_grows():
+    x = np.log(np.array([[[1e-6, 1e-6], [1e-6, 1e-6], [1e-6, 1e-6]], [[1e-6, 1e-6]] * 3]))
+    g = np.array([[[1e-6, 0.0], [3e-6, 0.0], [3e-6, 0.0]], [[0.0, -1e-6]] * 3])
+    band, passes = cg.first_band_to_level(x, g, np.log(np.array([4e-6, 4e-6, 4e-6])))
+    # Bands 1 and 2 tie: the first of them; one component alone: ln(Z_level / Z) / g (docs/models.md).
+    assert band.tolist() == [1, -1] and passes[0] == pytest.approx(np.log(np.sqrt(16 - 1)) / 3e-6, rel=1e-9)
+    assert np.isinf(passes[1])

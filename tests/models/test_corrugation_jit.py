@@ -87,3 +87,22 @@ def test_table_growth_equals_the_numpy_engine_bit_for_bit():
     assert np.array_equal(want, got)
     # at a grid point (w = 0) the table's own row, times the scale
     np.testing.assert_array_equal(jit.table_growth(table, *idx, np.zeros(n), np.ones(n)), table[idx])
+
+
+def test_the_first_band_to_level_is_the_full_solves_argmin_to_the_bit():
+    # Bands that cannot be first are not solved; the chosen band is solved as passes_to_band_level
+    # solves it. States at the level, with nothing growing, and with one band clearly first.
+    x, g, _ = _states(3)
+    x, g, level = x[:, 1:], g[:, 1:], np.log(np.array([2e-5, 3e-5, 2.5e-5, 4e-5, 3e-5]))
+    g[:50] = 0.0                      # never
+    x[50:60, 2] = np.log(5e-5)        # band 2 past its level: 0
+    g[60:100, 4] *= 50.0              # band 4 far ahead of the others
+    full = jit.passes_to_band_level(x, g, level)
+    band, passes = jit.first_band_to_level(x, g, level)
+    want = np.where(np.isinf(full).all(axis=1), -1, np.argmin(full, axis=1))
+    assert np.array_equal(band, want) and (band[:50] == -1).all() and (passes[50:60] == 0.0).all()
+    assert (band == 4).sum() > 40 and ((band >= 0) & (passes > 0)).sum() > 200
+    assert np.array_equal(passes, full[np.arange(len(full)), np.argmin(full, axis=1)])
+    twin = cg.first_band_to_level(x, g, level)
+    assert np.array_equal(twin[0], band)
+    np.testing.assert_allclose(twin[1], passes, rtol=1e-11)

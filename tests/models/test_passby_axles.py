@@ -215,3 +215,21 @@ def test_near_axle_terms_over_a_common_denominator_are_the_direct_quotients():
     direct = (broad / (x2 + D * D) + _OMNI)
     for got, rk in zip(passby_axles.near_axle_terms(x2, D, r2, broad), r2, strict=True):
         np.testing.assert_allclose(got, direct / (x2 + rk), rtol=2e-15, atol=0.0)
+
+
+@pytest.mark.parametrize("engine", ["numpy", "numba"])
+def test_passes_of_one_train_share_its_window_kernel_to_the_bit(engine):
+    # The kernel is computed once per distinct train: a history of repeated consists gives each pass
+    # what it gets alone, and a train differing in one offset's last bit is its own.
+    layout, length, _, _ = _mixed_trains(30, 4)
+    rows = np.random.default_rng(5).integers(0, 30, 400)
+    many = passby_axles._take(layout, rows)
+    first, inverse = passby_axles.distinct_trains(many, length[rows])
+    assert len(first) == len(np.unique(rows)) and np.array_equal(rows[first][inverse], rows)
+    got = passby_axles.window_kernels(many, length[rows], D, [R1, R2], engine)
+    alone = np.stack([passby_axles.window_kernels(passby_axles._take(layout, np.array([i])), length[i:i + 1], D,
+                                                  [R1, R2], engine)[:, 0] for i in rows], axis=1)
+    np.testing.assert_array_equal(got, alone)
+    nudged = passby_axles.AxleLayout(many.vehicles, many.pitch_m, many.offsets_m.copy())
+    nudged.offsets_m[7, 0] = np.nextafter(nudged.offsets_m[7, 0], np.inf)
+    assert len(passby_axles.distinct_trains(nudged, length[rows])[0]) == len(first) + 1

@@ -52,11 +52,9 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     if log_amplitude is None:
         log_amplitude = kernels.band_log_amplitude(log_components)
     margin = log_threshold - log_amplitude
-    axle_passes = _passes_to_level_split(kernels, log_components, growth, log_threshold, threads)
-    rows = np.arange(len(rate))
-    worst = np.where(np.isfinite(axle_passes).any(axis=1), np.argmin(axle_passes, axis=1),
-                     np.argmin(margin, axis=1))
-    passes = axle_passes[rows, worst] / axles
+    band, axle_passes = _first_band_split(kernels, log_components, growth, log_threshold, threads)
+    worst = np.where(np.isfinite(axle_passes), band, np.argmin(margin, axis=1))
+    passes = axle_passes / axles
     with np.errstate(divide="ignore", invalid="ignore"):
         days = np.where(np.isfinite(rate) & (rate > 0), passes / rate, np.inf)
     days = np.where(passes == 0.0, 0.0, days)
@@ -67,16 +65,16 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     return Forecast(growth.max(axis=2) if growth_max is None else growth_max, worst, passes, days, rate, due, due_ns)
 
 
-def _passes_to_level_split(kernels: ModuleType, log_components: np.ndarray, growth: np.ndarray,
-                           log_threshold: np.ndarray, threads: Threads | None) -> np.ndarray:
+def _first_band_split(kernels: ModuleType, log_components: np.ndarray, growth: np.ndarray,
+                      log_threshold: np.ndarray, threads: Threads | None) -> tuple[np.ndarray, np.ndarray]:
     parts = 0 if threads is None else min(threads.count, len(log_components) // PARALLEL_MIN_STATES)
     if threads is None or parts <= 1:
-        return kernels.passes_to_band_level(log_components, growth, log_threshold)
+        return kernels.first_band_to_level(log_components, growth, log_threshold)
     bounds = np.linspace(0, len(log_components), parts + 1).astype(int)
-    done = threads.pool.map(lambda lo, hi: kernels.passes_to_band_level(log_components[lo:hi], growth[lo:hi],
-                                                                        log_threshold),
-                            bounds[:-1], bounds[1:])  # both engines release the GIL
-    return np.concatenate(list(done))
+    done = list(threads.pool.map(lambda lo, hi: kernels.first_band_to_level(log_components[lo:hi], growth[lo:hi],
+                                                                             log_threshold),
+                                 bounds[:-1], bounds[1:]))  # both engines release the GIL
+    return np.concatenate([b for b, _ in done]), np.concatenate([n for _, n in done])
 
 
 def single(fc: Forecast) -> Forecast:

@@ -193,6 +193,17 @@ def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level
     return n.reshape(shape)
 
 
+def first_band_to_level(log_components: ArrayLike, growth: ArrayLike,
+                        log_level: ArrayLike) -> tuple[NDArray[np.int64], FloatArray]:
+    """The band that reaches its level first, and its passes [-]: per state (...), the argmin over
+    bands (B) of passes_to_band_level (the first of equal ones) and its value; band -1 (passes inf)
+    where no band ever reaches its level. log_components, growth (..., B, P); log_level (B,)."""
+    n = passes_to_band_level(log_components, growth, log_level)
+    first = np.argmin(n, axis=-1)
+    passes = np.take_along_axis(n, first[..., None], axis=-1)[..., 0]
+    return np.where(np.isinf(n).all(axis=-1), -1, first), passes
+
+
 def _excess(x: FloatArray, g: FloatArray, target: FloatArray,
             n: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """ln(band r.m.s.) - ln(level) after n passes, its slope and its curvature in n, for (P, M)

@@ -93,6 +93,62 @@ def _passes_to_level(x, g, target, out):  # pragma: no cover
         out[m] = n
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _first_band_to_level(x, g, target, band, passes):  # pragma: no cover
+    """Per state, _passes_to_level's argmin over bands without solving the bands that cannot be it.
+
+    A band's root n* is at most where its fastest component alone reaches the level (Newton starts
+    there and only steps down), and at least min over growing p of (level - 0.5 ln P - ln Z_p) / g_p
+    (the r.m.s. is at most sqrt(P) times its largest component) when no other component is that
+    close to the level already. A band whose lower bound exceeds another band's upper bound, or
+    the best root found so far, is not solved; the others are solved as _passes_to_level solves
+    them, so the chosen band and its passes are the same bits."""
+    n_s, n_b, n_p = x.shape
+    half_log_p = 0.5 * np.log(n_p)
+    lower = np.empty(n_b)
+    one = np.empty(1)
+    for i in range(n_s):
+        upper = np.inf
+        for m in range(n_b):
+            lo, hi, sure = np.inf, np.inf, True
+            for p in range(n_p):
+                xp, gp = x[i, m, p], g[i, m, p]
+                if not (np.isfinite(xp) and np.isfinite(gp)):
+                    sure = False
+                elif gp > 0:
+                    hi = min(hi, (target[m] - xp) / gp)
+                    lo = min(lo, (target[m] - half_log_p - xp) / gp)
+                elif xp >= target[m] - half_log_p:
+                    lo = 0.0
+            lower[m] = max(lo, 0.0) if sure else -np.inf
+            if sure:
+                upper = min(upper, max(hi, 0.0))
+        best, first = np.inf, -1
+        for m in range(n_b):
+            bound = min(best, upper)
+            if lower[m] > bound + 1e-9 * max(bound, 1.0):
+                continue
+            _passes_to_level(x[i, m:m + 1], g[i, m:m + 1], target[m:m + 1], one)
+            v = one[0]
+            if v != v:          # NaN: argmin's choice, whatever follows
+                best, first = v, m
+                break
+            if v < best:
+                best, first = v, m
+        band[i], passes[i] = first, best
+
+
+def first_band_to_level(log_components: ArrayLike, growth: ArrayLike,
+                        log_level: ArrayLike) -> tuple[NDArray[np.int64], FloatArray]:
+    """models.corrugation.first_band_to_level, compiled, solving only the bands that can be first."""
+    x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
+    shape, (b, p) = x.shape[:-2], x.shape[-2:]
+    band, passes = np.empty(int(np.prod(shape)), np.int64), np.empty(int(np.prod(shape)))
+    _first_band_to_level(np.ascontiguousarray(x.reshape(-1, b, p)), np.ascontiguousarray(g.reshape(-1, b, p)),
+                         np.ascontiguousarray(np.broadcast_to(np.asarray(log_level, float), (b,))), band, passes)
+    return band.reshape(shape), passes.reshape(shape)
+
+
 def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level: ArrayLike) -> FloatArray:
     """models.corrugation.passes_to_band_level, compiled: passes [-] until each band's r.m.s.
     reaches the level."""

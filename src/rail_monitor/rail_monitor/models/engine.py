@@ -18,7 +18,8 @@ def check_engine(engine: str) -> str:
 
 def corrugation_kernels(engine: str) -> ModuleType:
     """The module of the corrugation state's array kernels (band_log_amplitude,
-    passes_to_band_level, table_growth, history_sums, window_growth, add_by_day) of an engine."""
+    passes_to_band_level, first_band_to_level, table_growth, history_sums, window_growth, add_by_day) of an
+    engine."""
     if check_engine(engine) == "numba":
         from rail_monitor.models import corrugation_jit
 

@@ -149,9 +149,31 @@ def window_kernel(layout: AxleLayout, length_m: ArrayLike, d: float, r: float, e
 
 def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Sequence[float],
                    engine: str = "numpy") -> FloatArray:
-    """window_kernel for each path distance R [m] (radii x passes); engine as f_weighted_peaks's."""
+    """window_kernel for each path distance R [m] (radii x passes); engine as f_weighted_peaks's.
+    A pass's kernel depends on its train's geometry only, so it is computed once per distinct train
+    (a history holds few: consists of whole vehicles) and copied to the passes alike."""
     length = np.atleast_1d(np.asarray(length_m, float))
-    if check_engine(engine) == "numba":
+    check_engine(engine)
+    if len(length) < 2:
+        return _window_kernels(layout, length, d, radii, engine)
+    first, inverse = distinct_trains(layout, length)
+    if len(first) == len(length):
+        return _window_kernels(layout, length, d, radii, engine)
+    return _window_kernels(_take(layout, first), length[first], d, radii, engine)[:, inverse]
+
+
+def distinct_trains(layout: AxleLayout, length: FloatArray) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The first pass of each distinct train geometry (length, vehicles, pitch, axle offsets: alike
+    bit for bit) and the index of each pass's among them."""
+    rows = np.column_stack([length, layout.vehicles.view(np.float64), layout.pitch_m, layout.offsets_m])
+    keys = np.ascontiguousarray(rows).view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1])))[:, 0]
+    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
+    return first, inverse.ravel()
+
+
+def _window_kernels(layout: AxleLayout, length: FloatArray, d: float, radii: Sequence[float],
+                    engine: str) -> FloatArray:
+    if engine == "numba":
         from rail_monitor.models.passby_axles_jit import window_sums
 
         return layout.length_per_axle_m * window_sums(layout, length, d, list(radii)) / length
