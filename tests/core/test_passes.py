@@ -134,3 +134,17 @@ def test_the_control_character_class_is_unicodes_cc_zl_and_zp():
     for cp in range(sys.maxunicode + 1):
         c = chr(cp)
         assert _has_control(c) == (unicodedata.category(c) in ("Cc", "Zl", "Zp")), hex(cp)
+
+
+def test_class_groups_are_slices_in_class_order_and_masks_otherwise():
+    mixed = PassTable.from_rows({**GOOD, "train_id": str(i), "vehicle_class": c}
+                                for i, c in enumerate(["emu", "freight", "emu", "dmu", "freight", "emu"]))
+    groups = dict(mixed.class_groups)
+    assert sorted(groups) == ["dmu", "emu", "freight"]
+    assert groups["emu"].tolist() == [True, False, True, False, False, True]
+    ordered = mixed.take(mixed.class_order())
+    assert ordered.train_id.tolist() == ["0", "2", "5", "1", "4", "3"]          # stable within a class
+    assert dict(ordered.class_groups) == {"emu": slice(0, 3), "freight": slice(3, 5), "dmu": slice(5, 6)}
+    for name, rows in mixed.class_groups:  # the same passes either way
+        assert sorted(mixed.train_id[rows]) == sorted(ordered.train_id[dict(ordered.class_groups)[name]])
+    assert PassTable.empty().class_groups == [] and len(PassTable.empty().class_order()) == 0

@@ -319,7 +319,13 @@ def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepte
 def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable, out: NoiseRows,
                   rows: np.ndarray, corrugation: Corrugation | None = None) -> list[Future]:
     """model.predict_models over chunks of NOISE_CHUNK passes (each pass is independent), one task
-    each, putting the passes' predictions at rows of out."""
+    each, putting the passes' predictions at rows of out. The passes are taken in class order, so
+    that the model reads each class's rows of a chunk as a slice."""
+    order = passes.class_order()
+    passes, rows = passes.take(order), rows[order]
+    if corrugation is not None and corrugation.amplitude_m.ndim > 1:
+        corrugation = Corrugation(corrugation.wavelength_m, corrugation.amplitude_m[order], corrugation.post_grinding_m)
+
     def task(part: slice, state: Corrugation | None) -> None:
         out.put(rows[part], model.predict_models(passes.take(part), (), state))
 

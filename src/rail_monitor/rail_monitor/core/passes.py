@@ -7,6 +7,7 @@ defaults. Field names, units and enumeration values mirror ``rail_msgs/msg/Train
 
 from __future__ import annotations
 
+import functools
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, fields
@@ -104,6 +105,28 @@ class PassTable:
     def take(self, index: np.ndarray | Sequence[int] | slice) -> PassTable:
         """The rows selected by a boolean mask, an index array or a slice."""
         return PassTable(**{name: getattr(self, name)[index] for name in self.columns()})
+
+    @functools.cached_property
+    def class_groups(self) -> list[tuple[str, slice | np.ndarray]]:
+        """(vehicle class, its rows) per class among the passes: a slice where the class's passes
+        are one run (a table in class_order, or of one class), else a boolean mask (computed once:
+        a table's columns are not changed in place)."""
+        vc = self.vehicle_class
+        if not len(vc):
+            return []
+        starts = np.flatnonzero(np.concatenate([[True], vc[1:] != vc[:-1]]))
+        names = vc[starts].tolist()
+        if len(set(names)) < len(names):
+            return [(name, vc == name) for name in dict.fromkeys(names)]
+        return [(name, slice(a, b)) for name, a, b in zip(names, starts.tolist(), [*starts[1:].tolist(), len(vc)],
+                                                          strict=True)]
+
+    def class_order(self) -> np.ndarray:
+        """Indices that put the passes in runs of one class each (classes in order of first
+        appearance, passes in their order within a class)."""
+        vc = self.vehicle_class
+        return np.concatenate([np.flatnonzero(vc == name) for name in dict.fromkeys(vc.tolist())] or
+                              [np.zeros(0, np.intp)])
 
     def sorted(self) -> PassTable:
         """The rows in time order (stable, so equal stamps keep their order)."""

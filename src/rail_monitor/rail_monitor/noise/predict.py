@@ -141,7 +141,7 @@ class RollingNoiseModel:
         alike, so it cancels. ``passes`` valid with class defaults filled."""
         rail = self.rail_roughness_db(corrugation)
         out = np.empty((len(passes), len(self.band)))
-        for name, rows in _class_rows(passes):
+        for name, rows in passes.class_groups:
             speed = passes.speed_mps[rows]
             def at(table: np.ndarray, speed: np.ndarray = speed) -> np.ndarray:
                 return power(cb.at_band_frequencies(table, speed, self.band_hz, edition=self.edition))
@@ -225,7 +225,7 @@ class RollingNoiseModel:
         if self.cfg.contact_filter == "hertz_line":
             return level(wrn.contact_filter_power(passes.speed_mps, self.band, patch_a, self.cfg.band_points))
         out = np.empty((len(passes), len(self.band)))
-        for name, rows in _class_rows(passes):
+        for name, rows in passes.class_groups:
             terms = self.classes[name]
             out[rows] = cb.contact_filter_at_patch(terms.a3_db, passes.speed_mps[rows], terms.a3_patch_m,
                                                    patch_a[rows], self.band_hz, self.cfg.interpolation, self.edition)
@@ -253,7 +253,7 @@ class RollingNoiseModel:
     def _class_roughness(self, rail_db: np.ndarray, passes: PassTable, model: str, filter_db: np.ndarray | None
                          ) -> Iterator[tuple[str, np.ndarray, np.ndarray, dict[str, np.ndarray]]]:
         """(class, its rows' mask, and _roughness's energy and transfers there) per class among the passes."""
-        for name, rows in _class_rows(passes):
+        for name, rows in passes.class_groups:
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
             yield name, rows, *self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
                                                None if filter_db is None else filter_db[rows])
@@ -342,9 +342,3 @@ class RollingNoiseModel:
 def _weighted(components: dict[str, np.ndarray], weights: dict[bool, np.ndarray]) -> np.ndarray | float:
     """The sum over components and bands of power times its line's LpAeq weight (passes,)."""
     return sum((np.sum(w * weights[c in SOURCE_B_COMPONENTS], axis=-1) for c, w in components.items()), 0.0)
-
-
-def _class_rows(passes: PassTable) -> Iterator[tuple[str, np.ndarray]]:
-    """(vehicle class, its rows' mask) for each class among passes: the class terms are per class."""
-    for name in set(passes.vehicle_class.tolist()):
-        yield name, passes.vehicle_class == name

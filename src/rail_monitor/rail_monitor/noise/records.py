@@ -75,7 +75,8 @@ class NoiseRows:
 
     def put(self, rows: np.ndarray | slice, predictions: dict[str, NoisePrediction]) -> None:
         """The predictions of the passes at rows (an index array or a slice of the n)."""
-        if not isinstance(rows, slice) and len(rows) and rows[-1] - rows[0] == len(rows) - 1:
+        if not isinstance(rows, slice) and len(rows) and rows[-1] - rows[0] == len(rows) - 1 \
+                and (np.diff(rows) == 1).all():
             rows = slice(int(rows[0]), int(rows[-1]) + 1)  # ascending and contiguous: a block copy
         for name, p in predictions.items():
             with self._lock:  # the first part of a model sets its columns' shapes
