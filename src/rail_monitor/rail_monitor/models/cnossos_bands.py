@@ -77,23 +77,34 @@ def band_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: A
 
 def band_roughness_power(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike,
                          speed_mps: ArrayLike, band_hz: ArrayLike | None = None, rule: str = "reference",
-                         impact_db: ArrayLike | None = None, edition: str = DEFAULT_EDITION) -> FloatArray:
+                         impact_db: ArrayLike | None = None, edition: str = DEFAULT_EDITION,
+                         rail_power: FloatArray | None = None) -> FloatArray:
     """band_roughness as a power ratio re (1 um)^2, summed in energy without a round trip through
-    decibels (the ``reference`` rule; the ``noisemodelling`` rule's is 10^(L/10) of its level)."""
+    decibels (the ``reference`` rule; the ``noisemodelling`` rule's is 10^(L/10) of its level).
+    rail_power: the rail's power_at_bands, where the caller has it (the reference rule)."""
     if check_rule(rule, edition) == "noisemodelling":
         return power(band_roughness(rail_db, wheel_db, contact_filter_db, speed_mps, band_hz, rule, impact_db,
                                     edition))
 
     def at(table: ArrayLike) -> FloatArray:
-        if np.ndim(table) == 1:  # a class's or the site's spectrum: shared by the models and the baseline
-            speed, f = np.asarray(speed_mps, float), tables(edition).band_hz if band_hz is None else band_hz
-            return _power_at(np.asarray(table, float).tobytes(), speed.tobytes(), speed.shape,
-                             np.asarray(f, float).tobytes(), edition)
-        return power(at_band_frequencies(table, speed_mps, band_hz, rule, edition))
+        return power_at_bands(table, speed_mps, band_hz, edition)
 
-    filtered = (at(rail_db) + at(wheel_db)) * (power(contact_filter_db) if np.ndim(contact_filter_db) == 0
-                                               else at(contact_filter_db))
+    rail = at(rail_db) if rail_power is None else rail_power
+    filtered = (rail + at(wheel_db)) * (power(contact_filter_db) if np.ndim(contact_filter_db) == 0
+                                        else at(contact_filter_db))
     return filtered if impact_db is None else filtered + at(impact_db)
+
+
+def power_at_bands(table: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
+                   edition: str = DEFAULT_EDITION) -> FloatArray:
+    """10^(L/10) of a spectrum on the edition's grid [dB] read at lambda = v / f_i by the reference
+    rule: shape speed.shape + (bands,). One spectrum (a class's or the site's) is cached, being read
+    at the same passes' speeds by every model and the baseline; one per pass is not."""
+    if np.ndim(table) == 1:
+        speed, f = np.asarray(speed_mps, float), tables(edition).band_hz if band_hz is None else band_hz
+        return _power_at(np.asarray(table, float).tobytes(), speed.tobytes(), speed.shape,
+                         np.asarray(f, float).tobytes(), edition)
+    return power(at_band_frequencies(table, speed_mps, band_hz, "reference", edition))
 
 
 def contact_filter_at_patch(filter_db: ArrayLike, speed_mps: ArrayLike, table_patch_m: float,

@@ -174,10 +174,13 @@ class RollingNoiseModel:
         geometry = self._geometries(passes, models)
         weights = self._lpaeq_weights(geometry)
         rail = self.rail_roughness_db(corrugation)
+        # A rail per pass read at the bands once for every model (one spectrum is cached where read).
+        rail_power = (cb.power_at_bands(rail, passes.speed_mps, self.band_hz, self.edition)
+                      if rail.ndim == 2 and self.cfg.interpolation == "reference" else None)
         out, paths = {}, []
         for model in models:
             filter_db = self._filter_db(passes, model)
-            roughness, components = self._sources(rail, passes, model, filter_db)
+            roughness, components = self._sources(rail, passes, model, filter_db, rail_power)
             lines = self._paths(components, geometry)
             pb = pass_by_levels(geometry[0], lines)
             paths.append(a_weighted_paths(geometry[0], lines))
@@ -231,18 +234,18 @@ class RollingNoiseModel:
                                                    patch_a[rows], self.band_hz, self.cfg.interpolation, self.edition)
         return out
 
-    def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str,
-                 filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-        """Effective roughness [dB re 1 um] and sound power per metre of train per component
-        (power ratio re 1 pW/m) (passes x bands) on a rail roughness spectrum. filter_db: the
-        mechanics model's contact filter level per pass (passes x bands; None for CNOSSOS)."""
+    def _sources(self, rail_db: np.ndarray, passes: PassTable, model: str, filter_db: np.ndarray | None,
+                 rail_power: np.ndarray | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Effective roughness [dB re 1 um] and sound power per metre of train per component (power ratio
+        re 1 pW/m) (passes x bands) on a rail roughness spectrum. filter_db: the mechanics model's contact
+        filter level per pass (None for CNOSSOS); rail_power: the rail's power_at_bands, if at hand."""
         n, nb = len(passes), len(self.band)
         per_metre = (passes.axle_count / passes.train_length_m)[:, None]
         roughness = np.empty((n, nb))
         # Every component of the model, even with no passes (an empty history gives empty arrays);
         # one a class lacks stays 0 (-inf dB) on its passes (NoisePrediction.components).
         components = {c: np.zeros((n, nb)) for c in self.component_names(model)}
-        for name, rows, energy, transfers in self._class_roughness(rail_db, passes, model, filter_db):
+        for name, rows, energy, transfers in self._class_roughness(rail_db, passes, model, filter_db, rail_power):
             roughness[rows] = level(energy)
             for comp, lh in transfers.items():
                 components[comp][rows] = energy * power(lh) * per_metre[rows]
@@ -250,13 +253,15 @@ class RollingNoiseModel:
                 self._vehicle_sources(components, rows, self.classes[name], passes)
         return roughness, components
 
-    def _class_roughness(self, rail_db: np.ndarray, passes: PassTable, model: str, filter_db: np.ndarray | None
+    def _class_roughness(self, rail_db: np.ndarray, passes: PassTable, model: str, filter_db: np.ndarray | None,
+                         rail_power: np.ndarray | None = None
                          ) -> Iterator[tuple[str, np.ndarray, np.ndarray, dict[str, np.ndarray]]]:
-        """(class, its rows' mask, and _roughness's energy and transfers there) per class among the passes."""
+        """(class, its rows, and _roughness's energy and transfers there) per class among the passes."""
         for name, rows in passes.class_groups:
             rail = rail_db if rail_db.ndim == 1 else rail_db[rows]
             yield name, rows, *self._roughness(rail, self.classes[name], passes.speed_mps[rows], model,
-                                               None if filter_db is None else filter_db[rows])
+                                               None if filter_db is None else filter_db[rows],
+                                               None if rail_power is None else rail_power[rows])
 
     def _vehicle_sources(self, components: dict[str, np.ndarray], rows: np.ndarray, terms: ClassTerms,
                          passes: PassTable) -> None:
@@ -323,16 +328,17 @@ class RollingNoiseModel:
         return level(total + _weighted(others, weights))
 
     def _roughness(self, rail_db: np.ndarray, terms: ClassTerms, speed: np.ndarray, model: str,
-                   filter_db: np.ndarray | None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+                   filter_db: np.ndarray | None, rail_power: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Effective roughness at the band frequencies as a power ratio re (1 um)^2 (passes x
         bands) and the transfers [dB]."""
         rule = self.cfg.interpolation
         if model == "cnossos":
             return cb.band_roughness_power(rail_db, terms.wheel_db, terms.a3_db, speed, self.band_hz, rule,
-                                           self.impact_db, self.edition), terms.cnossos
+                                           self.impact_db, self.edition, rail_power), terms.cnossos
         if self.cfg.contact_filter == "cnossos":  # each table read on its own, as CNOSSOS-EU's total
             both = cb.band_roughness_power(rail_db, terms.wheel_db, 0.0, speed, self.band_hz, rule, None,
-                                           self.edition)
+                                           self.edition, rail_power)
             return both * power(filter_db), terms.mechanics
         combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
