@@ -4,7 +4,6 @@ span, the lead time and the sample history."""
 from __future__ import annotations
 
 import dataclasses
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -92,21 +91,6 @@ def test_a_forecast_beyond_any_time_stamp_has_no_date():
                    np.full(2, 1e-5), 60.0, 20.0)
     assert fc.days_to_threshold[0] > MAX_DATED_DAYS and np.isfinite(fc.days_to_threshold[0])
     assert fc.grinding_due_ns[0] == 0 and not fc.grinding_due[0]
-
-
-def test_forecasts_split_over_threads_are_the_same_bits():
-    from rail_monitor.corrugation import forecast as fcst
-
-    rng = np.random.default_rng(3)
-    n = 2 * fcst.PARALLEL_MIN_STATES + 5
-    x = np.log(rng.uniform(1e-7, 5e-6, (n, 3, 5)))
-    g = rng.normal(0, 1e-6, (n, 3, 5))
-    args = (x, g, rng.uniform(10, 100, n), np.full(n, 8.0), np.full(n, 10**18, np.int64), np.array([3e-6, 6e-6, 9e-6]),
-            30.0, 8.0)
-    with ThreadPoolExecutor(2) as pool:
-        one, two = fcst.forecasts(*args), fcst.forecasts(*args, threads=fcst.Threads(pool, 2))
-    for a, b in zip(dataclasses.astuple(one), dataclasses.astuple(two), strict=True):
-        assert np.array_equal(a, b)
 
 
 def test_interval_collapses_to_the_forecast_without_uncertainty(site_, tables):

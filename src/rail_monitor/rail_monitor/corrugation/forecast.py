@@ -7,10 +7,6 @@ days = train passes / train passes per day (docs/models.md, "Grinding forecast")
 
 from __future__ import annotations
 
-from concurrent.futures import Executor
-from types import ModuleType
-from typing import NamedTuple
-
 import numpy as np
 
 from rail_monitor.core.timeutil import NS_PER_DAY
@@ -23,28 +19,19 @@ from rail_monitor.models.engine import corrugation_kernels
 # Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
 # passes nearly balancing the others) can be 1e12 days away, past any 64-bit time stamp.
 MAX_DATED_DAYS = 36_525.0
-PARALLEL_MIN_STATES = 2_000  # fewer states per thread cost more to hand over than they save
 INTERVAL_DRAWS = 500  # draws of the forecast interval: its quantiles to about +-2 % of the spread
 INTERVAL_SEED = 20_260_901
 
 
-class Threads(NamedTuple):
-    """Threads a computation may split its work over: a pool and how many of its workers."""
-
-    pool: Executor
-    count: int
-
-
 def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, axles: np.ndarray,
               newest_ns: np.ndarray, threshold: np.ndarray, lead_time_days: float,
-              fallback_axles: float, threads: Threads | None = None, engine: str = "numpy",
+              fallback_axles: float, engine: str = "numpy",
               log_amplitude: np.ndarray | None = None, growth_max: np.ndarray | None = None) -> Forecast:
     """The forecast of N states at once: ln Z and g (N, B, P) [ln m, 1/axle pass], train passes per
     day and axles per train (N,) (NaN axles: ``fallback_axles``), newest pass time (N,) [ns],
     band thresholds (B,) [m]; a Forecast of arrays (grinding_due_ns 0: no date, the forecast
-    being infinite or beyond MAX_DATED_DAYS). threads: to split the states' root finding over
-    (each band's root is found on its own, so the split changes no bit). engine: of the per-band
-    reductions (numpy, or numba: models.corrugation_jit); log_amplitude: ln of each band's r.m.s.
+    being infinite or beyond MAX_DATED_DAYS). engine: of the per-band reductions and of the first
+    band to its threshold (numpy, or numba: models.corrugation_jit); log_amplitude: ln of each band's r.m.s.
     (N, B), and growth_max: g's largest component per band (N, B), when the caller has them."""
     kernels = corrugation_kernels(engine)
     axles = np.where(np.isfinite(axles), axles, fallback_axles)
@@ -52,7 +39,7 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     if log_amplitude is None:
         log_amplitude = kernels.band_log_amplitude(log_components)
     margin = log_threshold - log_amplitude
-    band, axle_passes = _first_band_split(kernels, log_components, growth, log_threshold, threads)
+    band, axle_passes = kernels.first_band_to_level(log_components, growth, log_threshold)
     worst = np.where(np.isfinite(axle_passes), band, np.argmin(margin, axis=1))
     passes = axle_passes / axles
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -63,18 +50,6 @@ def forecasts(log_components: np.ndarray, growth: np.ndarray, rate: np.ndarray, 
     ahead_ns = (np.where(dated, days, 0.0) * NS_PER_DAY).astype(np.int64)  # truncated toward zero, as int() does
     due_ns = np.where(dated, np.asarray(newest_ns, np.int64) + ahead_ns, 0)
     return Forecast(growth.max(axis=2) if growth_max is None else growth_max, worst, passes, days, rate, due, due_ns)
-
-
-def _first_band_split(kernels: ModuleType, log_components: np.ndarray, growth: np.ndarray,
-                      log_threshold: np.ndarray, threads: Threads | None) -> tuple[np.ndarray, np.ndarray]:
-    parts = 0 if threads is None else min(threads.count, len(log_components) // PARALLEL_MIN_STATES)
-    if threads is None or parts <= 1:
-        return kernels.first_band_to_level(log_components, growth, log_threshold)
-    bounds = np.linspace(0, len(log_components), parts + 1).astype(int)
-    done = list(threads.pool.map(lambda lo, hi: kernels.first_band_to_level(log_components[lo:hi], growth[lo:hi],
-                                                                             log_threshold),
-                                 bounds[:-1], bounds[1:]))  # both engines release the GIL
-    return np.concatenate([b for b, _ in done]), np.concatenate([n for _, n in done])
 
 
 def single(fc: Forecast) -> Forecast:

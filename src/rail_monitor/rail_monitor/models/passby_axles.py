@@ -165,7 +165,8 @@ def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Seq
 def distinct_trains(layout: AxleLayout, length: FloatArray) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """The first pass of each distinct train geometry (length, vehicles, pitch, axle offsets: alike
     bit for bit) and the index of each pass's among them."""
-    rows = np.column_stack([length, layout.vehicles.view(np.float64), layout.pitch_m, layout.offsets_m])
+    vehicles = np.asarray(layout.vehicles, np.int64).view(np.float64)  # its bits, as a float column of the key
+    rows = np.column_stack([length, vehicles, layout.pitch_m, layout.offsets_m])
     keys = np.ascontiguousarray(rows).view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1])))[:, 0]
     _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
     return first, inverse.ravel()
