@@ -318,13 +318,11 @@ def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepte
 
 def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable, out: NoiseRows,
                   rows: np.ndarray, corrugation: Corrugation | None = None) -> list[Future]:
-    """model.predict_models over chunks of NOISE_CHUNK passes (each pass is independent), one task
-    each, putting the passes' predictions at rows of out. The passes are taken in class order, so
-    that the model reads each class's rows of a chunk as a slice."""
+    """model.predict_models over chunks of NOISE_CHUNK passes (each independent), a task each putting
+    their predictions at rows of out; in class order, so the model reads a class's rows as a slice."""
     order = passes.class_order()
     passes, rows = passes.take(order), rows[order]
-    if corrugation is not None and corrugation.amplitude_m.ndim > 1:
-        corrugation = Corrugation(corrugation.wavelength_m, corrugation.amplitude_m[order], corrugation.post_grinding_m)
+    corrugation = None if corrugation is None else corrugation.of_passes(order)
 
     def task(part: slice, state: Corrugation | None) -> None:
         out.put(rows[part], model.predict_models(passes.take(part), (), state))
@@ -332,9 +330,7 @@ def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: Pa
     jobs = []
     for i in range(0, max(len(passes), 1), NOISE_CHUNK):
         part = slice(i, i + NOISE_CHUNK)
-        state = corrugation if corrugation is None or corrugation.amplitude_m.ndim == 1 else Corrugation(
-            corrugation.wavelength_m, corrugation.amplitude_m[part], corrugation.post_grinding_m)
-        jobs.append(pool.submit(task, part, state))
+        jobs.append(pool.submit(task, part, None if corrugation is None else corrugation.of_passes(part)))
     return jobs
 
 

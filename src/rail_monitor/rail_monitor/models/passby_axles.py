@@ -154,12 +154,11 @@ def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Seq
     (a history holds few: consists of whole vehicles) and copied to the passes alike."""
     length = np.atleast_1d(np.asarray(length_m, float))
     check_engine(engine)
-    if len(length) < 2:
-        return _window_kernels(layout, length, d, radii, engine)
-    first, inverse = distinct_trains(layout, length)
-    if len(first) == len(length):
-        return _window_kernels(layout, length, d, radii, engine)
-    return _window_kernels(_take(layout, first), length[first], d, radii, engine)[:, inverse]
+    if len(length) > 1:
+        first, inverse = distinct_trains(layout, length)
+        if len(first) < len(length):
+            return _window_kernels(_take(layout, first), length[first], d, radii, engine)[:, inverse]
+    return _window_kernels(layout, length, d, radii, engine)
 
 
 def distinct_trains(layout: AxleLayout, length: FloatArray) -> tuple[NDArray[np.intp], NDArray[np.intp]]:

@@ -20,6 +20,12 @@ class Corrugation:
     amplitude_m: np.ndarray
     post_grinding_m: np.ndarray
 
+    def of_passes(self, index: np.ndarray | slice) -> Corrugation:
+        """The state of the passes at index: a state per pass taken at those rows, one state kept."""
+        if self.amplitude_m.ndim == 1:
+            return self
+        return replace(self, amplitude_m=self.amplitude_m[index])
+
 
 @dataclass(frozen=True)
 class NoisePrediction:
