@@ -1,0 +1,218 @@
+"""Many CDR messages of one type read at once, field by field, into numpy columns.
+
+A node that takes a backlog reads it in one step per field instead of one step per field per
+message: the messages' bytes are joined, and each field is read for every message at once from
+the offset where it lies in each. The offsets follow from the lengths of the strings and
+sequences before the field and from CDR's alignment (bagio.cdr's module docstring), all computed
+as integer arrays. A message that is not one whole CDR message of the type is left out; the
+per-message reader (bagio.cdr.deserialize) then gives its error, so the two readers refuse the
+same bytes in the same words, and the tests hold them to the same values.
+
+Columns: numbers (n,); fixed arrays and sequences of one length (n, length); sequences whose
+lengths differ, a list of 1-D arrays; strings, a list of str; sequences of strings, a list of
+lists; sub-messages, a namespace of their own columns. Types holding sequences of messages are
+not read this way (TypeError).
+"""
+
+from __future__ import annotations
+
+import functools
+import struct
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+from rosbags.interfaces import Nodetype
+
+from rail_monitor.bagio.cdr import _BASE, ENCAPSULATION, CdrError, _layout, _Run, deserialize
+
+
+@dataclass
+class Columns:
+    """The messages read (``values``: their fields as columns, see the module docstring), the
+    positions among the given bytes of those read (``index``), and the others with the error the
+    per-message reader gives them (``refused``)."""
+
+    values: SimpleNamespace
+    index: np.ndarray
+    refused: list[tuple[int, CdrError]] = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return len(self.index)
+
+
+class _Walk:
+    """Per message: where the next field starts in the joined bytes, and whether it is whole so far
+    (a message refused reads from its start, so that no read leaves the bytes)."""
+
+    def __init__(self, raws: Sequence[bytes]) -> None:
+        n = len(raws)
+        length = np.fromiter(map(len, raws), np.int64, n)
+        self.start = np.zeros(n, np.int64)
+        np.cumsum(length[:-1], out=self.start[1:])
+        self.end = self.start + length
+        self.data = b"".join(raws)
+        self.buf = np.frombuffer(self.data + bytes(8), np.uint8)
+        self.ok = length >= 4
+        self.pos = np.where(self.ok, self.start + 4, self.start)
+        head = self._bytes(self.start, 2)
+        self._refuse((head[:, 0] != ENCAPSULATION[0]) | (head[:, 1] != ENCAPSULATION[1]))
+
+    def _refuse(self, bad: np.ndarray) -> None:
+        if bad.any():
+            self.ok &= ~bad
+            self.pos = np.where(self.ok, self.pos, self.start)
+
+    def _bytes(self, pos: np.ndarray, size: int) -> np.ndarray:
+        """(n, size) bytes from pos per message."""
+        at = pos[:, None] + np.arange(size)
+        if len(pos) and int(pos.max()) + size > len(self.buf):
+            np.minimum(at, len(self.buf) - 1, out=at)
+        return self.buf[at]
+
+    def _align(self, size: int, where: np.ndarray | None = None) -> None:
+        step = -(self.pos - self.start - 4) % size
+        self.pos += step if where is None else np.where(where, step, 0)
+
+    def run(self, run: _Run) -> dict[str, np.ndarray]:
+        """The fields of a run of fixed-size scalars per message: one read per distinct start
+        offset modulo 8 (the run's layout, padding included, depends on it alone)."""
+        phase = (self.pos - self.start - 4) % 8
+        kinds = np.unique(phase) if len(phase) else np.zeros(1, np.int64)
+        out: dict[str, np.ndarray] = {}
+        for p in kinds.tolist():
+            rows = slice(None) if len(kinds) == 1 else np.flatnonzero(phase == p)
+            dtype = _run_dtype(run, p)
+            self._refuse((self.pos + dtype.itemsize > self.end) & (phase == p))
+            got = self._bytes(self.pos[rows], dtype.itemsize).view(dtype)[:, 0]
+            for name, code in zip(run.names, run.codes, strict=True):
+                value = got[name] != 0 if code == "?" else got[name]
+                if len(kinds) == 1:
+                    out[name] = value.copy()
+                else:
+                    out.setdefault(name, np.zeros(len(phase), value.dtype))[rows] = value
+            self.pos[rows] += dtype.itemsize
+        return out
+
+    def count(self, active: np.ndarray | None = None) -> np.ndarray:
+        """A sequence's or string's uint32 count (0 for a message refused, or not active)."""
+        self._align(4, active)
+        fits = self.pos + 4 <= self.end
+        self._refuse(~fits if active is None else ~fits & active)
+        n = self._bytes(self.pos, 4).view("<u4")[:, 0].astype(np.int64)
+        live = self.ok if active is None else self.ok & active
+        self.pos += np.where(live, 4, 0)
+        return np.where(live, n, 0)
+
+    def string(self, active: np.ndarray | None = None) -> list[str | None]:
+        """A string per (active) message (None where refused, or not active)."""
+        active = np.ones(len(self.pos), bool) if active is None else active
+        n = self.count(active)
+        last = self.pos + n - 1
+        fits = (n >= 1) & (last < self.end)
+        self._refuse(active & ~(fits & (self._bytes(np.where(fits, last, self.start), 1)[:, 0] == 0)))
+        out: list[str | None] = [None] * len(n)
+        data, pos = self.data, self.pos.tolist()
+        for i in np.flatnonzero(self.ok & active).tolist():
+            try:
+                out[i] = data[pos[i]:pos[i] + int(n[i]) - 1].decode()
+            except UnicodeDecodeError:
+                self._refuse(np.arange(len(n)) == i)
+        self.pos += np.where(self.ok & active, n, 0)
+        return out
+
+    def numbers(self, code: str, length: int | None) -> Any:
+        """A fixed array (length) or a sequence (None) of one numeric type per message."""
+        dtype = np.dtype(_BASE[code]).newbyteorder("<")
+        n = np.full(len(self.pos), length, np.int64) if length is not None else self.count()
+        self._align(dtype.itemsize, n > 0)
+        stop = self.pos + n * dtype.itemsize
+        self._refuse(stop > self.end)
+        counts = np.unique(n[self.ok])
+        if len(counts) <= 1:   # one length (or none read): a 2-D column
+            k = int(counts[0]) if len(counts) else (length or 0)
+            out = self._bytes(self.pos, k * dtype.itemsize).view(dtype) if k else np.zeros((len(n), 0), dtype)
+        else:
+            ok, at = self.ok.tolist(), self.pos.tolist()
+            out = [np.frombuffer(self.data, dtype, int(n[i]), at[i]) if ok[i] else None for i in range(len(n))]
+        self.pos = np.where(self.ok, stop, self.pos)
+        return out
+
+
+@functools.cache
+def _run_dtype(run: _Run, phase: int) -> np.dtype:
+    """The numpy record of a run of fixed-size scalars starting phase bytes past an 8-byte boundary
+    (CDR alignment, counted from the end of the encapsulation header); bools as bytes."""
+    names, formats, offsets, at = [], [], [], phase
+    for name, code in zip(run.names, run.codes, strict=True):
+        dtype = np.dtype("u1" if code == "?" else code).newbyteorder("<")
+        at += -at % dtype.itemsize
+        names.append(name)
+        formats.append(dtype)
+        offsets.append(at - phase)
+        at += dtype.itemsize
+    return np.dtype({"names": names, "formats": formats, "offsets": offsets, "itemsize": at - phase})
+
+
+def _read(walk: _Walk, typename: str) -> SimpleNamespace:
+    out = SimpleNamespace()
+    for item in _layout(typename):
+        if isinstance(item, _Run):
+            vars(out).update(walk.run(item))
+            continue
+        name, kind, detail = item
+        if kind == Nodetype.BASE:
+            value: Any = walk.string()
+        elif kind == Nodetype.NAME:
+            value = _read(walk, detail)
+        else:
+            (item_kind, item_detail), length = detail[0], detail[1] if kind == Nodetype.ARRAY else None
+            if item_kind != Nodetype.BASE:
+                raise TypeError(f"{typename}.{name}: sequences of messages are not read as columns")
+            value = walk.numbers(item_detail[0], length) if item_detail[0] != "string" else _strings(walk, length)
+        setattr(out, name, value)
+    return out
+
+
+def _strings(walk: _Walk, length: int | None) -> list[list[str] | None]:
+    """A fixed array or sequence of strings per message, element j read for the messages that have one."""
+    n = np.full(len(walk.pos), length, np.int64) if length is not None else walk.count()
+    walk._refuse(n > walk.end - walk.pos)   # every string takes at least a byte
+    n = np.where(walk.ok, n, 0)
+    out: list[list[Any]] = [[] for _ in range(len(n))]
+    for j in range(int(n.max(initial=0))):
+        for i, s in enumerate(walk.string(n > j)):
+            if s is not None:
+                out[i].append(s)
+    return [v if ok else None for v, ok in zip(out, walk.ok.tolist(), strict=True)]
+
+
+def _rows(value: Any, keep: np.ndarray) -> Any:
+    """The columns of the messages at keep."""
+    if isinstance(value, SimpleNamespace):
+        return SimpleNamespace(**{k: _rows(v, keep) for k, v in vars(value).items()})
+    if isinstance(value, np.ndarray):
+        return value[keep]
+    return [value[i] for i in keep.tolist()]
+
+
+def read_columns(typename: str, raws: Sequence[bytes]) -> Columns:
+    """The messages of the type in raws (CDR bytes each) as columns, in order, and those that are
+    not whole messages of the type, each with the per-message reader's CdrError."""
+    walk = _Walk(raws)
+    values = _read(walk, typename)
+    keep = np.flatnonzero(walk.ok)
+    refused = []
+    for i in np.flatnonzero(~walk.ok).tolist():
+        try:
+            deserialize(typename, raws[i])
+        except CdrError as exc:
+            refused.append((i, exc))
+            continue
+        except struct.error as exc:  # not expected: deserialize wraps these
+            refused.append((i, CdrError(f"{typename}: {exc}")))
+            continue
+        raise AssertionError(f"{typename}: message {i} read whole by bagio.cdr but not as columns")
+    return Columns(values if len(keep) == len(raws) else _rows(values, keep), keep, refused)
