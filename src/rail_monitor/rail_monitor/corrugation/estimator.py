@@ -120,24 +120,23 @@ class CorrugationEstimator:
         return counted, (steps, summed)
 
     def _first_sight(self, passes: PassTable) -> np.ndarray:
-        """Mark the passes to count (keys not seen, not older than the kept history as it moves
-        on pass by pass) and add their keys to the seen set."""
+        """Mark the passes to count: keys not seen (nor twice among them), not older than the kept
+        history as it moves on pass by pass."""
+        stamps = passes.stamp_ns
+        newest = self.kept.newest_ns()
+        # Strictly in time order and newer than every kept pass: none is seen, none repeated.
+        if not len(stamps) or ((newest is None or stamps[0] > newest) and stamps[0] >= self.newest_ns - self.history_ns
+                                and bool(np.all(np.diff(stamps) > 0))):
+            return np.ones(len(stamps), bool)
         horizon = self.newest_ns - self.history_ns
-        seen = self.kept.seen
-        stamps = passes.stamp_ns.tolist()
-        keys = list(zip(stamps, passes.train_id.tolist(), strict=True))
-        # In time order from the horizon on, no pass falls behind it: only a repeated key is left out.
-        if (not stamps or (stamps[0] >= horizon and bool(np.all(np.diff(passes.stamp_ns) >= 0)))) \
-                and seen.isdisjoint(keys) and len(set(keys)) == len(keys):
-            seen.update(keys)
-            return np.ones(len(keys), bool)
-        counted = np.zeros(len(keys), bool)
-        for i, (stamp, key) in enumerate(zip(stamps, keys, strict=True)):
-            if key in seen or stamp < horizon:
+        seen = set(self.kept.seen())
+        counted = np.zeros(len(stamps), bool)
+        for i, key in enumerate(zip(stamps.tolist(), passes.train_id.tolist(), strict=True)):
+            if key in seen or key[0] < horizon:
                 continue
             seen.add(key)
             counted[i] = True
-            horizon = max(horizon, stamp - self.history_ns)
+            horizon = max(horizon, key[0] - self.history_ns)
         return counted
 
     def advance_history(self, passes: PassTable) -> Trajectory:

@@ -13,8 +13,8 @@ COLUMNS = ("stamp_ns", "train_id", "class_idx", "friction", "regime", "speed", "
 
 @dataclass
 class KeptPasses:
-    """Columns of the kept passes, in the order they were counted, and the set of their
-    (stamp [ns], train_id) keys."""
+    """Columns of the kept passes, in the order they were counted; their (stamp [ns], train_id)
+    keys are the passes seen."""
 
     stamp_ns: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     train_id: np.ndarray = field(default_factory=lambda: np.zeros(0, object))
@@ -25,25 +25,33 @@ class KeptPasses:
     axles: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     load: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))    # wheel load [N]
     creepage: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))  # lateral [-]
-    seen: set[tuple[int, str]] = field(default_factory=set)
-
-    def __post_init__(self) -> None:
-        if not self.seen and len(self.stamp_ns):
-            self.seen = set(zip(self.stamp_ns.tolist(), self.train_id.tolist(), strict=True))
+    _seen: set[tuple[int, str]] | None = field(default=None, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.stamp_ns)
 
+    def seen(self) -> set[tuple[int, str]]:
+        """The keys of the kept passes as a set, built when first asked for after a change (passes
+        newer than every kept one need no look-up: most calls never build it)."""
+        if self._seen is None:
+            self._seen = set(zip(self.stamp_ns.tolist(), self.train_id.tolist(), strict=True))
+        return self._seen
+
+    def newest_ns(self) -> int | None:
+        """The newest kept stamp [ns] (None: none kept)."""
+        return int(self.stamp_ns.max()) if len(self.stamp_ns) else None
+
     def extend(self, **cols: np.ndarray) -> None:
-        """Append passes (their keys must already be in ``seen``)."""
+        """Append passes."""
         for name in COLUMNS:
             setattr(self, name, np.concatenate([getattr(self, name), cols[name]]))
+        self._seen = None
 
     def drop(self, gone: np.ndarray) -> None:
-        """Forget the passes of a boolean mask, keys included."""
-        self.seen.difference_update(zip(self.stamp_ns[gone].tolist(), self.train_id[gone].tolist(), strict=True))
+        """Forget the passes of a boolean mask."""
         for name in COLUMNS:
             setattr(self, name, getattr(self, name)[~gone])
+        self._seen = None
 
 
 class RowQueue:
