@@ -1,7 +1,8 @@
 """Messages read together as columns (rail_monitor.bagio.cdr_columns) against the per-message
-reader (rail_monitor.bagio.cdr.message_view): the same values bit for bit, row by row, and the
-same bytes refused with the same error, on random messages of every graph type that has no
-sequence of messages, mixed with cut and garbled copies."""
+reader (rail_monitor.bagio.cdr.message_view), both ways the columns are read (a few messages one
+by one and stacked, more field by field): the same values bit for bit, row by row, and the same
+bytes refused with the same error, on random messages of every graph type that has no sequence
+of messages, mixed with cut and garbled copies."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import pytest
 from rosbags.interfaces import Nodetype
 
 from rail_monitor.bagio.cdr import CdrError, message_view, serialize
-from rail_monitor.bagio.cdr_columns import read_columns
+from rail_monitor.bagio.cdr_columns import FEW, read_columns
 from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.bagio.typestore import typestore
 
@@ -79,7 +80,7 @@ def _batch(rng, typename, n, equal_lengths):
 @pytest.mark.parametrize("typename", COLUMN_TYPES)
 def test_columns_equal_the_per_message_reader_and_refuse_the_same_bytes(typename, equal_lengths):
     rng = np.random.default_rng(zlib.crc32(typename.encode()) + equal_lengths)
-    for n in (1, 2, 7, 40):
+    for n in (1, 2, FEW - 1, FEW, 40):  # read one by one and stacked, then field by field
         raws = _batch(rng, typename, n, equal_lengths)
         want, errors = [], {}
         for i, raw in enumerate(raws):
@@ -100,15 +101,17 @@ def test_sequences_of_one_length_are_2d_columns():
     fields = [random_fields(rng, typename) for _ in range(3)]
     for f in fields:
         f["amplitude_m"] = rng.random(6).tolist()
-    got = read_columns(typename, [serialize(typename, f) for f in fields]).values
-    assert got.amplitude_m.shape == (3, 6)
-    assert got.k_b_by_friction.shape == (3, 4)
-    assert got.header.stamp.sec.shape == (3,)
-    np.testing.assert_array_equal(got.amplitude_m, [f["amplitude_m"] for f in fields])
+    for n in (3, FEW + 3):
+        got = read_columns(typename, [serialize(typename, fields[k % 3]) for k in range(n)]).values
+        assert got.amplitude_m.shape == (n, 6)
+        assert got.k_b_by_friction.shape == (n, 4)
+        assert got.header.stamp.sec.shape == (n,)
+        np.testing.assert_array_equal(got.amplitude_m, [fields[k % 3]["amplitude_m"] for k in range(n)])
 
 
 def test_no_bytes_and_empty_bytes():
     typename = "rail_msgs/msg/TrainPass"
     assert len(read_columns(typename, [])) == 0
-    got = read_columns(typename, [b"", b"\x00\x01\x00\x00"])
-    assert len(got) == 0 and [i for i, _ in got.refused] == [0, 1]
+    for n in (2, FEW):
+        got = read_columns(typename, [b"", b"\x00\x01\x00\x00"] * (n // 2))
+        assert len(got) == 0 and [i for i, _ in got.refused] == list(range(n))

@@ -17,7 +17,6 @@ not read this way (TypeError).
 from __future__ import annotations
 
 import functools
-import struct
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from types import SimpleNamespace
@@ -26,7 +25,7 @@ from typing import Any
 import numpy as np
 from rosbags.interfaces import Nodetype
 
-from rail_monitor.bagio.cdr import _BASE, ENCAPSULATION, CdrError, _layout, _Run, deserialize
+from rail_monitor.bagio.cdr import _BASE, ENCAPSULATION, CdrError, _layout, _Run, deserialize, message_view
 
 
 @dataclass
@@ -198,9 +197,43 @@ def _rows(value: Any, keep: np.ndarray) -> Any:
     return [value[i] for i in keep.tolist()]
 
 
+FEW = 12  # fewer messages than this are read one by one (a numpy step per field costs more than a message)
+
+
+def _stack(typename: str, views: list[SimpleNamespace]) -> SimpleNamespace:
+    """The columns of messages read one by one (bagio.cdr.message_view), as read_columns gives them."""
+    out = SimpleNamespace()
+    for item in _layout(typename):
+        if isinstance(item, _Run):
+            for name, code in zip(item.names, item.codes, strict=True):
+                dtype = np.dtype(bool) if code == "?" else np.dtype(code).newbyteorder("<")
+                setattr(out, name, np.array([getattr(v, name) for v in views], dtype))
+            continue
+        name, kind, detail = item
+        values = [getattr(v, name) for v in views]
+        if kind == Nodetype.NAME:
+            values = _stack(detail, values)
+        elif kind != Nodetype.BASE and detail[0][1][0] != "string":
+            lengths = {len(v) for v in values}
+            if len(lengths) <= 1:
+                dtype = np.dtype(_BASE[detail[0][1][0]]).newbyteorder("<")
+                values = np.stack(values) if values and lengths != {0} else np.zeros((len(values), 0), dtype)
+        setattr(out, name, values)
+    return out
+
+
 def read_columns(typename: str, raws: Sequence[bytes]) -> Columns:
     """The messages of the type in raws (CDR bytes each) as columns, in order, and those that are
     not whole messages of the type, each with the per-message reader's CdrError."""
+    if len(raws) < FEW:
+        views, index, refused = [], [], []
+        for i, raw in enumerate(raws):
+            try:
+                views.append(message_view(typename, raw))
+                index.append(i)
+            except CdrError as exc:
+                refused.append((i, exc))
+        return Columns(_stack(typename, views), np.array(index, np.intp), refused)
     walk = _Walk(raws)
     values = _read(walk, typename)
     keep = np.flatnonzero(walk.ok)
@@ -210,9 +243,6 @@ def read_columns(typename: str, raws: Sequence[bytes]) -> Columns:
             deserialize(typename, raws[i])
         except CdrError as exc:
             refused.append((i, exc))
-            continue
-        except struct.error as exc:  # not expected: deserialize wraps these
-            refused.append((i, CdrError(f"{typename}: {exc}")))
             continue
         raise AssertionError(f"{typename}: message {i} read whole by bagio.cdr but not as columns")
     return Columns(values if len(keep) == len(raws) else _rows(values, keep), keep, refused)

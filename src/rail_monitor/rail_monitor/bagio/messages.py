@@ -6,19 +6,21 @@ turns into CDR bytes (batch mode, bag writers) and ``rail_monitor.nodes.convert.
 rclpy message (the live graph). Fields left out take their zero value.
 
 From a message: the ``*_from_msg`` functions and :func:`pass_row` read rclpy messages and
-rosbags' deserialised objects alike (the two have the same attribute names).
+rosbags' deserialised objects alike (the two have the same attribute names);
+:func:`passes_from_columns` reads TrainPasses taken together (bagio.cdr_columns).
 """
 
 from __future__ import annotations
 
 from dataclasses import fields as dataclass_fields
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from rail_monitor.alerts.config import NOISE_METRICS
 from rail_monitor.alerts.manager import Alert
-from rail_monitor.core.timeutil import TIME_MSG_END_NS, fits_time_msg, from_sec_nanosec, to_sec_nanosec
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, fits_time_msg, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
@@ -79,6 +81,27 @@ def train_pass_fields(row: dict[str, Any], frame_id: str) -> Fields:
 def pass_row(msg: Any) -> dict[str, Any]:
     """A TrainPass as a PassTable row."""
     return {"stamp_ns": time_ns(msg.header.stamp), **{k: getattr(msg, k) for k in PASS_FIELDS}}
+
+
+class PassHead(NamedTuple):
+    """What a model's outputs take from their TrainPass: its stamp [ns], its header as fields
+    (stamp and frame_id as sent) and its train_id."""
+
+    stamp_ns: int
+    header: Fields
+    train_id: str
+
+
+def passes_from_columns(values: Any) -> tuple[PassTable, list[PassHead]]:
+    """TrainPasses read as columns (bagio.cdr_columns.read_columns) as a PassTable, and their heads."""
+    stamp = values.header.stamp
+    stamp_ns = stamp.sec.astype(np.int64) * NS_PER_S + stamp.nanosec.astype(np.int64)
+    table = PassTable(stamp_ns=stamp_ns, **{k: np.array(v, object) if isinstance(v, list) else v
+                                            for k in PASS_FIELDS for v in [getattr(values, k)]})
+    heads = [PassHead(ns, {"stamp": {"sec": s, "nanosec": n}, "frame_id": f}, t) for ns, s, n, f, t in zip(
+        stamp_ns.tolist(), stamp.sec.tolist(), stamp.nanosec.tolist(), values.header.frame_id, values.train_id,
+        strict=True)]
+    return table, heads
 
 
 # -- model outputs --------------------------------------------------------------------------------

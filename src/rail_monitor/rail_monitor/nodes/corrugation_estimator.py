@@ -28,6 +28,7 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from rail_monitor.advice import plan
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.bagio.messages import (
+    PassHead,
     corrugation_state_fields,
     event_from_msg,
     indirect_roughness_fields,
@@ -57,7 +58,6 @@ from rail_msgs.msg import (
     MeasuredPassNoise,
     RoughnessSurvey,
     SpeedAdvisory,
-    TrainPass,
 )
 from rail_msgs.srv import EvaluateSpeedDistribution
 
@@ -126,7 +126,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
     def _on_measured(self, msgs: list[MeasuredPassNoise]) -> None:
         self.observer.add_measurements([measurement_from_msg(m) for m in msgs])
 
-    def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
+    def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
         start = 0
         while (cut := next_cut(table.stamp_ns[start:], self.pending, self.observer)) is not None:
             n, window = cut

@@ -21,7 +21,8 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.parameter import Parameter
 
-from rail_monitor.bagio.messages import pass_row, time_ns
+from rail_monitor.bagio.cdr_columns import read_columns
+from rail_monitor.bagio.messages import PassHead, passes_from_columns
 from rail_monitor.bagio.typestore import TRAIN_PASS
 from rail_monitor.core.node_params import BATCH_SPECS, STAMP_SPECS, StampParams
 from rail_monitor.core.params import ParamGroups, values_of
@@ -36,7 +37,6 @@ from rail_monitor.nodes.base import (
     declare,
     declare_site,
     isolate_failures,
-    read_views,
     runs,
     subscribe_batched,
 )
@@ -69,7 +69,7 @@ class PassConsumerNode(RailNode):
 
     def listen(self) -> None:
         """Subscribe train_pass (the last step of a subclass's __init__), and say so."""
-        # Raw: each TrainPass is read straight from its CDR, not converted by rclpy.
+        # Raw: the TrainPasses taken are read from their CDR together, as columns (not converted by rclpy).
         subscribe_batched(self, TrainPass, "train_pass", self._on_train_passes, STREAM_SUB_QOS, self.max_batch,
                           raw=True)
         announce(self, site=self.site.site_id, radius_m=f"{self.site.curve_radius_m:g}",
@@ -79,24 +79,26 @@ class PassConsumerNode(RailNode):
         """What the start-up line states besides the site (subclasses)."""
         return {}
 
-    def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
+    def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
         """Handle consecutive accepted passes in order (table rows, class defaults filled, match
-        msgs): one vectorised call, computing before it publishes. Nothing by default."""
+        heads: what outputs copy of their pass): one vectorised call, computing before it
+        publishes. Nothing by default."""
 
     def on_validated(self, table: PassTable, reasons: list[str]) -> None:
         """See every taken pass with its reason ('' accepted), once, before on_passes. Nothing by default."""
 
     def _on_train_passes(self, raws: list[bytes]) -> None:
         try:
-            msgs = read_views(TRAIN_PASS, raws, self._unreadable_pass)
-            if msgs:
-                self._handle(msgs)
+            read = read_columns(TRAIN_PASS, raws)
+            for _, exc in read.refused:
+                self._unreadable_pass(exc)
+            if len(read):
+                self._handle(*passes_from_columns(read.values))
         finally:
             self.taken += len(raws)  # after handling: a reader of ``taken`` sees the passes' effects
 
-    def _handle(self, msgs: list[TrainPass]) -> None:
+    def _handle(self, table: PassTable, heads: list[PassHead]) -> None:
         """Rejections and runs of accepted passes, in message order."""
-        table = PassTable.from_rows([pass_row(m) for m in msgs])
         reasons = rejection_reasons(table, self.site)
         self.stream_ns = reject_ahead(table.stamp_ns, reasons, self.stream_ns, self.margins, self._live_clock_ns())
         reasons = reasons.tolist()
@@ -104,10 +106,10 @@ class PassConsumerNode(RailNode):
         for run in runs(reasons, lambda a, b: not a and not b):
             why = reasons[run.start]
             if not why:
-                self._accept(with_class_defaults(table.take(run), self.site), msgs[run])
+                self._accept(with_class_defaults(table.take(run), self.site), heads[run])
                 continue
             self.rejected[why] += 1
-            self.get_logger().warning(f"pass {msgs[run.start].train_id!r} rejected: {why}",
+            self.get_logger().warning(f"pass {heads[run.start].train_id!r} rejected: {why}",
                                       throttle_duration_sec=self.log_throttle_s)
 
     def _unreadable_pass(self, exc: Exception) -> None:
@@ -132,18 +134,18 @@ class PassConsumerNode(RailNode):
         reject_ahead(np.array([stamp_ns]), reasons, self.stream_ns, self.margins, self._live_clock_ns())
         return str(reasons[0])
 
-    def _accept(self, table: PassTable, msgs: list[TrainPass]) -> None:
-        self.accepted.tick(len(msgs))
-        self.last_pass_ns = time_ns(msgs[-1].header.stamp)
+    def _accept(self, table: PassTable, heads: list[PassHead]) -> None:
+        self.accepted.tick(len(heads))
+        self.last_pass_ns = heads[-1].stamp_ns
         # A model failing on one accepted pass must not stop the node, nor the other passes.
-        isolate_failures(len(msgs), lambda rows: self.on_passes(table.take(rows), msgs[rows]),
-                         lambda i, exc: self.model_error(msgs[i], exc))
+        isolate_failures(len(heads), lambda rows: self.on_passes(table.take(rows), heads[rows]),
+                         lambda i, exc: self.model_error(heads[i], exc))
 
-    def model_error(self, msg: TrainPass, exc: Exception) -> None:
+    def model_error(self, head: PassHead, exc: Exception) -> None:
         """Count and log a model raising on an accepted pass (diagnostics go to ERROR)."""
         why = f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"
         self.model_errors[why] += 1
-        self.get_logger().error(f"pass {msg.train_id!r}: model error {why}", throttle_duration_sec=self.log_throttle_s)
+        self.get_logger().error(f"pass {head.train_id!r}: model error {why}", throttle_duration_sec=self.log_throttle_s)
 
     def diagnostic_values(self) -> dict[str, Any]:
         values: dict[str, Any] = {

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.bagio.cdr import message_view
-from rail_monitor.bagio.messages import corrugation_from_msg, header_of, rolling_noise_fields, time_ns
+from rail_monitor.bagio.messages import PassHead, corrugation_from_msg, rolling_noise_fields, time_ns
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
@@ -39,7 +39,7 @@ from rail_monitor.noise.config import NOISE_SPECS, noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation
 from rail_monitor.noise.state_of_pass import first_state_needed, state_arrived, state_index
-from rail_msgs.msg import CorrugationState, RollingNoise, TrainPass
+from rail_msgs.msg import CorrugationState, RollingNoise
 
 STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass queue is as deep)
 
@@ -48,7 +48,7 @@ STATES_KEPT = 10_000  # states kept for passes still to come (the train_pass que
 class _Pending:
     table: PassTable  # the passes taken with it (class defaults filled)
     row: int          # its row
-    msg: TrainPass
+    head: PassHead
     stamp_ns: int
     deadline: float   # monotonic [s]; -inf: do not wait
 
@@ -94,12 +94,12 @@ class RollingNoisePredictor(PassConsumerNode):
             self._state_stamps.append(self.states[-1][0])
         self._flush()
 
-    def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
+    def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
         # Always wait (a separate estimator may not be discovered yet when the first pass comes);
         # run without an estimator with state_wait_s:=0.
         wait = self.wait_s > 0
         deadline = time.monotonic() + self.wait_s if wait else float("-inf")
-        self.pending.extend(_Pending(table, i, msg, time_ns(msg.header.stamp), deadline) for i, msg in enumerate(msgs))
+        self.pending.extend(_Pending(table, i, head, head.stamp_ns, deadline) for i, head in enumerate(heads))
         self._flush()
 
     def _flush(self) -> None:
@@ -120,7 +120,7 @@ class RollingNoisePredictor(PassConsumerNode):
         stamps = np.fromiter((st for st, _, _ in states), np.int64, len(states))
         trains = [last for _, last, _ in states]
         arrived = state_arrived(stamps, trains, np.array([p.stamp_ns for p in pending], np.int64),
-                                [p.msg.train_id for p in pending])
+                                [p.head.train_id for p in pending])
         n = 0
         for p, has_state in zip(pending, arrived.tolist(), strict=True):
             if not has_state:
@@ -133,7 +133,7 @@ class RollingNoisePredictor(PassConsumerNode):
             return
         ready = [self.pending.popleft() for _ in range(n)]
         index = state_index(stamps, trains, np.array([p.stamp_ns for p in ready], np.int64),
-                            [p.msg.train_id for p in ready])
+                            [p.head.train_id for p in ready])
         self._predict(ready, [states[k][2] if k >= 0 else None for k in index.tolist()])
 
     def _states_from(self, stamp_ns: int) -> list[tuple[int, str, Corrugation]]:
@@ -159,9 +159,9 @@ class RollingNoisePredictor(PassConsumerNode):
             for k, p in enumerate(passes):
                 for v in values:
                     self.sent.publish(self.pub, rolling_noise_fields(
-                        v, k, header_of(p.msg), p.msg.train_id, self.model.receiver))
+                        v, k, p.head.header, p.head.train_id, self.model.receiver))
 
-        isolate_failures(len(ready), predict, lambda i, exc: self.model_error(ready[i].msg, exc))
+        isolate_failures(len(ready), predict, lambda i, exc: self.model_error(ready[i].head, exc))
 
     def diagnostic_values(self) -> dict[str, Any]:
         last = self.states[-1][0] if self.states else 0

@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 from typing import Any
 
-from rail_monitor.bagio.messages import header_of, squeal_prediction_fields
+from rail_monitor.bagio.messages import PassHead, squeal_prediction_fields
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Sent, declare
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
@@ -19,7 +19,7 @@ from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STREAM_QOS
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
 from rail_monitor.squeal.predict import predict
-from rail_msgs.msg import SquealPrediction, TrainPass
+from rail_msgs.msg import SquealPrediction
 
 
 class SquealRiskNode(PassConsumerNode):
@@ -36,11 +36,10 @@ class SquealRiskNode(PassConsumerNode):
     def key_parameters(self) -> dict[str, Any]:
         return {"k3": self.site.contact.k3_convention}
 
-    def on_passes(self, table: PassTable, msgs: list[TrainPass]) -> None:
+    def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
         values = predict(self.cfg, self.site, table)
-        for i, msg in enumerate(msgs):
-            self.sent.publish(self.pub, squeal_prediction_fields(
-                values, i, header_of(msg), msg.train_id))
+        for i, head in enumerate(heads):
+            self.sent.publish(self.pub, squeal_prediction_fields(values, i, head.header, head.train_id))
 
     def diagnostic_values(self) -> dict[str, Any]:
         return {**super().diagnostic_values(), "published": sum(self.sent.values())}
