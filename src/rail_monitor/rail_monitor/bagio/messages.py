@@ -26,7 +26,7 @@ from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import SQUEAL, Predicted, Residual
 from rail_monitor.noise.config import MODELS
-from rail_monitor.noise.records import Corrugation, NoisePrediction
+from rail_monitor.noise.records import NoisePrediction
 from rail_monitor.squeal.config import RISK_HIGH
 
 if TYPE_CHECKING:
@@ -237,34 +237,16 @@ def alert_from_msg(msg: Any) -> Alert:
                  time_ns(msg.header.stamp), time_ns(msg.raised_time), time_ns(msg.due_time))
 
 
-def corrugation_from_msg(msg: Any) -> Corrugation:
-    """The bands and amplitudes of a CorrugationState; ValueError (its :func:`corrugation_refusal`)
-    when they are unusable. A state without post-grinding amplitudes counts growth from zero."""
-    why = corrugation_refusal(msg)
-    if why:
-        raise ValueError(why)
-    amp = np.asarray(msg.amplitude_m, float)
-    post = np.asarray(msg.post_grinding_m, float) if len(msg.post_grinding_m) else np.zeros_like(amp)
-    return Corrugation(np.asarray(msg.wavelength_m, float), amp, post)
-
-
-def corrugation_series(msgs: list[Any]) -> dict[str, np.ndarray]:
-    """CorrugationStates on the same bands as AlertManager.on_states' arguments: stamps [ns], bands
-    [m] and thresholds [m] of the first, amplitudes [m] (states x bands), forecast fields per state."""
-    return {"stamp_ns": stamps_ns(msgs), "wavelength_m": np.asarray(msgs[0].wavelength_m),
-            "amplitude_m": np.array([m.amplitude_m for m in msgs]), "threshold_m": np.asarray(msgs[0].threshold_m),
-            "days_to_threshold": np.array([m.days_to_threshold for m in msgs]),
-            "grinding_due": np.array([m.grinding_due for m in msgs]),
-            "grinding_due_ns": np.array([time_ns(m.grinding_due_time) for m in msgs], np.int64)}
-
-
 # -- checks on the model outputs a node takes from others -----------------------------------------
 # Any publisher may write to a topic: a node refuses (and counts) what it cannot use, instead of
 # raising alerts on it, predicting from it or stopping.
+STAMP_REFUSAL = "stamp not set, or before 1970"
+
+
 def stamp_refusal(stamp: Any) -> str:
     """Why a header stamp is unusable ('' when it is usable)."""
     ns = time_ns(stamp)
-    return "" if ns > 0 and fits_time_msg(ns) else "stamp not set, or before 1970"
+    return "" if ns > 0 and fits_time_msg(ns) else STAMP_REFUSAL
 
 
 def squeal_refusal(msg: Any) -> str:
@@ -278,30 +260,4 @@ def noise_refusal(msg: Any) -> str:
         return "model unknown"
     if not all(np.isfinite(getattr(msg, k)) for k in NOISE_METRICS):
         return "a single-number level is not finite"
-    return stamp_refusal(msg.header.stamp)
-
-
-def corrugation_refusal(msg: Any) -> str:
-    """Why the bands and amplitudes of a CorrugationState are unusable ('' when usable)."""
-    wl, amp, post = (np.asarray(a, float) for a in (msg.wavelength_m, msg.amplitude_m, msg.post_grinding_m))
-    if not (len(wl) == len(amp) > 0 and len(post) in (0, len(wl))):
-        return "wavelength_m, amplitude_m and post_grinding_m differ in length, or are empty"
-    if not np.all(np.isfinite(wl) & (wl > 0)):
-        return "a wavelength is not positive and finite"
-    if not (np.all(np.isfinite(amp) & (amp >= 0)) and np.all(np.isfinite(post) & (post >= 0))):
-        return "an amplitude is negative or not finite"
-    return ""
-
-
-def state_refusal(msg: Any) -> str:
-    """Why a CorrugationState is unusable for alerts ('' when usable): its bands and amplitudes,
-    its thresholds, its forecast and its stamp."""
-    why = corrugation_refusal(msg)
-    if why:
-        return why
-    thr = np.asarray(msg.threshold_m, float)
-    if len(thr) != len(msg.wavelength_m) or not np.all(np.isfinite(thr) & (thr > 0)):
-        return "threshold_m is not one positive, finite value per band"
-    if np.isnan(msg.days_to_threshold) or msg.days_to_threshold < 0:
-        return "days_to_threshold is NaN or negative"
     return stamp_refusal(msg.header.stamp)

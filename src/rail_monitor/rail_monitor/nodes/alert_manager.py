@@ -26,25 +26,25 @@ from rclpy.parameter import Parameter
 
 from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, SEVERITY_CRITICAL, alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager, describe
+from rail_monitor.bagio.cdr_columns import read_columns
 from rail_monitor.bagio.messages import (
-    corrugation_series,
     measurement_from_msg,
     noise_refusal,
     noise_residual_fields,
     predicted_from_msg,
     squeal_refusal,
     stamps_ns,
-    state_refusal,
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
+from rail_monitor.bagio.state_columns import band_runs, corrugation_series, state_refusals
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import LEAD_TIME
 from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
 from rail_monitor.measured.residuals import Residual, ResidualTracker
-from rail_monitor.nodes.base import Sent, declare, read_views, runs, subscribe_batched, take_queued, wall_timer
+from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
@@ -161,10 +161,15 @@ class AlertManagerNode(PassConsumerNode):
             self._emit(self.alerts.on_residuals(residuals))
 
     def _on_states(self, raws: list[bytes]) -> None:
-        views = read_views(CORRUGATION_STATE, raws, lambda exc: self._unreadable_on("corrugation/state", exc))
-        ok = self._usable("corrugation/state", views, state_refusal)
-        for run in runs(ok, _same_bands):  # states on the same bands and thresholds, as one series
-            self._emit(self.alerts.on_states(**corrugation_series(ok[run])))
+        read = read_columns(CORRUGATION_STATE, raws)
+        for _, exc in read.refused:
+            self._unreadable_on("corrugation/state", exc)
+        reasons = state_refusals(read.values)
+        self.inputs["corrugation/state"] += len(reasons)
+        for why in reasons[reasons != ""].tolist():
+            self._refuse("corrugation/state", why)
+        for run in band_runs(read.values, np.flatnonzero(reasons == "")):  # one series per bands and thresholds
+            self._emit(self.alerts.on_states(**corrugation_series(read.values, run)))
 
     def _on_set_parameters(self, params: list[Parameter]) -> SetParametersResult:
         """ros2 param set on alerts.*: checked as at start-up (ranges, hysteresis), then applied to
@@ -215,11 +220,6 @@ class AlertManagerNode(PassConsumerNode):
         if self.alerts.standing:
             return DiagnosticStatus.WARN, f"{len(self.alerts.standing)} alert(s) standing"
         return super()._level()
-
-
-def _same_bands(a: Any, b: Any) -> bool:
-    return np.array_equal(a.wavelength_m, b.wavelength_m) and np.array_equal(a.threshold_m, b.threshold_m)
-
 
 
 def main(args: list[str] | None = None) -> int:

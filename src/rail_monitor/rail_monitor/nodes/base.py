@@ -15,7 +15,6 @@ from rclpy.clock import Clock, ClockType
 from rclpy.exceptions import ParameterException
 from rclpy.node import Node
 
-from rail_monitor.bagio.cdr import CdrError, message_view
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamGroups, ParamSpec
 from rail_monitor.core.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
@@ -112,18 +111,6 @@ def declare_site(node: Node) -> Site:
         for key, value in declare(node, VEHICLE_SPECS, prefix=f"vehicle.{name}.").items():
             flat[f"vehicle.{name}.{key}"] = value
     return site_from_values(flat)
-
-
-def read_views(typename: str, raws: list[bytes], refused: Callable[[CdrError], None]) -> list[Any]:
-    """The messages of a raw subscription's CDR bytes as attribute views (bagio.cdr.message_view),
-    in order; refused(error) for each that is not one of the type."""
-    out = []
-    for raw in raws:
-        try:
-            out.append(message_view(typename, raw))
-        except CdrError as exc:
-            refused(exc)
-    return out
 
 
 def take_queued(sub: Any, limit: int) -> list[Any]:

@@ -25,8 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.bagio.cdr import message_view
-from rail_monitor.bagio.messages import PassHead, corrugation_from_msg, rolling_noise_fields, time_ns
+from rail_monitor.bagio.cdr_columns import read_columns
+from rail_monitor.bagio.messages import PassHead, rolling_noise_fields
+from rail_monitor.bagio.state_columns import corrugation, corrugation_refusals, time_ns
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
@@ -81,17 +82,15 @@ class RollingNoisePredictor(PassConsumerNode):
         return {"models": "+".join(self.model.models), "state_wait_s": f"{self.wait_s:g}"}
 
     def _on_states(self, raws: list[bytes]) -> None:
-        for raw in raws:
-            try:
-                msg = message_view(CORRUGATION_STATE, raw)
-                corrugation = corrugation_from_msg(msg)
-            except ValueError as exc:  # unusable, or not a CorrugationState's CDR (CdrError)
-                self.states_rejected[str(exc)] += 1
-                self.get_logger().warning(f"corrugation state refused: {exc}",
-                                          throttle_duration_sec=self.log_throttle_s)
-                continue
-            self.states.append((time_ns(msg.header.stamp), msg.last_train_id, corrugation))
-            self._state_stamps.append(self.states[-1][0])
+        read = read_columns(CORRUGATION_STATE, raws)
+        reasons = corrugation_refusals(read.values)
+        for why in [str(exc) for _, exc in read.refused] + [r for r in reasons.tolist() if r]:
+            self.states_rejected[why] += 1
+            self.get_logger().warning(f"corrugation state refused: {why}", throttle_duration_sec=self.log_throttle_s)
+        stamps, trains = time_ns(read.values.header.stamp).tolist(), read.values.last_train_id
+        for i in np.flatnonzero(reasons == "").tolist():
+            self.states.append((stamps[i], trains[i], corrugation(read.values, i)))
+            self._state_stamps.append(stamps[i])
         self._flush()
 
     def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
