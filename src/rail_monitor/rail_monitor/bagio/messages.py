@@ -17,17 +17,14 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from rail_monitor.alerts.config import NOISE_METRICS
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.core.passes import PassTable
-from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, fits_time_msg, from_sec_nanosec, to_sec_nanosec
+from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
-from rail_monitor.measured.residuals import SQUEAL, Predicted, Residual
-from rail_monitor.noise.config import MODELS
+from rail_monitor.measured.residuals import Residual
 from rail_monitor.noise.records import NoisePrediction
-from rail_monitor.squeal.config import RISK_HIGH
 
 if TYPE_CHECKING:
     from rail_monitor.advice.plan import SpeedAdvice
@@ -61,11 +58,6 @@ def header_of(msg: Any) -> Fields:
     """The header of a message as fields (outputs carry their pass's header)."""
     h = msg.header
     return {"stamp": {"sec": h.stamp.sec, "nanosec": h.stamp.nanosec}, "frame_id": h.frame_id}
-
-
-def stamps_ns(msgs: list[Any]) -> np.ndarray:
-    """The header stamps of messages [ns]."""
-    return np.array([time_ns(m.header.stamp) for m in msgs], np.int64)
 
 
 # -- TrainPass ------------------------------------------------------------------------------------
@@ -207,15 +199,6 @@ def measurement_from_msg(msg: Any) -> Measurement:
                        np.array(msg.vehicle_lpaeq_dba, float))
 
 
-def predicted_from_msg(msg: Any) -> Predicted:
-    """A RollingNoise, or a SquealPrediction (its risk), as the prediction a measurement is paired with."""
-    if hasattr(msg, "risk"):
-        return Predicted(time_ns(msg.header.stamp), str(msg.train_id), SQUEAL, np.zeros(0), float("nan"),
-                         float("nan"), float("nan"), int(msg.risk))
-    return Predicted(time_ns(msg.header.stamp), str(msg.train_id), str(msg.model), np.array(msg.lp_db, float),
-                     float(msg.lpaeq_tp_dba), float(msg.lpafmax_dba), float(msg.tel_dba))
-
-
 def residual_from_msg(msg: Any) -> Residual:
     """A NoiseResidual as a Residual."""
     names = [f.name for f in dataclass_fields(Residual) if f.name != "stamp_ns"]
@@ -235,29 +218,3 @@ def alert_from_msg(msg: Any) -> Alert:
     """A WaysideAlert as an Alert."""
     return Alert(msg.kind, msg.key, msg.severity, msg.active, msg.summary, msg.value, msg.threshold, msg.unit,
                  time_ns(msg.header.stamp), time_ns(msg.raised_time), time_ns(msg.due_time))
-
-
-# -- checks on the model outputs a node takes from others -----------------------------------------
-# Any publisher may write to a topic: a node refuses (and counts) what it cannot use, instead of
-# raising alerts on it, predicting from it or stopping.
-STAMP_REFUSAL = "stamp not set, or before 1970"
-
-
-def stamp_refusal(stamp: Any) -> str:
-    """Why a header stamp is unusable ('' when it is usable)."""
-    ns = time_ns(stamp)
-    return "" if ns > 0 and fits_time_msg(ns) else STAMP_REFUSAL
-
-
-def squeal_refusal(msg: Any) -> str:
-    """Why a SquealPrediction is unusable ('' when it is usable)."""
-    return stamp_refusal(msg.header.stamp) or ("risk unknown" if msg.risk > RISK_HIGH else "")
-
-
-def noise_refusal(msg: Any) -> str:
-    """Why a RollingNoise is unusable ('' when it is usable)."""
-    if msg.model not in MODELS:
-        return "model unknown"
-    if not all(np.isfinite(getattr(msg, k)) for k in NOISE_METRICS):
-        return "a single-number level is not finite"
-    return stamp_refusal(msg.header.stamp)

@@ -29,21 +29,25 @@ from rail_monitor.alerts.manager import Alert, AlertManager, describe
 from rail_monitor.bagio.cdr_columns import read_columns
 from rail_monitor.bagio.messages import (
     measurement_from_msg,
-    noise_refusal,
     noise_residual_fields,
-    predicted_from_msg,
-    squeal_refusal,
-    stamps_ns,
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
-from rail_monitor.bagio.state_columns import band_runs, corrugation_series, state_refusals
-from rail_monitor.bagio.typestore import CORRUGATION_STATE
+from rail_monitor.bagio.output_columns import (
+    band_runs,
+    corrugation_series,
+    noise_refusals,
+    predictions,
+    squeal_refusals,
+    state_refusals,
+    time_ns,
+)
+from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import LEAD_TIME
 from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
-from rail_monitor.measured.residuals import Residual, ResidualTracker
+from rail_monitor.measured.residuals import Predicted, Residual, ResidualTracker
 from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
@@ -83,12 +87,11 @@ class AlertManagerNode(PassConsumerNode):
                                               STREAM_SUB_QOS, self.max_batch)
         # Each stream in its own order (streams do not interact): what is queued is taken at once and
         # fed as one series; alerts/standing (latched, latest only) is published once per series.
+        # Raw: the messages taken are read from their CDR together, as columns (not converted by rclpy).
         for msg_type, topic, handle, qos in ((SquealPrediction, "noise/squeal", self._on_squeal, STREAM_SUB_QOS),
-                                             (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS)):
-            subscribe_batched(self, msg_type, topic, handle, qos, self.max_batch)
-        # Raw: a state is read straight from its CDR (numpy views of its arrays), not converted by rclpy.
-        subscribe_batched(self, CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS, self.max_batch,
-                          raw=True)
+                                             (RollingNoise, "noise/rolling", self._on_noise, STREAM_SUB_QOS),
+                                             (CorrugationState, "corrugation/state", self._on_states, STATE_SUB_QOS)):
+            subscribe_batched(self, msg_type, topic, handle, qos, self.max_batch, raw=True)
         # The initial (empty) standing set for late subscribers, once the clock runs: a message
         # stamped 0 before the first /clock would stretch a bag's timeline back to 1970.
         self._initial = wall_timer(self, 0.1, self._publish_initial_standing)
@@ -101,17 +104,17 @@ class AlertManagerNode(PassConsumerNode):
     def on_validated(self, table: PassTable, reasons: list[str]) -> None:
         self._emit(self.alerts.on_train_passes(table.stamp_ns, np.array([bool(r) for r in reasons])))
 
-    def _usable(self, topic: str, msgs: list[Any], refusal: Callable[[Any], str]) -> list[Any]:
-        """The messages of topic this node can use; the others counted by reason and logged."""
-        self.inputs[topic] += len(msgs)
-        ok = []
-        for m in msgs:
-            why = refusal(m)
-            if why:
-                self._refuse(topic, why)
-            else:
-                ok.append(m)
-        return ok
+    def _usable(self, topic: str, raws: list[bytes], refusals: Callable[[Any], np.ndarray]) -> tuple[Any, np.ndarray]:
+        """The messages of topic as columns, and the rows of those this node can use; the others
+        counted by reason and logged."""
+        read = read_columns(GRAPH_TOPICS[topic][0], raws)
+        for _, exc in read.refused:
+            self._unreadable_on(topic, exc)
+        reasons = refusals(read.values)
+        self.inputs[topic] += len(reasons)
+        for why in reasons[reasons != ""].tolist():
+            self._refuse(topic, why)
+        return read.values, np.flatnonzero(reasons == "")
 
     def _refuse(self, topic: str, why: str) -> None:
         self.inputs[f"{topic} refused: {why}"] += 1
@@ -121,30 +124,31 @@ class AlertManagerNode(PassConsumerNode):
         self.inputs[topic] += 1
         self._refuse(topic, f"not a readable CDR message ({exc})")
 
-    def _on_squeal(self, msgs: list[SquealPrediction]) -> None:
-        msgs = self._usable("noise/squeal", msgs, squeal_refusal)
-        if msgs:
-            self._emit(self.alerts.on_squeal(stamps_ns(msgs), np.array([m.risk for m in msgs])))
-            self._predicted(msgs)
+    def _on_squeal(self, raws: list[bytes]) -> None:
+        values, ok = self._usable("noise/squeal", raws, squeal_refusals)
+        if len(ok):
+            self._emit(self.alerts.on_squeal(time_ns(values.header.stamp)[ok], values.risk[ok].astype(np.int64)))
+            self._predicted(predictions(values, ok))
 
-    def _on_noise(self, msgs: list[RollingNoise]) -> None:
-        msgs = self._usable("noise/rolling", msgs, noise_refusal)
+    def _on_noise(self, raws: list[bytes]) -> None:
+        values, ok = self._usable("noise/rolling", raws, noise_refusals)
+        stamps, model_of = time_ns(values.header.stamp), np.array(values.model, object)
         events: list[Alert] = []
-        for model in dict.fromkeys(m.model for m in msgs):  # each source model's stream in its order
-            mine = [m for m in msgs if m.model == model]
-            events += self.alerts.on_noise(stamps_ns(mine), model, {
-                k: np.array([getattr(m, k) for m in mine]) for k in NOISE_METRICS})
+        for model in dict.fromkeys(model_of[ok].tolist()):  # each source model's stream in its order
+            mine = ok[model_of[ok] == model]
+            events += self.alerts.on_noise(stamps[mine], model, {
+                k: np.asarray(getattr(values, k), float)[mine] for k in NOISE_METRICS})
         self._emit(sorted(events, key=lambda e: e.stamp_ns))
-        self._predicted(msgs)
+        self._predicted(predictions(values, ok))
 
-    def _predicted(self, msgs: list[Any]) -> None:
+    def _predicted(self, predicted: list[Predicted]) -> None:
         """Predictions for the measurements. Measurements sent before these passes are queued by
         now (a replay sends each before the next pass, acknowledged): they are taken first, so
         they are scored in stamp order."""
         queued = take_queued(self.measured_sub, self.max_batch)
         if queued:
             self._on_measured(queued)
-        self._residuals(self.tracker.add_predictions([predicted_from_msg(m) for m in msgs]))
+        self._residuals(self.tracker.add_predictions(predicted))
 
     def _on_measured(self, msgs: list[MeasuredPassNoise]) -> None:
         self.inputs["noise/measured"] += len(msgs)
@@ -161,15 +165,9 @@ class AlertManagerNode(PassConsumerNode):
             self._emit(self.alerts.on_residuals(residuals))
 
     def _on_states(self, raws: list[bytes]) -> None:
-        read = read_columns(CORRUGATION_STATE, raws)
-        for _, exc in read.refused:
-            self._unreadable_on("corrugation/state", exc)
-        reasons = state_refusals(read.values)
-        self.inputs["corrugation/state"] += len(reasons)
-        for why in reasons[reasons != ""].tolist():
-            self._refuse("corrugation/state", why)
-        for run in band_runs(read.values, np.flatnonzero(reasons == "")):  # one series per bands and thresholds
-            self._emit(self.alerts.on_states(**corrugation_series(read.values, run)))
+        values, ok = self._usable("corrugation/state", raws, state_refusals)
+        for run in band_runs(values, ok):  # one series per bands and thresholds
+            self._emit(self.alerts.on_states(**corrugation_series(values, run)))
 
     def _on_set_parameters(self, params: list[Parameter]) -> SetParametersResult:
         """ros2 param set on alerts.*: checked as at start-up (ranges, hysteresis), then applied to

@@ -27,7 +27,7 @@ import numpy as np
 
 from rail_monitor.bagio.cdr_columns import read_columns
 from rail_monitor.bagio.messages import PassHead, rolling_noise_fields
-from rail_monitor.bagio.state_columns import corrugation, corrugation_refusals, time_ns
+from rail_monitor.bagio.output_columns import corrugation, corrugation_refusals, time_ns
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable

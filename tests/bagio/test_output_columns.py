@@ -1,13 +1,14 @@
-"""CorrugationStates taken together (rail_monitor.bagio.state_columns): each state's refusal is the
-first rule it breaks, stated here state by state, whether its columns came as one block (every
-state on as many bands) or per state; runs and series as a loop over the states gives them."""
+"""Model outputs taken together (rail_monitor.bagio.output_columns): each message's refusal is the
+first rule it breaks, stated here message by message, whether a state's columns came as one block
+(every state on as many bands) or per state; runs, series and predictions as a loop over the
+messages gives them."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from rail_monitor.bagio import state_columns as sc
+from rail_monitor.bagio import output_columns as sc
 from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.cdr_columns import FEW, read_columns
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
@@ -55,7 +56,7 @@ def _expected(f):
             return why, why
     for bad, why in ((len(thr) != len(wl) or not np.all(np.isfinite(thr) & (thr > 0))), sc.THRESHOLD), \
                      (np.isnan(f["days_to_threshold"]) or f["days_to_threshold"] < 0, sc.DAYS), \
-                     (not (0 < ns < 2**31 * 10**9), "stamp not set, or before 1970"):
+                     (not (0 < ns < 2**31 * 10**9), sc.STAMP):
         if bad:
             return "", why
     return "", ""
@@ -102,3 +103,42 @@ def test_runs_and_series_follow_the_bands_and_thresholds(n):
     assert series["stamp_ns"].tolist() == [fields[k]["header"]["stamp"]["sec"] * 10**9
                                            + fields[k]["header"]["stamp"]["nanosec"] for k in got[-1]]
     assert series["grinding_due"].tolist() == [fields[k]["grinding_due"] for k in got[-1]]
+
+
+@pytest.mark.parametrize("n", [5, FEW + 5])
+def test_noise_and_squeal_refusals_and_predictions(n):
+    from rail_monitor.measured.residuals import SQUEAL
+
+    rng = np.random.default_rng(n)
+    noise, squeal = [], []
+    for k in range(n):
+        stamp = {"sec": int(rng.integers(1, 2**31 - 1)), "nanosec": int(rng.integers(0, 10**9))}
+        header = {"stamp": stamp, "frame_id": "site"}
+        levels = {m: float(rng.random() * 90) for m in ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")}
+        noise.append({"header": header, "train_id": f"T{k}", "model": ("cnossos", "mechanics")[k % 2],
+                      "lp_db": rng.random(4).tolist(), **levels})
+        squeal.append({"header": header, "train_id": f"T{k}", "risk": int(rng.integers(0, 4))})
+    # each flaw once, and a model unknown with a level not finite: the model is named
+    noise[1]["model"] = "other"
+    noise[2]["tel_dba"] = float("inf")
+    noise[3]["header"] = {"stamp": {"sec": 0, "nanosec": 0}, "frame_id": "site"}
+    noise[4].update(model="", lpafmax_dba=float("nan"))
+    squeal[1]["risk"] = 4
+    squeal[2]["header"] = {"stamp": {"sec": -1, "nanosec": 0}, "frame_id": "site"}
+    squeal[3].update(risk=9, header=noise[3]["header"])
+    want_noise = ["", sc.MODEL, sc.LEVEL, sc.STAMP, sc.MODEL] + [""] * (n - 5)
+    want_squeal = ["", sc.RISK, sc.STAMP, sc.STAMP] + [""] * (n - 4)
+    nv = read_columns("rail_msgs/msg/RollingNoise", [serialize("rail_msgs/msg/RollingNoise", f) for f in noise]).values
+    sv = read_columns("rail_msgs/msg/SquealPrediction",
+                      [serialize("rail_msgs/msg/SquealPrediction", f) for f in squeal]).values
+    assert sc.noise_refusals(nv).tolist() == want_noise
+    assert sc.squeal_refusals(sv).tolist() == want_squeal
+    ok = np.flatnonzero(sc.noise_refusals(nv) == "")
+    for p, k in zip(sc.predictions(nv, ok), ok.tolist(), strict=True):
+        f = noise[k]
+        assert (p.stamp_ns, p.train_id, p.model) == (f["header"]["stamp"]["sec"] * 10**9
+                                                     + f["header"]["stamp"]["nanosec"], f["train_id"], f["model"])
+        assert (p.lpaeq_tp_dba, p.lpafmax_dba, p.tel_dba) == (f["lpaeq_tp_dba"], f["lpafmax_dba"], f["tel_dba"])
+        np.testing.assert_array_equal(p.lp_db, f["lp_db"])
+    got = sc.predictions(sv, np.array([0]))[0]
+    assert (got.model, got.squeal_risk, got.train_id) == (SQUEAL, squeal[0]["risk"], "T0")

@@ -1,7 +1,8 @@
-"""CorrugationStates taken together (read as columns, bagio.cdr_columns): why each is unusable,
-the corrugation each carries, and runs of them as the alert manager's series. The one place for
-each check on a state a node takes from another: any publisher may write to the topic, so a node
-refuses (and counts) what it cannot use instead of predicting or raising alerts from it.
+"""Model outputs a node takes from another (CorrugationState, RollingNoise, SquealPrediction),
+taken together as columns (bagio.cdr_columns): why each is unusable, and what the node uses of
+them (a state's corrugation, runs of states as the alert manager's series, predictions for the
+measured noise). The one place for each check on them: any publisher may write to a topic, so a
+node refuses (and counts) what it cannot use instead of predicting or raising alerts from it.
 
 A column of per-band values is (states, bands) where every state has as many values, else one
 array per state; each check is written once over a (states, bands) block and applied to the
@@ -14,15 +15,22 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.bagio.messages import STAMP_REFUSAL
+from rail_monitor.alerts.config import NOISE_METRICS
 from rail_monitor.core.timeutil import NS_PER_S, fits_time_msg
+from rail_monitor.measured.residuals import SQUEAL, Predicted
+from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.records import Corrugation
+from rail_monitor.squeal.config import RISK_HIGH
 
 LENGTHS = "wavelength_m, amplitude_m and post_grinding_m differ in length, or are empty"
 WAVELENGTH = "a wavelength is not positive and finite"
 AMPLITUDE = "an amplitude is negative or not finite"
 THRESHOLD = "threshold_m is not one positive, finite value per band"
 DAYS = "days_to_threshold is NaN or negative"
+STAMP = "stamp not set, or before 1970"
+MODEL = "model unknown"
+LEVEL = "a single-number level is not finite"
+RISK = "risk unknown"
 
 
 def time_ns(t: Any) -> np.ndarray:
@@ -71,9 +79,43 @@ def state_refusals(values: Any) -> np.ndarray:
         _first(part, bad, THRESHOLD)
     days = np.asarray(values.days_to_threshold, float)
     _first(out, np.isnan(days) | (days < 0), DAYS)
-    stamp = time_ns(values.header.stamp)
-    _first(out, ~((stamp > 0) & fits_time_msg(stamp)), STAMP_REFUSAL)
+    _first(out, _bad_stamp(values), STAMP)
     return out
+
+
+def _bad_stamp(values: Any) -> np.ndarray:
+    """Header stamps not set, before 1970 or past what builtin_interfaces/Time holds."""
+    stamp = time_ns(values.header.stamp)
+    return ~((stamp > 0) & fits_time_msg(stamp))
+
+
+def noise_refusals(values: Any) -> np.ndarray:
+    """Why each RollingNoise is unusable ('' when usable): its model, its single-number levels, its stamp."""
+    out = np.full(len(values.model), "", object)
+    _first(out, ~np.isin(np.array(values.model, object), list(MODELS)), MODEL)
+    _first(out, ~np.all([np.isfinite(getattr(values, k)) for k in NOISE_METRICS], axis=0), LEVEL)
+    _first(out, _bad_stamp(values), STAMP)
+    return out
+
+
+def squeal_refusals(values: Any) -> np.ndarray:
+    """Why each SquealPrediction is unusable ('' when usable): its stamp, its risk."""
+    out = np.full(len(values.risk), "", object)
+    _first(out, _bad_stamp(values), STAMP)
+    _first(out, values.risk > RISK_HIGH, RISK)
+    return out
+
+
+def predictions(values: Any, rows: np.ndarray) -> list[Predicted]:
+    """RollingNoise (or SquealPrediction: its risk) at rows as the predictions measurements are paired with."""
+    stamps, ids = time_ns(values.header.stamp).tolist(), values.train_id
+    if hasattr(values, "risk"):
+        risk = values.risk.tolist()
+        return [Predicted(stamps[i], ids[i], SQUEAL, np.zeros(0), float("nan"), float("nan"), float("nan"), risk[i])
+                for i in rows.tolist()]
+    eq, fmax, tel = (np.asarray(getattr(values, k), float).tolist() for k in ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba"))
+    return [Predicted(stamps[i], ids[i], values.model[i], np.array(values.lp_db[i], float), eq[i], fmax[i], tel[i])
+            for i in rows.tolist()]
 
 
 def corrugation(values: Any, i: int) -> Corrugation:
