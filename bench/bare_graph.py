@@ -108,9 +108,9 @@ class _Alerts(_StandIn):
 class _CountingRecorder(McapRecorder):
     """mcap_recorder with a callback that counts and writes nothing."""
 
-    def _on_message(self, topic: str, data: bytes) -> None:
-        self.counts[topic] += 1
-        self.meter.tick()
+    def _on_messages(self, topic: str, msgs: list[bytes]) -> None:
+        self.counts[topic] += len(msgs)
+        self.meter.tick(len(msgs))
 
 
 def _outputs(passes: PassTable, values: Mapping[str, Any]) -> tuple[bytes, dict[str, bytes], bytes]:

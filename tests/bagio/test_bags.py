@@ -97,6 +97,23 @@ def test_split_by_size_keeps_every_message(tmp_path: Path, sample_passes):
     assert len(read_bag_passes(tmp_path / "split")) == 2000
 
 
+def test_messages_written_together_make_the_same_files_as_one_by_one(tmp_path: Path, sample_passes):
+    # split by size inside a block of messages, as at its edges; the files equal byte for byte
+    data = pass_cdr(sample_passes.take(slice(0, 700)), "s")
+    stamps = [1_000_000_000 + i for i in range(len(data))]
+    for name, blocks in (("one", [1] * len(data)), ("many", [1, 37, 200, 3, 459])):
+        with McapBagWriter(tmp_path / name / "bag", chunk_size=4096, max_file_bytes=20_000) as w:
+            w.add_topic("/train_pass", TRAIN_PASS, [qos_dict()])
+            at = 0
+            for n in blocks:
+                w.write_many("/train_pass", data[at:at + n], stamps[at:at + n])
+                at += n
+            assert w.written("/train_pass") == len(data)
+    one, many = (sorted((tmp_path / name / "bag").glob("*.mcap")) for name in ("one", "many"))
+    assert len(one) > 2 and [f.name for f in one] == [f.name for f in many]
+    assert all(a.read_bytes() == b.read_bytes() for a, b in zip(one, many, strict=True))
+
+
 def test_split_by_duration(tmp_path: Path, sample_passes):
     part = sample_passes.take(slice(0, 1000))  # about 10 days
     with McapBagWriter(tmp_path / "d", max_file_duration_ns=2 * 86400 * 10**9) as w:

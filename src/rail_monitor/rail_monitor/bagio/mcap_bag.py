@@ -16,7 +16,7 @@ import os
 import shutil
 import time
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -178,6 +178,17 @@ class McapBagWriter:
     # -- writing ----------------------------------------------------------------------------
     def write(self, topic: str, data: bytes, log_time_ns: int, publish_time_ns: int | None = None) -> None:
         """Append one serialised message [CDR bytes] at log_time_ns [ns since the epoch]."""
+        self.write_many(topic, [data], [log_time_ns], None if publish_time_ns is None else [publish_time_ns])
+
+    def written(self, topic: str) -> int:
+        """Messages of the topic written so far (0: none, or not added)."""
+        t = self._topics.get(topic)
+        return 0 if t is None else t.count
+
+    def write_many(self, topic: str, datas: Sequence[bytes], log_times_ns: Sequence[int],
+                   publish_times_ns: Sequence[int] | None = None) -> None:
+        """Append messages of one topic in order (write's, one by one; the flush period is looked
+        at after the last)."""
         if self.closed:
             raise RailMonitorError("bag writer is closed")
         if self.error:
@@ -185,29 +196,28 @@ class McapBagWriter:
         t = self._topics.get(topic)
         if t is None:
             raise RailMonitorError(f"topic {topic} was not added to the bag")
-        f = self._file
-        if f is not None and f.first_ns is not None and (
-            (self._max_bytes and f.stream.tell() >= self._max_bytes)
-            or (self._max_duration and log_time_ns - f.first_ns >= self._max_duration)
-        ):
-            with self._failing_on_os_error():
-                self._split(f)
-            f = None
         with self._failing_on_os_error():
-            if f is None:
-                f = self._file = self._open_file()
-            f.writer.add_message(channel_id=f.channel_ids[topic], log_time=log_time_ns, data=data,
-                                 publish_time=log_time_ns if publish_time_ns is None else publish_time_ns,
-                                 sequence=t.count)
-        if f.first_ns is None:
-            f.first_ns = log_time_ns
-        f.first_ns = min(f.first_ns, log_time_ns)
-        f.last_ns = max(f.last_ns, log_time_ns)
-        self._newest_ns = max(self._newest_ns, log_time_ns)
-        f.count += 1
-        f.topic_counts[topic] += 1
-        t.count += 1
-        self._maybe_flush(log_time_ns)
+            for k, (data, log_time_ns) in enumerate(zip(datas, log_times_ns, strict=True)):
+                f = self._file
+                if f is not None and f.first_ns is not None and (
+                    (self._max_bytes and f.stream.tell() >= self._max_bytes)
+                    or (self._max_duration and log_time_ns - f.first_ns >= self._max_duration)
+                ):
+                    self._split(f)
+                    f = None
+                if f is None:
+                    f = self._file = self._open_file()
+                f.writer.add_message(channel_id=f.channel_ids[topic], log_time=log_time_ns, data=data,
+                                     publish_time=log_time_ns if publish_times_ns is None else publish_times_ns[k],
+                                     sequence=t.count)
+                f.first_ns = log_time_ns if f.first_ns is None else min(f.first_ns, log_time_ns)
+                f.last_ns = max(f.last_ns, log_time_ns)
+                self._newest_ns = max(self._newest_ns, log_time_ns)
+                f.count += 1
+                f.topic_counts[topic] += 1
+                t.count += 1
+        if len(datas):
+            self._maybe_flush(log_times_ns[-1])
 
     def _maybe_flush(self, log_time_ns: int) -> None:
         now = time.monotonic()

@@ -29,8 +29,7 @@ def write_passes_bag(table: PassTable, folder: str | Path, frame_id: str, topic:
     time = stamp; returns the bag folder."""
     with McapBagWriter(folder, chunk_size=chunk_size) as bag:
         bag.add_topic(topic, TRAIN_PASS, [STREAM.as_metadata()])
-        for stamp, data in zip(table.stamp_ns, pass_cdr(table, frame_id), strict=True):
-            bag.write(topic, data, int(stamp))
+        bag.write_many(topic, pass_cdr(table, frame_id), table.stamp_ns.tolist())
         ns = topic.rsplit("/", 1)[0]
         for name, typename, qos, items, to_fields in (
                 ("roughness_survey", ROUGHNESS_SURVEY, EVENT, events, roughness_survey_fields),

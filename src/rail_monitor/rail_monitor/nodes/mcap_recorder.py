@@ -62,6 +62,7 @@ class McapRecorder(TapNode):
         self.tap = TopicTap(self, self.cfg.topics, self.cfg.discovery_period_s, self._add_topic, self._on_messages)
         wall_timer(self, max(self.cfg.flush_period_s, 0.05), self._flush, callback_group=self.tap.group)
         self.dropped = 0  # messages not recorded after a write error
+        self._failed = False  # a write error was reported
         self.refused: Counter[str] = Counter()  # messages that could not be written, by cause
         self.diagnostics = Diagnostics(
             self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
@@ -88,41 +89,51 @@ class McapRecorder(TapNode):
         self.get_logger().info(f"recording {topic} [{typename}]")
 
     def _on_messages(self, topic: str, msgs: list[bytes]) -> None:
-        for data in msgs:
-            self._on_message(topic, data)
-
-    def _on_message(self, topic: str, data: bytes) -> None:
+        """The messages of one take, received together: one receipt time."""
         with self._lock:
             if self.writer.closed:
                 return
             now = self.get_clock().now().nanoseconds
-            if now <= 0 and self.cfg.log_time == "receive" and len(self._before_clock) < BEFORE_CLOCK_MAX:
-                # Sim time before the first /clock: no receipt time yet. Held, and logged at the
-                # clock's first time, so the bag's timeline is the pass time's alone.
-                self._before_clock.append((topic, data))
+            if now <= 0 and self.cfg.log_time == "receive":
+                for data in msgs:
+                    self._before_first_clock(topic, data)
                 return
             self._write_before_clock(now)
-            self._write(topic, data, self._log_time(topic, data, now))
+            self._write(topic, msgs, [self._log_time(topic, data, now) for data in msgs])
+
+    def _before_first_clock(self, topic: str, data: bytes) -> None:
+        """Sim time before the first /clock: no receipt time yet. Held, and logged at the clock's
+        first time, so the bag's timeline is the pass time's alone (at most BEFORE_CLOCK_MAX held)."""
+        if len(self._before_clock) < BEFORE_CLOCK_MAX:
+            self._before_clock.append((topic, data))
+            return
+        self._write_before_clock(0)
+        self._write(topic, [data], [self._log_time(topic, data, 0)])
 
     def _write_before_clock(self, now: int) -> None:
         """Log what arrived before the first /clock at now (the clock's first time), or, when no
         clock ever came (now 0), at its header stamp or the wall clock."""
         held, self._before_clock = self._before_clock, []
         for topic, data in held:
-            self._write(topic, data, now if now > 0 else self._log_time(topic, data, 0))
+            self._write(topic, [data], [now if now > 0 else self._log_time(topic, data, 0)])
 
-    def _write(self, topic: str, data: bytes, log_time_ns: int) -> None:
+    def _write(self, topic: str, datas: list[bytes], log_times_ns: list[int]) -> None:
+        """Write messages of a topic in order; one that cannot be written is counted and skipped."""
         with self._lock:
+            before = self.writer.written(topic)
             try:
-                self.writer.write(topic, data, log_time_ns)
+                self.writer.write_many(topic, datas, log_times_ns)
+                done, failed = len(datas), None
             except RailMonitorError as exc:
-                self._write_failed(exc)
-                return
+                done, failed = self.writer.written(topic) - before, None
+                self._write_failed(exc, len(datas) - done)
             except Exception as exc:  # one malformed message must not stop the recording
-                self.refused[f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"] += 1
-                return
-            self.counts[topic] += 1
-        self.meter.tick()
+                done, failed = self.writer.written(topic) - before, exc
+            self.counts[topic] += done
+            self.meter.tick(done)
+            if failed is not None:
+                self.refused[f"{type(failed).__name__}: {(str(failed).splitlines() or [''])[0]}"] += 1
+                self._write(topic, datas[done + 1:], log_times_ns[done + 1:])
 
     def _log_time(self, topic: str, data: bytes, now: int) -> int:
         """The node clock at receipt, now (as rosbag2; pass time on sim time), or with log_time
@@ -134,10 +145,13 @@ class McapRecorder(TapNode):
             return stamp
         return now if now > 0 else stamp if stamp > 0 else time.time_ns()
 
-    def _write_failed(self, exc: RailMonitorError) -> None:
-        """A full disk or a write error: the bag stops; what it holds stays readable (salvage)."""
-        self.dropped += 1
-        if self.dropped == 1:
+    def _write_failed(self, exc: RailMonitorError, lost: int = 0) -> None:
+        """A full disk or a write error: the bag stops; what it holds stays readable (salvage).
+        lost: the messages it leaves unrecorded."""
+        first = not self._failed
+        self._failed = True
+        self.dropped += lost
+        if first:
             self.get_logger().error(str(exc))
             self.diagnostics.publish()  # at once: an operator must hear of it before the next period
 
