@@ -105,3 +105,24 @@ def test_times_past_2038_are_never_and_unknown_fields_are_refused():
     with pytest.raises(KeyError, match="no field"):
         serialize("rail_msgs/msg/TrainPass", {"train_idd": "x"})
     assert message_class("rail_msgs/msg/TrainPass").__name__ == "TrainPass"
+
+
+def test_outputs_as_columns_are_the_bytes_of_each_outputs_fields(outputs):
+    # the columns a node publishes a backlog's outputs from, written together (bagio.cdr_from_columns),
+    # against each pass's fields written alone: every model, every pass of a real run
+    from rail_monitor.bagio.cdr_from_columns import serialize_columns
+
+    r = outputs
+    heads = []
+    for i in range(len(r.accepted)):
+        tp = fields.train_pass_fields(r.accepted.row(i), r.site.site_id)
+        heads.append(fields.PassHead(0, tp["header"], tp["train_id"]))
+    n = len(heads)
+    assert n > 20
+    for model, out in r.noise.items():
+        got = serialize_columns("rail_msgs/msg/RollingNoise", fields.rolling_noise_columns(out, heads, r.receiver), n)
+        assert got == [serialize("rail_msgs/msg/RollingNoise", fields.rolling_noise_fields(
+            out, i, heads[i].header, heads[i].train_id, r.receiver)) for i in range(n)], model
+    got = serialize_columns("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_columns(r.squeal, heads), n)
+    assert got == [serialize("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_fields(
+        r.squeal, i, heads[i].header, heads[i].train_id)) for i in range(n)]

@@ -102,6 +102,19 @@ def squeal_prediction_fields(values: dict[str, np.ndarray], i: int, header: Fiel
     return {"header": header, "train_id": train_id, **{k: v[i].item() for k, v in values.items()}}
 
 
+def heads_columns(heads: list[PassHead]) -> Fields:
+    """The header and train_id of each pass's output, as columns (bagio.cdr_from_columns)."""
+    return {"header": {"stamp": {"sec": [h.header["stamp"]["sec"] for h in heads],
+                                 "nanosec": [h.header["stamp"]["nanosec"] for h in heads]},
+                       "frame_id": [h.header["frame_id"] for h in heads]},
+            "train_id": [h.train_id for h in heads]}
+
+
+def squeal_prediction_columns(values: dict[str, np.ndarray], heads: list[PassHead]) -> Fields:
+    """rail_monitor.squeal.predict.predict's rows as SquealPrediction columns for their passes."""
+    return {**heads_columns(heads), **values}
+
+
 def corrugation_state_fields(snap: StateSnapshot, fc: Forecast, frame_id: str) -> Fields:
     """A corrugation state (a StateSnapshot, or the estimator itself) and its Forecast as
     CorrugationState fields."""
@@ -130,6 +143,20 @@ def speed_advisory_fields(advice: SpeedAdvice, stamp_ns: int, frame_id: str) -> 
         else:
             out[name] = float(value)
     return out
+
+
+def rolling_noise_columns(p: NoisePrediction, heads: list[PassHead], receiver: Any) -> Fields:
+    """A NoisePrediction of the passes as RollingNoise columns (rolling_noise_fields, pass by pass)."""
+    n = len(heads)
+    components = [p.components(i) for i in range(n)]
+    return {**heads_columns(heads), "model": [p.model] * n, "speed_mps": p.speed_mps,
+            "receiver_distance_m": np.full(n, float(receiver.distance_m)),
+            "receiver_height_m": np.full(n, float(receiver.height_m)),
+            "band_centre_hz": np.broadcast_to(p.band_centre_hz, (n, len(p.band_centre_hz))), "lp_db": p.lp_db,
+            "lw_db": p.lw_db, "roughness_db": p.roughness_db, "pass_by_time_s": p.pass_by_time_s,
+            "lpaeq_tp_dba": p.lpaeq_tp_dba, "lpafmax_dba": p.lpafmax_dba, "tel_dba": p.tel_dba,
+            "roughness_growth_increase_db": p.roughness_growth_increase_db,
+            "component_names": [c[0] for c in components], "component_lpaeq_dba": [c[1] for c in components]}
 
 
 def rolling_noise_fields(p: NoisePrediction, i: int, header: Fields, train_id: str, receiver: Any) -> Fields:

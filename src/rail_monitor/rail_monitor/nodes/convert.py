@@ -13,6 +13,7 @@ from builtin_interfaces.msg import Time
 
 from rail_monitor.bagio import messages
 from rail_monitor.bagio.cdr import serialize
+from rail_monitor.bagio.cdr_from_columns import serialize_columns
 from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.nodes.qos import profile
 
@@ -70,6 +71,11 @@ def to_cdr(cls: type, fields: Mapping[str, Any]) -> bytes:
     """The CDR bytes of to_msg(cls, fields), packed by bagio.cdr's compiled encoder: what the nodes
     publish (rclpy sends bytes as they are), so no rclpy message is built and converted per output."""
     return serialize(typename_of(cls), fields)
+
+
+def to_cdr_many(cls: type, columns: Any, n: int) -> list[bytes]:
+    """The CDR bytes of n messages given as columns (bagio.cdr_from_columns), as to_cdr gives each."""
+    return serialize_columns(typename_of(cls), columns, n)
 
 
 def time_msg(ns: int) -> Time:

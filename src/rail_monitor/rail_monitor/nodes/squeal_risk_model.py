@@ -11,9 +11,10 @@ from __future__ import annotations
 import sys
 from typing import Any
 
-from rail_monitor.bagio.messages import PassHead, squeal_prediction_fields
+from rail_monitor.bagio.messages import PassHead, squeal_prediction_columns
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Sent, declare
+from rail_monitor.nodes.convert import to_cdr_many
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STREAM_QOS
@@ -38,8 +39,8 @@ class SquealRiskNode(PassConsumerNode):
 
     def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
         values = predict(self.cfg, self.site, table)
-        for i, head in enumerate(heads):
-            self.sent.publish(self.pub, squeal_prediction_fields(values, i, head.header, head.train_id))
+        for data in to_cdr_many(SquealPrediction, squeal_prediction_columns(values, heads), len(heads)):
+            self.sent.send(self.pub, data)
 
     def diagnostic_values(self) -> dict[str, Any]:
         return {**super().diagnostic_values(), "published": sum(self.sent.values())}

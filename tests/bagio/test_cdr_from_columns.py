@@ -1,0 +1,51 @@
+"""Messages written together from columns (rail_monitor.bagio.cdr_from_columns) against the
+per-message writer (rail_monitor.bagio.cdr.serialize, itself held to rosbags' bytes): the same
+bytes for every message, on random messages of every graph type that has no sequence of
+messages (random string and sequence lengths: every alignment an offset can take)."""
+
+from __future__ import annotations
+
+import zlib
+
+import numpy as np
+import pytest
+
+from rail_monitor.bagio.cdr import serialize
+from rail_monitor.bagio.cdr_columns import FEW, read_columns
+from rail_monitor.bagio.cdr_from_columns import serialize_columns
+from tests.bagio.test_cdr_columns import COLUMN_TYPES
+
+from conftest import random_fields
+
+
+@pytest.mark.parametrize("equal_lengths", [True, False])
+@pytest.mark.parametrize("typename", COLUMN_TYPES)
+def test_bytes_written_together_equal_one_by_one(typename, equal_lengths):
+    rng = np.random.default_rng(zlib.crc32(typename.encode()) + 7 * equal_lengths)
+    for n in (1, FEW - 1, FEW, 50):
+        base = random_fields(rng, typename)
+        fields = []
+        for _ in range(n):
+            f = random_fields(rng, typename)
+            if equal_lengths:  # every numeric sequence as long as the first message's
+                f = {k: (v * len(base[k]))[:len(base[k])] if isinstance(v, list) and v else base[k]
+                     if isinstance(v, list) else v for k, v in f.items()}
+            fields.append(f)
+        want = [serialize(typename, f) for f in fields]
+        columns = read_columns(typename, want).values   # the columns a node reads, in every form
+        assert serialize_columns(typename, columns, n) == want
+
+
+def test_a_missing_column_or_a_fixed_array_of_the_wrong_length_is_refused():
+    typename = "rail_msgs/msg/CorrugationState"
+    rng = np.random.default_rng(3)
+    raws = [serialize(typename, random_fields(rng, typename)) for _ in range(FEW)]
+    columns = read_columns(typename, raws).values
+    whole = columns.k_b_by_friction
+    columns.k_b_by_friction = whole[:, :3]
+    with pytest.raises(ValueError, match="k_b_by_friction"):
+        serialize_columns(typename, columns, FEW)
+    columns.k_b_by_friction = whole
+    del columns.calibration_surveys
+    with pytest.raises(KeyError, match="calibration_surveys"):
+        serialize_columns(typename, columns, FEW)
