@@ -4,6 +4,8 @@ graph) agree field for field for every topic the graph records."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
@@ -126,3 +128,12 @@ def test_outputs_as_columns_are_the_bytes_of_each_outputs_fields(outputs):
     got = serialize_columns("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_columns(r.squeal, heads), n)
     assert got == [serialize("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_fields(
         r.squeal, i, heads[i].header, heads[i].train_id)) for i in range(n)]
+    # states: with the constants changed part way (as a survey or a grinding changes them)
+    traj, site = r.trajectory, r.site.site_id
+    later = dataclasses.replace(traj.constants, threshold=traj.constants.threshold * 2, calibration_surveys=3,
+                                k_b=traj.constants.k_b * 1.5, last_grinding_ns=traj.constants.last_grinding_ns + 7)
+    for t in (traj, dataclasses.replace(traj, constants_from=((len(traj) // 3, later),))):
+        got = [b for cols, m in fields.corrugation_state_columns(t, site)
+               for b in serialize_columns("rail_msgs/msg/CorrugationState", cols, m)]
+        assert got == [serialize("rail_msgs/msg/CorrugationState", fields.corrugation_state_fields(*t.state(k), site))
+                       for k in range(len(t))]

@@ -12,6 +12,7 @@ rosbags' deserialised objects alike (the two have the same attribute names);
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import fields as dataclass_fields
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -20,7 +21,7 @@ import numpy as np
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
-from rail_monitor.corrugation.records import Forecast, StateSnapshot
+from rail_monitor.corrugation.records import Forecast, StateSnapshot, Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual
@@ -130,6 +131,41 @@ def corrugation_state_fields(snap: StateSnapshot, fc: Forecast, frame_id: str) -
         "grinding_due": bool(fc.grinding_due), "grinding_due_time": future_time_fields(fc.grinding_due_ns),
         "k_b_by_friction": [float(k) for k in snap.k_b], "k_b_p10_by_friction": [float(k) for k in snap.k_b_p10],
         "k_b_p90_by_friction": [float(k) for k in snap.k_b_p90], "calibration_surveys": int(snap.calibration_surveys)}
+
+
+def time_columns(ns: np.ndarray) -> Fields:
+    """builtin_interfaces/Time columns of ns since the epoch (time_fields, element by element)."""
+    sec, nanosec = np.divmod(np.asarray(ns, np.int64), NS_PER_S)
+    return {"sec": sec, "nanosec": nanosec}
+
+
+def corrugation_state_columns(traj: Trajectory, frame_id: str) -> list[tuple[Fields, int]]:
+    """The state after each counted pass of a Trajectory as CorrugationState columns
+    (corrugation_state_fields, state by state): (columns, states) per run of constants in force."""
+    f, out = traj.forecast, []
+    cuts = [0, *[first for first, _ in traj.constants_from if 0 < first < len(traj)], len(traj)]
+    for lo, hi in itertools.pairwise(cuts):
+        if hi <= lo:
+            continue
+        c, n, rows = traj.constants_at(lo), hi - lo, slice(lo, hi)
+        due = f.grinding_due_ns[rows]
+        out.append(({
+            "header": {"stamp": time_columns(traj.stamp_ns[rows]), "frame_id": [frame_id] * n},
+            "last_train_id": [str(t) for t in traj.train_id[rows]], "pass_count": traj.pass_count[rows],
+            "axle_pass_count": traj.axle_pass_count[rows], "total_pass_count": traj.total_pass_count[rows],
+            "last_grinding_time": time_columns(np.full(n, c.last_grinding_ns)),
+            "wavelength_m": np.broadcast_to(c.bands, (n, len(c.bands))), "amplitude_m": traj.amplitude[rows],
+            "growth_per_axle_pass": f.growth_per_axle_pass[rows],
+            "threshold_m": np.broadcast_to(c.threshold, (n, len(c.threshold))),
+            "post_grinding_m": np.broadcast_to(c.grinding_amplitude, (n, len(c.grinding_amplitude))),
+            "worst_band": f.worst_band[rows], "worst_wavelength_m": np.asarray(c.bands)[f.worst_band[rows]],
+            "passes_to_threshold": f.passes_to_threshold[rows], "days_to_threshold": f.days_to_threshold[rows],
+            "passes_per_day": f.passes_per_day[rows], "grinding_due": f.grinding_due[rows],
+            "grinding_due_time": time_columns(np.where((due > 0) & (due < TIME_MSG_END_NS), due, 0)),
+            **{name: np.broadcast_to(np.asarray(k, float), (n, len(k))) for name, k in (
+                ("k_b_by_friction", c.k_b), ("k_b_p10_by_friction", c.k_b_p10), ("k_b_p90_by_friction", c.k_b_p90))},
+            "calibration_surveys": np.full(n, c.calibration_surveys)}, n))
+    return out
 
 
 def speed_advisory_fields(advice: SpeedAdvice, stamp_ns: int, frame_id: str) -> Fields:
