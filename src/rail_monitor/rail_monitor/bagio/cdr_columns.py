@@ -66,10 +66,7 @@ class _Walk:
 
     def _bytes(self, pos: np.ndarray, size: int) -> np.ndarray:
         """(n, size) bytes from pos per message."""
-        at = pos[:, None] + np.arange(size)
-        if len(pos) and int(pos.max()) + size > len(self.buf):
-            np.minimum(at, len(self.buf) - 1, out=at)
-        return self.buf[at]
+        return self.buf.take(pos[:, None] + np.arange(size), mode="clip")
 
     def _align(self, size: int, where: np.ndarray | None = None) -> None:
         step = -(self.pos - self.start - 4) % size
@@ -79,7 +76,8 @@ class _Walk:
         """The fields of a run of fixed-size scalars per message: one read per distinct start
         offset modulo 8 (the run's layout, padding included, depends on it alone)."""
         phase = (self.pos - self.start - 4) % 8
-        kinds = np.unique(phase) if len(phase) else np.zeros(1, np.int64)
+        kinds = phase[:1] if not len(phase) or (phase == phase[0]).all() else np.unique(phase)
+        kinds = kinds if len(kinds) else np.zeros(1, np.int64)
         out: dict[str, np.ndarray] = {}
         for p in kinds.tolist():
             rows = slice(None) if len(kinds) == 1 else np.flatnonzero(phase == p)

@@ -25,6 +25,7 @@ ROUGHNESS_SURVEY = "rail_msgs/msg/RoughnessSurvey"
 MEASURED_PASS_NOISE = "rail_msgs/msg/MeasuredPassNoise"
 
 
+@functools.cache  # a package's place does not move while the process runs
 def _share_dir(package: str) -> Path:
     from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
 
