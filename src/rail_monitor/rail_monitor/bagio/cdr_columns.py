@@ -198,14 +198,20 @@ def _rows(value: Any, keep: np.ndarray) -> Any:
 FEW = 12  # fewer messages than this are read one by one (a numpy step per field costs more than a message)
 
 
+@functools.cache
+def _packed_dtype(run: _Run) -> np.dtype:
+    """A record of a run's fields, as their columns are typed (bools as bool)."""
+    return np.dtype([(name, bool if code == "?" else np.dtype(code).newbyteorder("<"))
+                     for name, code in zip(run.names, run.codes, strict=True)])
+
+
 def _stack(typename: str, views: list[SimpleNamespace]) -> SimpleNamespace:
     """The columns of messages read one by one (bagio.cdr.message_view), as read_columns gives them."""
     out = SimpleNamespace()
     for item in _layout(typename):
-        if isinstance(item, _Run):
-            for name, code in zip(item.names, item.codes, strict=True):
-                dtype = np.dtype(bool) if code == "?" else np.dtype(code).newbyteorder("<")
-                setattr(out, name, np.array([getattr(v, name) for v in views], dtype))
+        if isinstance(item, _Run):  # one record array per run, its fields the columns
+            rec = np.array([tuple(getattr(v, name) for name in item.names) for v in views], _packed_dtype(item))
+            vars(out).update({name: rec[name] for name in item.names})
             continue
         name, kind, detail = item
         values = [getattr(v, name) for v in views]
@@ -215,7 +221,7 @@ def _stack(typename: str, views: list[SimpleNamespace]) -> SimpleNamespace:
             lengths = {len(v) for v in values}
             if len(lengths) <= 1:
                 dtype = np.dtype(_BASE[detail[0][1][0]]).newbyteorder("<")
-                values = np.stack(values) if values and lengths != {0} else np.zeros((len(values), 0), dtype)
+                values = np.array(values, dtype) if values and lengths != {0} else np.zeros((len(values), 0), dtype)
         setattr(out, name, values)
     return out
 

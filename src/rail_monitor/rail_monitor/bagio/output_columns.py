@@ -92,7 +92,7 @@ def _bad_stamp(values: Any) -> np.ndarray:
 def noise_refusals(values: Any) -> np.ndarray:
     """Why each RollingNoise is unusable ('' when usable): its model, its single-number levels, its stamp."""
     out = np.full(len(values.model), "", object)
-    _first(out, ~np.isin(np.array(values.model, object), list(MODELS)), MODEL)
+    _first(out, np.array([m not in MODELS for m in values.model], bool), MODEL)
     _first(out, ~np.all([np.isfinite(getattr(values, k)) for k in NOISE_METRICS], axis=0), LEVEL)
     _first(out, _bad_stamp(values), STAMP)
     return out
