@@ -120,6 +120,17 @@ class _Walk:
         self.pos += np.where(self.ok & active, n, 0)
         return out
 
+    def _elements(self, pos: np.ndarray, k: int, dtype: np.dtype) -> np.ndarray:
+        """(n, k) values from pos per message, read as values (not bytes) from the bytes viewed at
+        each offset modulo the value's size (a message already refused reads from its start)."""
+        size, out = dtype.itemsize, np.empty((len(pos), k), dtype)
+        residue = pos % size
+        for r in (residue[:1] if (residue == residue[0]).all() else np.unique(residue)).tolist():
+            rows = slice(None) if (residue == r).all() else residue == r
+            values = np.frombuffer(self.buf, dtype, (len(self.buf) - r) // size, r)
+            out[rows] = values.take(((pos[rows] - r) // size)[:, None] + np.arange(k), mode="clip")
+        return out
+
     def numbers(self, code: str, length: int | None) -> Any:
         """A fixed array (length) or a sequence (None) of one numeric type per message."""
         dtype = np.dtype(_BASE[code]).newbyteorder("<")
@@ -130,7 +141,7 @@ class _Walk:
         counts = np.unique(n[self.ok])
         if len(counts) <= 1:   # one length (or none read): a 2-D column
             k = int(counts[0]) if len(counts) else (length or 0)
-            out = self._bytes(self.pos, k * dtype.itemsize).view(dtype) if k else np.zeros((len(n), 0), dtype)
+            out = self._elements(self.pos, k, dtype) if k else np.zeros((len(n), 0), dtype)
         else:
             ok, at = self.ok.tolist(), self.pos.tolist()
             out = [np.frombuffer(self.data, dtype, int(n[i]), at[i]) if ok[i] else None for i in range(len(n))]
