@@ -37,6 +37,18 @@ def test_duplicates_inside_one_batch_count_once(site_, tables):
     assert est.advance(twice).tolist() == [True, False, True] and est.pass_count == 2
 
 
+@pytest.mark.parametrize("in_order", [True, False])
+def test_a_batch_a_model_fails_on_leaves_its_passes_to_count(site_, tables, sample, in_order, monkeypatch):
+    # The node retries a failed batch pass by pass: the failed attempt must not have marked them seen.
+    est = _estimator(site_, tables)
+    part = sample.take(slice(0, 30) if in_order else [*range(15, 30), *range(15)])
+    with monkeypatch.context() as m:
+        m.setattr(est, "_growth", lambda *a: 1 / 0)
+        with pytest.raises(ZeroDivisionError):
+            est.advance(part)
+    assert est.advance(part).all() and est.pass_count == 30
+
+
 def test_running_forecast_sums_match_a_recount_after_pruning(site_, tables, sample):
     # The forecast keeps running sums over the kept passes (added per pass, removed as passes age
     # out of the history); they must equal a recount from the kept passes.
