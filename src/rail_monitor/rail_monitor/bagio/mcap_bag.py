@@ -1,12 +1,11 @@
 """A rosbag2-compatible MCAP bag writer: one folder, metadata.yaml version 9, split files.
 
-Layout and fields follow rosbag2 Jazzy's MCAP storage: header profile ``ros2``; one schema per
-type with encoding ``ros2msg`` (full dependency text); channels with message encoding ``cdr``
-and metadata ``offered_qos_profiles`` (YAML text) and ``topic_type_hash`` (RIHS01); a
-``rosbag2`` metadata record; zstd-compressed chunks. Chunks are
-closed at least every ``flush_period_ns`` of log time or wall time, and every write goes to the
-OS at once, so a killed process leaves every complete chunk readable
-(see :func:`rail_monitor.bagio.integrity.scan_mcap`).
+Layout and fields follow rosbag2 Jazzy's MCAP storage: header profile ``ros2``; one schema per type
+with encoding ``ros2msg`` (full dependency text); channels with message encoding ``cdr`` and metadata
+``offered_qos_profiles`` (YAML text) and ``topic_type_hash`` (RIHS01); a ``rosbag2`` metadata record;
+zstd-compressed chunks. Chunks are closed at least every ``flush_period_ns`` of log time or wall
+time, and every write goes to the OS at once, so a killed process leaves every complete chunk
+readable (see :func:`rail_monitor.bagio.integrity.scan_mcap`).
 """
 
 from __future__ import annotations
@@ -93,10 +92,8 @@ class McapBagWriter:
         self.folder = new_output_folder(Path(folder))
         self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
         self._chunk_size = chunk_size
-        self._max_bytes = max_file_bytes
-        self._max_duration = max_file_duration_ns
-        self._flush_ns = flush_period_ns
-        self._flush_wall = flush_wall_period_s
+        self._max_bytes, self._max_duration = max_file_bytes, max_file_duration_ns
+        self._flush_ns, self._flush_wall = flush_period_ns, flush_wall_period_s
         self._last_flush_ns = 0
         self._last_flush_wall = time.monotonic()
         self._records = dict(records or {})
@@ -176,28 +173,23 @@ class McapBagWriter:
             self.deleted_bytes += old.size
 
     # -- writing ----------------------------------------------------------------------------
-    def write(self, topic: str, data: bytes, log_time_ns: int, publish_time_ns: int | None = None) -> None:
-        """Append one serialised message [CDR bytes] at log_time_ns [ns since the epoch]."""
-        self.write_many(topic, [data], [log_time_ns], None if publish_time_ns is None else [publish_time_ns])
+    def write(self, topic: str, data: bytes, log_time_ns: int) -> None:
+        """Append one serialised message [CDR bytes] at log_time_ns [ns since the epoch], its publish time."""
+        self.write_many(topic, [data], [log_time_ns])
 
     def written(self, topic: str) -> int:
         """Messages of the topic written so far (0: none, or not added)."""
-        t = self._topics.get(topic)
-        return 0 if t is None else t.count
+        return self._topics[topic].count if topic in self._topics else 0
 
-    def write_many(self, topic: str, datas: Sequence[bytes], log_times_ns: Sequence[int],
-                   publish_times_ns: Sequence[int] | None = None) -> None:
-        """Append messages of one topic in order (write's, one by one; the flush period is looked
-        at after the last)."""
-        if self.closed:
-            raise RailMonitorError("bag writer is closed")
-        if self.error:
-            raise RailMonitorError(self.error)
+    def write_many(self, topic: str, datas: Sequence[bytes], log_times_ns: Sequence[int]) -> None:
+        """Append messages of one topic in order, as write one by one (the flush period looked at after the last)."""
+        if self.closed or self.error:
+            raise RailMonitorError("bag writer is closed" if self.closed else self.error)
         t = self._topics.get(topic)
         if t is None:
             raise RailMonitorError(f"topic {topic} was not added to the bag")
         with self._failing_on_os_error():
-            for k, (data, log_time_ns) in enumerate(zip(datas, log_times_ns, strict=True)):
+            for data, log_time_ns in zip(datas, log_times_ns, strict=True):
                 f = self._file
                 if f is not None and f.first_ns is not None and (
                     (self._max_bytes and f.stream.tell() >= self._max_bytes)
@@ -208,14 +200,12 @@ class McapBagWriter:
                 if f is None:
                     f = self._file = self._open_file()
                 f.writer.add_message(channel_id=f.channel_ids[topic], log_time=log_time_ns, data=data,
-                                     publish_time=log_time_ns if publish_times_ns is None else publish_times_ns[k],
-                                     sequence=t.count)
+                                     publish_time=log_time_ns, sequence=t.count)
                 f.first_ns = log_time_ns if f.first_ns is None else min(f.first_ns, log_time_ns)
                 f.last_ns = max(f.last_ns, log_time_ns)
                 self._newest_ns = max(self._newest_ns, log_time_ns)
-                f.count += 1
+                f.count, t.count = f.count + 1, t.count + 1
                 f.topic_counts[topic] += 1
-                t.count += 1
         if len(datas):
             self._maybe_flush(log_times_ns[-1])
 
