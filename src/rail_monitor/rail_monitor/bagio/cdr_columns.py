@@ -110,13 +110,19 @@ class _Walk:
         last = self.pos + n - 1
         fits = (n >= 1) & (last < self.end)
         self._refuse(active & ~(fits & (self._bytes(np.where(fits, last, self.start), 1)[:, 0] == 0)))
-        out: list[str | None] = [None] * len(n)
-        data, pos = self.data, self.pos.tolist()
-        for i in np.flatnonzero(self.ok & active).tolist():
-            try:
-                out[i] = data[pos[i]:pos[i] + int(n[i]) - 1].decode()
-            except UnicodeDecodeError:
-                self._refuse(np.arange(len(n)) == i)
+        rows = np.flatnonzero(self.ok & active)
+        data, starts, ends = self.data, self.pos[rows].tolist(), (self.pos[rows] + n[rows] - 1).tolist()
+        try:
+            texts: list[str | None] = [data[a:b].decode() for a, b in zip(starts, ends, strict=True)]
+        except UnicodeDecodeError:  # one by one: the messages whose string is not UTF-8 are refused
+            texts = [_utf8(data[a:b]) for a, b in zip(starts, ends, strict=True)]
+            self._refuse(np.isin(np.arange(len(n)), rows[[t is None for t in texts]]))
+        if len(rows) == len(n):
+            out = texts
+        else:
+            out = [None] * len(n)
+            for i, text in zip(rows.tolist(), texts, strict=True):
+                out[i] = text
         self.pos += np.where(self.ok & active, n, 0)
         return out
 
@@ -147,6 +153,13 @@ class _Walk:
             out = [np.frombuffer(self.data, dtype, int(n[i]), at[i]) if ok[i] else None for i in range(len(n))]
         self.pos = np.where(self.ok, stop, self.pos)
         return out
+
+
+def _utf8(data: bytes) -> str | None:
+    try:
+        return data.decode()
+    except UnicodeDecodeError:
+        return None
 
 
 @functools.cache
