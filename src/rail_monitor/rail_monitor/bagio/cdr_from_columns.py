@@ -35,7 +35,8 @@ class _Plan:
     def __init__(self, n: int) -> None:
         self.pos = np.full(n, len(ENCAPSULATION), np.int64)
         self.blocks: list[tuple[Any, np.ndarray, np.ndarray]] = []   # rows, offsets, (rows, width) bytes
-        self.strings: list[tuple[np.ndarray, list[bytes | None]]] = []  # offsets, bytes per message
+        # offsets, bytes per message: strings, and arrays whose lengths differ between messages
+        self.pieces: list[tuple[np.ndarray, list[bytes | None]]] = []
 
     def align(self, size: int, where: np.ndarray | None = None) -> None:
         step = -(self.pos - 4) % size
@@ -53,10 +54,10 @@ class _Plan:
 
     def string(self, texts: list[str | None], active: np.ndarray | None = None) -> None:
         data = [None if t is None else t.encode() for t in texts]
-        live = np.array([d is not None for d in data]) if active is None else active
-        self.count(np.array([0 if d is None else len(d) + 1 for d in data], np.int64), live)
-        self.strings.append((self.pos.copy(), data))
-        self.pos += np.array([0 if d is None else len(d) + 1 for d in data], np.int64)
+        size = np.array([0 if d is None else len(d) + 1 for d in data], np.int64)   # the NUL included
+        self.count(size, np.array([d is not None for d in data]) if active is None else active)
+        self.pieces.append((self.pos.copy(), data))
+        self.pos += size
 
 
 def _plan(plan: _Plan, typename: str, values: Any, n: int) -> None:
@@ -99,7 +100,7 @@ def _numbers(plan: _Plan, name: str, value: Any, dtype: np.dtype, length: int | 
         block = np.ascontiguousarray(np.asarray(value, dtype)).reshape(n, -1)
         plan.put(slice(None), block.view(np.uint8).reshape(n, -1))
     else:
-        plan.strings.append((plan.pos.copy(), [r.tobytes() for r in rows]))
+        plan.pieces.append((plan.pos.copy(), [r.tobytes() for r in rows]))
         plan.pos += counts * dtype.itemsize
 
 
@@ -131,7 +132,7 @@ def serialize_columns(typename: str, values: Any, n: int) -> list[bytes]:
     for rows, offsets, data in plan.blocks:
         if data.size:
             buf[(start[:-1][rows] + offsets)[:, None] + np.arange(data.shape[1])] = data
-    for offsets, datas in plan.strings:
+    for offsets, datas in plan.pieces:
         at = (start[:-1] + offsets).tolist()
         for a, d in zip(at, datas, strict=True):
             if d:

@@ -88,7 +88,7 @@ class PassHead(NamedTuple):
 def passes_from_columns(values: Any) -> tuple[PassTable, list[PassHead]]:
     """TrainPasses read as columns (bagio.cdr_columns.read_columns) as a PassTable, and their heads."""
     stamp = values.header.stamp
-    stamp_ns = stamp.sec.astype(np.int64) * NS_PER_S + stamp.nanosec.astype(np.int64)
+    stamp_ns = time_columns_ns(stamp)
     table = PassTable(stamp_ns=stamp_ns, **{k: np.array(v, object) if isinstance(v, list) else v
                                             for k in PASS_FIELDS for v in [getattr(values, k)]})
     heads = [PassHead(ns, {"stamp": {"sec": s, "nanosec": n}, "frame_id": f}, t) for ns, s, n, f, t in zip(
@@ -137,6 +137,11 @@ def time_columns(ns: np.ndarray) -> Fields:
     """builtin_interfaces/Time columns of ns since the epoch (time_fields, element by element)."""
     sec, nanosec = np.divmod(np.asarray(ns, np.int64), NS_PER_S)
     return {"sec": sec, "nanosec": nanosec}
+
+
+def time_columns_ns(t: Any) -> np.ndarray:
+    """ns since the epoch of builtin_interfaces/Time columns (time_ns, element by element; int64)."""
+    return t.sec.astype(np.int64) * NS_PER_S + t.nanosec.astype(np.int64)
 
 
 def corrugation_state_columns(traj: Trajectory, frame_id: str) -> list[tuple[Fields, int]]:

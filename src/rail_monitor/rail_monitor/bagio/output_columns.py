@@ -16,7 +16,8 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.alerts.config import NOISE_METRICS
-from rail_monitor.core.timeutil import NS_PER_S, fits_time_msg
+from rail_monitor.bagio.messages import time_columns_ns
+from rail_monitor.core.timeutil import fits_time_msg
 from rail_monitor.measured.residuals import SQUEAL, Predicted
 from rail_monitor.noise.config import MODELS
 from rail_monitor.noise.records import Corrugation
@@ -31,11 +32,6 @@ STAMP = "stamp not set, or before 1970"
 MODEL = "model unknown"
 LEVEL = "a single-number level is not finite"
 RISK = "risk unknown"
-
-
-def time_ns(t: Any) -> np.ndarray:
-    """ns since the epoch of builtin_interfaces/Time columns (int64)."""
-    return t.sec.astype(np.int64) * NS_PER_S + t.nanosec.astype(np.int64)
 
 
 def _blocks(values: Any, names: tuple[str, ...]) -> list[tuple[slice | int, list[np.ndarray]]]:
@@ -85,7 +81,7 @@ def state_refusals(values: Any) -> np.ndarray:
 
 def _bad_stamp(values: Any) -> np.ndarray:
     """Header stamps not set, before 1970 or past what builtin_interfaces/Time holds."""
-    stamp = time_ns(values.header.stamp)
+    stamp = time_columns_ns(values.header.stamp)
     return ~((stamp > 0) & fits_time_msg(stamp))
 
 
@@ -108,7 +104,7 @@ def squeal_refusals(values: Any) -> np.ndarray:
 
 def predictions(values: Any, rows: np.ndarray) -> list[Predicted]:
     """RollingNoise (or SquealPrediction: its risk) at rows as the predictions measurements are paired with."""
-    stamps, ids = time_ns(values.header.stamp).tolist(), values.train_id
+    stamps, ids = time_columns_ns(values.header.stamp).tolist(), values.train_id
     if hasattr(values, "risk"):
         risk = values.risk.tolist()
         return [Predicted(stamps[i], ids[i], SQUEAL, np.zeros(0), float("nan"), float("nan"), float("nan"), risk[i])
@@ -149,9 +145,10 @@ def corrugation_series(values: Any, rows: np.ndarray) -> dict[str, np.ndarray]:
     and thresholds [m] of the first, amplitudes [m] (states x bands), forecast fields per state."""
     first = int(rows[0])
     amp = values.amplitude_m
-    return {"stamp_ns": time_ns(values.header.stamp)[rows], "wavelength_m": np.asarray(values.wavelength_m[first]),
+    return {"stamp_ns": time_columns_ns(values.header.stamp)[rows],
+            "wavelength_m": np.asarray(values.wavelength_m[first]),
             "amplitude_m": amp[rows] if isinstance(amp, np.ndarray) else np.array([amp[i] for i in rows.tolist()]),
             "threshold_m": np.asarray(values.threshold_m[first]),
             "days_to_threshold": np.asarray(values.days_to_threshold)[rows],
             "grinding_due": np.asarray(values.grinding_due)[rows],
-            "grinding_due_ns": time_ns(values.grinding_due_time)[rows]}
+            "grinding_due_ns": time_columns_ns(values.grinding_due_time)[rows]}

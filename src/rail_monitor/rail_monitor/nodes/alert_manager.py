@@ -30,6 +30,7 @@ from rail_monitor.bagio.cdr_columns import read_columns
 from rail_monitor.bagio.messages import (
     measurement_from_msg,
     noise_residual_fields,
+    time_columns_ns,
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
@@ -40,7 +41,6 @@ from rail_monitor.bagio.output_columns import (
     predictions,
     squeal_refusals,
     state_refusals,
-    time_ns,
 )
 from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.core.errors import ConfigError
@@ -127,12 +127,13 @@ class AlertManagerNode(PassConsumerNode):
     def _on_squeal(self, raws: list[bytes]) -> None:
         values, ok = self._usable("noise/squeal", raws, squeal_refusals)
         if len(ok):
-            self._emit(self.alerts.on_squeal(time_ns(values.header.stamp)[ok], values.risk[ok].astype(np.int64)))
+            stamps = time_columns_ns(values.header.stamp)
+            self._emit(self.alerts.on_squeal(stamps[ok], values.risk[ok].astype(np.int64)))
             self._predicted(predictions(values, ok))
 
     def _on_noise(self, raws: list[bytes]) -> None:
         values, ok = self._usable("noise/rolling", raws, noise_refusals)
-        stamps, model_of = time_ns(values.header.stamp), np.array(values.model, object)
+        stamps, model_of = time_columns_ns(values.header.stamp), np.array(values.model, object)
         events: list[Alert] = []
         for model in dict.fromkeys(model_of[ok].tolist()):  # each source model's stream in its order
             mine = ok[model_of[ok] == model]

@@ -26,8 +26,8 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.bagio.cdr_columns import read_columns
-from rail_monitor.bagio.messages import PassHead, rolling_noise_columns
-from rail_monitor.bagio.output_columns import corrugation, corrugation_refusals, time_ns
+from rail_monitor.bagio.messages import PassHead, rolling_noise_columns, time_columns_ns
+from rail_monitor.bagio.output_columns import corrugation, corrugation_refusals
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
@@ -51,7 +51,6 @@ class _Pending:
     table: PassTable  # the passes taken with it (class defaults filled)
     row: int          # its row
     head: PassHead
-    stamp_ns: int
     deadline: float   # monotonic [s]; -inf: do not wait
 
 
@@ -88,7 +87,7 @@ class RollingNoisePredictor(PassConsumerNode):
         for why in [str(exc) for _, exc in read.refused] + [r for r in reasons.tolist() if r]:
             self.states_rejected[why] += 1
             self.get_logger().warning(f"corrugation state refused: {why}", throttle_duration_sec=self.log_throttle_s)
-        stamps, trains = time_ns(read.values.header.stamp).tolist(), read.values.last_train_id
+        stamps, trains = time_columns_ns(read.values.header.stamp).tolist(), read.values.last_train_id
         for i in np.flatnonzero(reasons == "").tolist():
             self.states.append((stamps[i], trains[i], corrugation(read.values, i)))
             self._state_stamps.append(stamps[i])
@@ -99,7 +98,7 @@ class RollingNoisePredictor(PassConsumerNode):
         # run without an estimator with state_wait_s:=0.
         wait = self.wait_s > 0
         deadline = time.monotonic() + self.wait_s if wait else float("-inf")
-        self.pending.extend(_Pending(table, i, head, head.stamp_ns, deadline) for i, head in enumerate(heads))
+        self.pending.extend(_Pending(table, i, head, deadline) for i, head in enumerate(heads))
         self._flush()
 
     def _flush(self) -> None:
@@ -116,10 +115,10 @@ class RollingNoisePredictor(PassConsumerNode):
             return
         now = time.monotonic()
         pending = list(self.pending)
-        states = self._states_from(min(p.stamp_ns for p in pending))
+        states = self._states_from(min(p.head.stamp_ns for p in pending))
         stamps = np.fromiter((st for st, _, _ in states), np.int64, len(states))
         trains = [last for _, last, _ in states]
-        arrived = state_arrived(stamps, trains, np.array([p.stamp_ns for p in pending], np.int64),
+        arrived = state_arrived(stamps, trains, np.array([p.head.stamp_ns for p in pending], np.int64),
                                 [p.head.train_id for p in pending])
         n = 0
         for p, has_state in zip(pending, arrived.tolist(), strict=True):
@@ -132,7 +131,7 @@ class RollingNoisePredictor(PassConsumerNode):
         if not n:
             return
         ready = [self.pending.popleft() for _ in range(n)]
-        index = state_index(stamps, trains, np.array([p.stamp_ns for p in ready], np.int64),
+        index = state_index(stamps, trains, np.array([p.head.stamp_ns for p in ready], np.int64),
                             [p.head.train_id for p in ready])
         self._predict(ready, [states[k][2] if k >= 0 else None for k in index.tolist()])
 
