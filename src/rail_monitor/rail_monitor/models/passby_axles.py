@@ -58,9 +58,10 @@ STEPS_PER_TAU = 8           # time steps per F time constant, at least
 SAMPLES_PER_DISTANCE = 16   # time steps per horizontal distance travelled, at least
 MAX_AXLES_PER_VEHICLE = 16  # a vehicle given more axles is laid out with this many (the same power)
 PASS_CHUNK = 4096           # passes per block of the exact window kernel
-# Points (passes x times x path distances) per block of the numpy time history: each temporary
-# (256 kB) stays in a core's L2 cache. 200,000 streamed from memory and was 4x slower on 200
-# passes; the blocks change no bit (elementwise terms, summed axle by axle in a fixed order).
+# Points (times x path distances, over a block's passes) per block of the numpy time history, and
+# per step of its axle columns: each temporary (<= 128 kB) stays in a core's L2 cache (16,000 and
+# 64,000 were 1.2x slower on the sample's batches of 200 passes, 200,000 4x). The blocks change no
+# bit: the terms are elementwise and a pass's axles are summed one at a time in a fixed order.
 HISTORY_ELEMENTS = 32_000
 
 
@@ -233,23 +234,34 @@ def f_weighted_peaks(paths_of: Sequence[Paths], layout: AxleLayout, length_m: Ar
 
         return compiled(length, speed, dt, decay, before, samples, lo, hi, layout, weight, d, radii, use, c)
     out = np.empty((len(paths_of), len(length)))
-    order = np.lexsort((hi - lo, samples))   # blocks of passes alike, so that little of a block is idle
-    start = 0
-    while start < len(order):
-        stop = start + 1
-        while stop < len(order) and (stop + 1 - start) * samples[order[stop]] * len(radii) <= HISTORY_ELEMENTS:
-            stop += 1
-        part = order[start:stop]
-        t = (np.arange(int(samples[part].max()))[None, :] - before[part, None]) * dt[part, None]
+    # Most near axles first (_histories): the passes an axle column reaches lead each block.
+    order = np.lexsort((samples, -(hi - lo + 1) * layout.axles_per_vehicle))
+    for part in _blocks(samples[order] * len(radii), HISTORY_ELEMENTS):
+        part = order[part]
+        s_part = samples[part]
         x = _histories(radii, _take(layout, part), length[part], speed[part], lo[part], hi[part], weight[part],
-                       t, d)
-        own = np.arange(t.shape[1])[None, :] < samples[part, None]
+                       s_part, before[part], dt[part], d)
+        own = np.arange(int(s_part.max()))[None, :] < s_part[:, None]
+        rep = np.repeat(part, s_part)
+        padded = np.zeros((len(use), *own.shape))   # a row's tail is after its window: the average is causal
         for m, (ks, cs) in enumerate(zip(use, c, strict=True)):
-            total = cs[0][part, None] * x[ks[0]]
+            total = cs[0][rep] * x[ks[0]]
             for k, ck in zip(ks[1:], cs[1:], strict=True):
-                total = total + ck[part, None] * x[k]
-            y = exponential_average(total, decay[part])
-            out[m, part] = np.where(own, y, -np.inf).max(axis=1)
+                total = total + ck[rep] * x[k]
+            padded[m][own] = total
+        y = exponential_average(padded, decay[part])
+        out[:, part] = np.where(own, y, -np.inf).max(axis=2)
+    return out
+
+
+def _blocks(size: NDArray[np.int64], limit: int) -> list[slice]:
+    """Consecutive runs of items whose sizes sum to at most limit (an item larger alone)."""
+    ends = np.cumsum(size)
+    out, start = [], 0
+    while start < len(size):
+        base = ends[start - 1] if start else 0
+        stop = max(start + 1, int(np.searchsorted(ends, base + limit, side="right")))
+        out.append(slice(start, stop))
         start = stop
     return out
 
@@ -277,48 +289,76 @@ def near_axle_terms(x2: FloatArray, d: float, r2: Sequence[float], broad: float)
     gives the same bits alone as with others. models.passby_axles_jit does these operations in
     this order."""
     d0 = x2 + d * d
-    num = broad + _OMNI * d0
+    num = _OMNI * d0
+    num += broad
     out = []
-    for a in range(0, len(r2), 2):
+    for a in range(0, len(r2), 2):   # in place where a temporary is not needed again: the same operations
         da = x2 + r2[a]
+        den = d0 * da
         if a + 1 == len(r2):
-            out.append(num / (d0 * da))
+            out.append(np.divide(num, den, out=den))
             continue
         db = x2 + r2[a + 1]
-        q = num / (d0 * da * db)
-        out += [q * db, q * da]
+        den *= db
+        q = np.divide(num, den, out=den)
+        out += [np.multiply(q, db, out=db), np.multiply(q, da, out=da)]
     return out
 
 
 def _histories(radii: list[float], layout: AxleLayout, length: FloatArray, speed: FloatArray,
-               lo: NDArray[np.int64], hi: NDArray[np.int64], weight: FloatArray, t: FloatArray, d: float) -> FloatArray:
-    """X_R(t) per path distance R, (radii, passes, samples): the squared pressure of unit power per
-    metre at the times t [s] after the train's middle passes (per pass, from 6 tau before), the
-    vehicles lo ... hi axle by axle (weight: P / (k 4 pi) per pass), the rest, where a pass has
-    any, as the line segments they occupy."""
-    front = 0.5 * length[:, None] + speed[:, None] * t                             # (passes, T) [m]
+               lo: NDArray[np.int64], hi: NDArray[np.int64], weight: FloatArray, samples: NDArray[np.int64],
+               before: NDArray[np.int64], dt: FloatArray, d: float) -> FloatArray:
+    """X_R(t) per path distance R, (radii, sum of samples): the squared pressure of unit power per
+    metre, pass after pass at its own times (n - before) dt [s] after the train's middle passes,
+    n < samples; the vehicles lo ... hi axle by axle (weight: P / (k 4 pi) per pass), the rest,
+    where a pass has any, as the line segments they occupy. The passes come in decreasing order of
+    their near axles (k (hi - lo + 1)).
+
+    Laid out flat, pass after pass (no idle time or axle): the axle column j (vehicle lo + j // k,
+    axle j % k) reaches the leading passes, those with more than j near axles."""
+    rep = np.repeat(np.arange(len(samples)), samples)
+    ends = np.cumsum(samples)
+    n = np.arange(int(ends[-1])) - (ends - samples)[rep]
+    front = 0.5 * length[rep] + speed[rep] * ((n - before[rep]) * dt[rep])     # [m]
     broad, r2 = _BROADSIDE * d * d, [r * r for r in radii]
-
-    def per_radius(s: FloatArray) -> FloatArray:
-        """directivity / (x^2 + R^2) per R (passes, w, radii, T) of the axles s (passes, w) behind
-        the front, with one division (near_axle_terms)."""
-        x2 = np.subtract(front[:, None, :], s[:, :, None])
+    k = layout.axles_per_vehicle.astype(np.int64)
+    near = (hi - lo + 1) * k
+    total = np.zeros((len(radii), len(front)))
+    reach = np.searchsorted(-near, -np.arange(int(near[0])), side="right")   # passes each column reaches
+    column = 0
+    while column < len(reach):
+        rows, size = int(reach[column]), int(ends[reach[column] - 1])
+        width = max(1, min(len(reach) - column, HISTORY_ELEMENTS // (size * len(radii))))
+        cols = np.arange(column, column + width)
+        kr = k[:rows, None]
+        j, i = cols[None, :] // kr, cols[None, :] % kr
+        offset = (lo[:rows, None] + j) * layout.pitch_m[:rows, None] + layout.offsets_m[np.arange(rows)[:, None], i]
+        on = cols[None, :] < near[:rows, None]
+        x2 = np.subtract(front[None, :size], np.repeat(np.where(on, offset, 0.0).T, samples[:rows], axis=1))
         np.square(x2, out=x2)
-        out = np.empty((*x2.shape[:2], len(radii), x2.shape[2]))
-        for k, term in enumerate(near_axle_terms(x2, d, r2, broad)):
-            out[:, :, k] = term
-        return out
-
-    width = max(1, HISTORY_ELEMENTS // (front.size * len(radii)))
-    total = weight[None, :, None] * np.moveaxis(_sum_over_axles(layout, lo, hi - lo + 1, per_radius, width), 1, 0)
+        terms = near_axle_terms(x2, d, r2, broad)
+        if not on.all():
+            idle = np.repeat(~on.T, samples[:rows], axis=1)
+            for term in terms:
+                term[idle] = 0.0
+        if width == 1:
+            for kk, term in enumerate(terms):
+                total[kk, :size] += term[0]
+        else:
+            stacked = np.stack(terms, axis=1)   # one addition per column
+            for c in range(width):
+                total[:, :size] += stacked[c]
+        column += width
+    total *= weight[rep]
     far = (lo > 0) | (hi < layout.vehicles - 1)
     if not far.any():
         return total
     # The vehicles before lo and after hi, as the line segments they occupy.
-    f = front[far]
-    head, tail = f - (lo * layout.pitch_m)[far, None], f - ((hi + 1) * layout.pitch_m)[far, None]
-    rear = f - length[far, None]
+    at = far[rep]
+    f, which = front[at], rep[at]
+    head, tail = f - (lo * layout.pitch_m)[which], f - ((hi + 1) * layout.pitch_m)[which]
+    rear = f - length[which]
     g = kernel_antiderivative
-    for k, r in enumerate(radii):
-        total[k, far] += g(f, d, r) - g(head, d, r) + g(tail, d, r) - g(rear, d, r)
+    for kk, r in enumerate(radii):
+        total[kk, at] += g(f, d, r) - g(head, d, r) + g(tail, d, r) - g(rear, d, r)
     return total
