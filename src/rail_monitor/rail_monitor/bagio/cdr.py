@@ -1,17 +1,14 @@
 """CDR bytes of a message given as plain fields (:mod:`rail_monitor.bagio.messages`), and the fields
 of CDR bytes, without rclpy.
 
-The encoder of a type is compiled once from its definition in the typestore: the fields are
-flattened (nested messages inline), and each run of consecutive fixed-size fields is packed by
-one ``struct`` format chosen by the run's start offset modulo 8, so a message costs a few struct
-calls instead of building a message object. The bytes are classic little-endian CDR as rclpy
-and rosbags write it: a 4-byte encapsulation header (CDR_LE), every primitive aligned to its
-size relative to the end of that header, zero padding, strings as uint32 length (with the
-terminating NUL) then UTF-8 bytes and NUL, sequences as a uint32 count then the elements; the
-test suite checks the bytes against rosbags' serialiser and rclpy for every graph topic.
-Missing fields take their zero value; unknown fields raise KeyError. The decoder is compiled the
-same way and reads numeric sequences as numpy views of the bytes (no copy); bytes that do not hold
-one whole message raise CdrError, a ValueError.
+The encoder of a type is compiled once from its layout (bagio.cdr_layout: the CDR rules, runs of
+fixed-size fields): nested messages inline, and each run of consecutive fixed-size fields packed
+by one ``struct`` format chosen by the run's start offset modulo 8, so a message costs a few
+struct calls instead of building a message object; the test suite checks the bytes against
+rosbags' serialiser and rclpy for every graph topic. Missing fields take their zero value;
+unknown fields raise KeyError. The decoder is compiled the same way and reads numeric sequences
+as numpy views of the bytes (no copy); bytes that do not hold one whole message raise CdrError,
+a ValueError.
 """
 
 from __future__ import annotations
@@ -25,11 +22,9 @@ from typing import Any
 import numpy as np
 from rosbags.interfaces import Nodetype
 
+from rail_monitor.bagio.cdr_layout import ENCAPSULATION, Run, base_dtype, layout
 from rail_monitor.bagio.typestore import typestore
 
-ENCAPSULATION = b"\x00\x01\x00\x00"  # CDR, little-endian, no options
-_BASE = {"bool": "?", "int8": "b", "uint8": "B", "byte": "B", "char": "B", "int16": "h", "uint16": "H",
-         "int32": "i", "uint32": "I", "int64": "q", "uint64": "Q", "float32": "f", "float64": "d"}
 _COUNT = struct.Struct("<I")
 
 Encoder = Callable[[bytearray, Mapping[str, Any]], None]
@@ -39,41 +34,6 @@ def _pad(buf: bytearray, size: int) -> None:
     over = (len(buf) - 4) % size
     if over:
         buf += bytes(size - over)
-
-
-def _zero_of(name: str) -> Any:
-    return False if name == "bool" else 0.0 if name.startswith("float") else 0
-
-
-class _Run:
-    """Consecutive fixed-size scalar fields: one struct per start offset modulo 8."""
-
-    def __init__(self) -> None:
-        self.names: list[str] = []
-        self.codes: list[str] = []
-        self.zeros: list[Any] = []
-        self._structs: dict[int, struct.Struct] = {}
-
-    def _struct(self, offset: int) -> struct.Struct:
-        s = self._structs.get(offset)
-        if s is None:
-            fmt, at = "<", offset
-            for code in self.codes:
-                size = struct.calcsize(code)
-                pad = -at % size
-                fmt += "x" * pad + code
-                at += pad + size
-            s = self._structs[offset] = struct.Struct(fmt)
-        return s
-
-    def encode(self, buf: bytearray, fields: Mapping[str, Any]) -> None:
-        s = self._struct((len(buf) - 4) % 8)
-        buf += s.pack(*[fields.get(n, z) for n, z in zip(self.names, self.zeros, strict=True)])
-
-    def decode(self, data: memoryview, pos: int, out: dict[str, Any]) -> int:
-        s = self._struct((pos - 4) % 8)
-        out.update(zip(self.names, s.unpack_from(data, pos), strict=True))
-        return pos + s.size
 
 
 def _string(buf: bytearray, value: str) -> None:
@@ -92,7 +52,7 @@ def _array_encoder(name: str, item: tuple[Any, Any], length: int | None) -> Enco
     """A fixed array (length) or a sequence (None) of base types, strings or messages."""
     kind, detail = item
     if kind == Nodetype.BASE and detail[0] != "string":
-        dtype = np.dtype(_BASE[detail[0]]).newbyteorder("<")
+        dtype = base_dtype(detail[0])
         size = dtype.itemsize
 
         def numeric(buf: bytearray, fields: Mapping[str, Any]) -> None:
@@ -126,31 +86,13 @@ def _nested(name: str, sub: Encoder) -> Encoder:
     return lambda buf, f: sub(buf, f.get(name, {}))
 
 
-@functools.cache
-def _layout(typename: str) -> tuple[_Run | tuple[str, int, Any], ...]:
-    """A type's fields in order: consecutive fixed-size ones as one _Run, the others as
-    (name, node kind, node detail); shared by its encoder and its decoder."""
-    out: list[_Run | tuple[str, int, Any]] = []
-    for name, (kind, detail) in typestore().fielddefs[typename][1]:
-        if kind == Nodetype.BASE and detail[0] != "string":
-            if not out or not isinstance(out[-1], _Run):
-                out.append(_Run())
-            run = out[-1]
-            run.names.append(name)
-            run.codes.append(_BASE[detail[0]])
-            run.zeros.append(_zero_of(detail[0]))
-        else:
-            out.append((name, kind, detail))
-    return tuple(out)
-
-
-def _steps(typename: str, run: Callable[[_Run], Any], string: Callable[[str], Any], nested: Callable[[str, str], Any],
+def _steps(typename: str, run: Callable[[Run], Any], string: Callable[[str], Any], nested: Callable[[str, str], Any],
            array: Callable[[str, Any, int | None], Any]) -> list[Any]:
     """One step per item of the type's layout, made by the function for its kind (a run of
     fixed-size fields, a string, a sub-message, an array or sequence of length or None)."""
     out = []
-    for item in _layout(typename):
-        if isinstance(item, _Run):
+    for item in layout(typename):
+        if isinstance(item, Run):
             out.append(run(item))
             continue
         name, kind, detail = item
@@ -217,7 +159,7 @@ def _fields_of(container: Any) -> dict[str, Any]:
 def _array_decoder(name: str, item: tuple[Any, Any], length: int | None, make: type) -> Decoder:
     kind, detail = item
     if kind == Nodetype.BASE and detail[0] != "string":
-        dtype = np.dtype(_BASE[detail[0]]).newbyteorder("<")
+        dtype = base_dtype(detail[0])
 
         def numeric(data: memoryview, pos: int, out: dict[str, Any]) -> int:
             n, pos = _read_count(data, pos, length)

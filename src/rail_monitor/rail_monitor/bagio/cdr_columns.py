@@ -25,7 +25,8 @@ from typing import Any
 import numpy as np
 from rosbags.interfaces import Nodetype
 
-from rail_monitor.bagio.cdr import _BASE, ENCAPSULATION, CdrError, _layout, _Run, deserialize, message_view
+from rail_monitor.bagio.cdr import CdrError, deserialize, message_view
+from rail_monitor.bagio.cdr_layout import ENCAPSULATION, Run, base_dtype, layout, run_dtype
 
 
 @dataclass
@@ -72,7 +73,7 @@ class _Walk:
         step = -(self.pos - self.start - 4) % size
         self.pos += step if where is None else np.where(where, step, 0)
 
-    def run(self, run: _Run) -> dict[str, np.ndarray]:
+    def run(self, run: Run) -> dict[str, np.ndarray]:
         """The fields of a run of fixed-size scalars per message: one read per distinct start
         offset modulo 8 (the run's layout, padding included, depends on it alone)."""
         phase = (self.pos - self.start - 4) % 8
@@ -81,7 +82,7 @@ class _Walk:
         out: dict[str, np.ndarray] = {}
         for p in kinds.tolist():
             rows = slice(None) if len(kinds) == 1 else np.flatnonzero(phase == p)
-            dtype = _run_dtype(run, p)
+            dtype = run_dtype(run, p)
             self._refuse((self.pos + dtype.itemsize > self.end) & (phase == p))
             got = self._bytes(self.pos[rows], dtype.itemsize).view(dtype)[:, 0]
             for name, code in zip(run.names, run.codes, strict=True):
@@ -139,7 +140,7 @@ class _Walk:
 
     def numbers(self, code: str, length: int | None) -> Any:
         """A fixed array (length) or a sequence (None) of one numeric type per message."""
-        dtype = np.dtype(_BASE[code]).newbyteorder("<")
+        dtype = base_dtype(code)
         n = np.full(len(self.pos), length, np.int64) if length is not None else self.count()
         self._align(dtype.itemsize, n > 0)
         stop = self.pos + n * dtype.itemsize
@@ -162,25 +163,10 @@ def _utf8(data: bytes) -> str | None:
         return None
 
 
-@functools.cache
-def _run_dtype(run: _Run, phase: int) -> np.dtype:
-    """The numpy record of a run of fixed-size scalars starting phase bytes past an 8-byte boundary
-    (CDR alignment, counted from the end of the encapsulation header); bools as bytes."""
-    names, formats, offsets, at = [], [], [], phase
-    for name, code in zip(run.names, run.codes, strict=True):
-        dtype = np.dtype("u1" if code == "?" else code).newbyteorder("<")
-        at += -at % dtype.itemsize
-        names.append(name)
-        formats.append(dtype)
-        offsets.append(at - phase)
-        at += dtype.itemsize
-    return np.dtype({"names": names, "formats": formats, "offsets": offsets, "itemsize": at - phase})
-
-
 def _read(walk: _Walk, typename: str) -> SimpleNamespace:
     out = SimpleNamespace()
-    for item in _layout(typename):
-        if isinstance(item, _Run):
+    for item in layout(typename):
+        if isinstance(item, Run):
             vars(out).update(walk.run(item))
             continue
         name, kind, detail = item
@@ -223,7 +209,7 @@ FEW = 12  # fewer messages than this are read one by one (a numpy step per field
 
 
 @functools.cache
-def _packed_dtype(run: _Run) -> np.dtype:
+def _packed_dtype(run: Run) -> np.dtype:
     """A record of a run's fields, as their columns are typed (bools as bool)."""
     return np.dtype([(name, bool if code == "?" else np.dtype(code).newbyteorder("<"))
                      for name, code in zip(run.names, run.codes, strict=True)])
@@ -232,8 +218,8 @@ def _packed_dtype(run: _Run) -> np.dtype:
 def _stack(typename: str, views: list[SimpleNamespace]) -> SimpleNamespace:
     """The columns of messages read one by one (bagio.cdr.message_view), as read_columns gives them."""
     out = SimpleNamespace()
-    for item in _layout(typename):
-        if isinstance(item, _Run):  # one record array per run, its fields the columns
+    for item in layout(typename):
+        if isinstance(item, Run):  # one record array per run, its fields the columns
             rec = np.array([tuple(getattr(v, name) for name in item.names) for v in views], _packed_dtype(item))
             vars(out).update({name: rec[name] for name in item.names})
             continue
@@ -244,7 +230,7 @@ def _stack(typename: str, views: list[SimpleNamespace]) -> SimpleNamespace:
         elif kind != Nodetype.BASE and detail[0][1][0] != "string":
             lengths = {len(v) for v in values}
             if len(lengths) <= 1:
-                dtype = np.dtype(_BASE[detail[0][1][0]]).newbyteorder("<")
+                dtype = base_dtype(detail[0][1][0])
                 values = np.array(values, dtype) if values and lengths != {0} else np.zeros((len(values), 0), dtype)
         setattr(out, name, values)
     return out

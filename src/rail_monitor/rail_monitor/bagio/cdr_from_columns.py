@@ -18,8 +18,9 @@ from typing import Any
 import numpy as np
 from rosbags.interfaces import Nodetype
 
-from rail_monitor.bagio.cdr import _BASE, ENCAPSULATION, _layout, _Run, serialize
-from rail_monitor.bagio.cdr_columns import FEW, _run_dtype
+from rail_monitor.bagio.cdr import serialize
+from rail_monitor.bagio.cdr_columns import FEW
+from rail_monitor.bagio.cdr_layout import ENCAPSULATION, Run, base_dtype, layout, run_dtype
 
 
 def _get(values: Any, name: str) -> Any:
@@ -61,12 +62,12 @@ class _Plan:
 
 
 def _plan(plan: _Plan, typename: str, values: Any, n: int) -> None:
-    for item in _layout(typename):
-        if isinstance(item, _Run):
+    for item in layout(typename):
+        if isinstance(item, Run):
             phase = (plan.pos - 4) % 8
             for p in np.unique(phase).tolist():
                 rows = np.flatnonzero(phase == p)
-                rec = np.zeros(len(rows), _run_dtype(item, p))
+                rec = np.zeros(len(rows), run_dtype(item, p))
                 for name in item.names:
                     rec[name] = np.asarray(_get(values, name))[rows]
                 plan.put(rows, rec.view(np.uint8).reshape(len(rows), -1))
@@ -84,7 +85,7 @@ def _plan(plan: _Plan, typename: str, values: Any, n: int) -> None:
             if item_detail[0] == "string":
                 _strings(plan, value, length)
             else:
-                _numbers(plan, name, value, np.dtype(_BASE[item_detail[0]]).newbyteorder("<"), length, n)
+                _numbers(plan, name, value, base_dtype(item_detail[0]), length, n)
 
 
 def _numbers(plan: _Plan, name: str, value: Any, dtype: np.dtype, length: int | None, n: int) -> None:
