@@ -10,7 +10,8 @@ import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 
 from rail_monitor.bagio.topics import GRAPH_TOPICS
-from rail_monitor.nodes.convert import TOPICS, to_cdr, to_msg, typename_of
+from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.nodes.convert import TOPICS, message_class, to_cdr, to_msg, typename_of
 
 from conftest import random_fields
 
@@ -44,3 +45,9 @@ def test_a_value_out_of_its_fields_range_is_refused():
     fields = random_fields(np.random.default_rng(6), typename_of(cls))
     with pytest.raises(Exception):  # noqa: B017  (struct.error, as rclpy's own check raises)
         to_cdr(cls, {**fields, "risk": 256})
+
+
+def test_a_type_that_is_not_installed_is_named_in_one_line():
+    for typename in ("nope_msgs/msg/Thing", "rail_msgs/msg/NoSuchMessage"):
+        with pytest.raises(RailMonitorError, match=f"message type {typename} is not installed"):
+            message_class(typename)

@@ -15,15 +15,19 @@ from rail_monitor.bagio import messages
 from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.cdr_from_columns import serialize_columns
 from rail_monitor.bagio.topics import GRAPH_TOPICS
+from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.nodes.qos import profile
 
 _SCALARS = {"boolean": bool, "float": float, "double": float, "string": str}
 
 
 def message_class(typename: str) -> type:
-    """The generated rclpy class of 'pkg/msg/Type'."""
+    """The generated rclpy class of 'pkg/msg/Type'; RailMonitorError when it is not installed."""
     pkg, kind, name = typename.split("/")
-    return getattr(importlib.import_module(f"{pkg}.{kind}"), name)
+    try:
+        return getattr(importlib.import_module(f"{pkg}.{kind}"), name)
+    except (ImportError, AttributeError):
+        raise RailMonitorError(f"message type {typename} is not installed") from None
 
 
 # The recorded topics with their rclpy message class and publisher profile.

@@ -13,7 +13,6 @@ taken yet; subscribing stays in the executor, serialised with the message callba
 
 from __future__ import annotations
 
-import importlib
 import threading
 from collections.abc import Callable
 from typing import Any
@@ -23,9 +22,9 @@ from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, qos_policy_name_from_kind
 
-from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.params import values_of
 from rail_monitor.nodes.base import RailNode, declare, subscribe_batched
+from rail_monitor.nodes.convert import message_class
 from rail_monitor.nodes.qos import subscription_qos
 
 DEFAULT_TYPES_PREFIX = "rail_msgs/"
@@ -113,7 +112,7 @@ class TopicTap:
             if not offered:
                 continue  # only subscribers so far: wait for a publisher to learn its QoS
             typename = types[0]
-            msg_type = import_type(typename)
+            msg_type = message_class(typename)
             self._on_topic(topic, typename, offered)
             # One QoS event handler, not rclpy's default two: every event handler is walked at each of
             # the executor's wake-ups, and the type cannot clash (a topic of several types is not taken).
@@ -128,12 +127,3 @@ class TopicTap:
                 f"a publisher of {topic} offers a QoS this subscription cannot match "
                 f"({qos_policy_name_from_kind(event.last_policy_kind)}); its messages are not taken")
         return warn
-
-
-def import_type(typename: str) -> type:
-    """The rclpy message class of 'pkg/msg/Name'; RailMonitorError when it is not installed."""
-    pkg, _, name = typename.split("/")
-    try:
-        return getattr(importlib.import_module(f"{pkg}.msg"), name)
-    except (ImportError, AttributeError):
-        raise RailMonitorError(f"message type {typename} is not installed") from None
