@@ -5,6 +5,7 @@ messages (random string and sequence lengths: every alignment an offset can take
 
 from __future__ import annotations
 
+import struct
 import zlib
 
 import numpy as np
@@ -49,3 +50,19 @@ def test_a_missing_column_or_a_fixed_array_of_the_wrong_length_is_refused():
     del columns.calibration_surveys
     with pytest.raises(KeyError, match="calibration_surveys"):
         serialize_columns(typename, columns, FEW)
+
+
+def test_an_integer_its_field_cannot_hold_is_refused_as_one_message_refuses_it():
+    typename = "rail_msgs/msg/TrainPass"
+    rng = np.random.default_rng(4)
+    raws = [serialize(typename, random_fields(rng, typename)) for _ in range(FEW)]
+    for name, bad in (("vehicle_count", 70_000), ("friction_state", -1)):
+        columns = read_columns(typename, raws).values
+        column = getattr(columns, name).astype(np.int64)
+        column[FEW // 2] = bad
+        setattr(columns, name, column)
+        with pytest.raises(ValueError, match=f"field {name}: a value is outside"):
+            serialize_columns(typename, columns, FEW)
+        fields = random_fields(rng, typename) | {name: bad}
+        with pytest.raises(struct.error):   # the per-message writer: numpy would have wrapped it
+            serialize(typename, fields)

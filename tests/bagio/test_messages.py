@@ -14,7 +14,7 @@ from rail_monitor.alerts.manager import Alert
 from rail_monitor.bagio import messages as fields
 from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.topics import GRAPH_TOPICS
-from rail_monitor.bagio.typestore import typestore
+from rail_monitor.bagio.typestore import TRAIN_PASS, typestore
 from rail_monitor.nodes.convert import TOPICS, message_class, to_msg
 
 from conftest import TOP
@@ -121,13 +121,19 @@ def test_outputs_as_columns_are_the_bytes_of_each_outputs_fields(outputs):
         heads.append(fields.PassHead(0, tp["header"], tp["train_id"]))
     n = len(heads)
     assert n > 20
-    for model, out in r.noise.items():
-        got = serialize_columns("rail_msgs/msg/RollingNoise", fields.rolling_noise_columns(out, heads, r.receiver), n)
-        assert got == [serialize("rail_msgs/msg/RollingNoise", fields.rolling_noise_fields(
-            out, i, heads[i].header, heads[i].train_id, r.receiver)) for i in range(n)], model
-    got = serialize_columns("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_columns(r.squeal, heads), n)
-    assert got == [serialize("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_fields(
-        r.squeal, i, heads[i].header, heads[i].train_id)) for i in range(n)]
+    # a node's heads (taken from the TrainPasses it read) and batch's (from the table it sent)
+    for head in (fields.heads_columns(heads), fields.table_heads_columns(r.accepted, r.site.site_id)):
+        for model, out in r.noise.items():
+            columns = fields.rolling_noise_columns(out, head, r.receiver)
+            got = serialize_columns("rail_msgs/msg/RollingNoise", columns, n)
+            assert got == [serialize("rail_msgs/msg/RollingNoise", fields.rolling_noise_fields(
+                out, i, heads[i].header, heads[i].train_id, r.receiver)) for i in range(n)], model
+        got = serialize_columns("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_columns(r.squeal, head), n)
+        assert got == [serialize("rail_msgs/msg/SquealPrediction", fields.squeal_prediction_fields(
+            r.squeal, i, heads[i].header, heads[i].train_id)) for i in range(n)]
+    # every pass sent, the rejected ones included
+    got = serialize_columns(TRAIN_PASS, fields.train_pass_columns(r.passes, "s"), len(r.passes))
+    assert got == [serialize(TRAIN_PASS, fields.train_pass_fields(r.passes.row(i), "s")) for i in range(len(r.passes))]
     # states: with the constants changed part way (as a survey or a grinding changes them)
     traj, site = r.trajectory, r.site.site_id
     later = dataclasses.replace(traj.constants, threshold=traj.constants.threshold * 2, calibration_surveys=3,

@@ -10,11 +10,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from rail_monitor.advice.plan import SpeedAdvice
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.app.batch import BatchResult, BatchRun
 from rail_monitor.bagio import messages as fields
 from rail_monitor.bagio.cdr import serialize
+from rail_monitor.bagio.cdr_from_columns import serialize_columns
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
 from rail_monitor.bagio.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
@@ -55,6 +58,13 @@ class BatchBag:
             self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
         self.bag.write(f"{self.ns}/{name}", serialize(typename, msg), max(stamp_ns, 0))
 
+    def _write(self, name: str, columns: dict[str, Any], stamp_ns: np.ndarray) -> None:
+        """Messages of a graph topic given as columns, one per stamp (bagio.cdr_from_columns)."""
+        self._write_cdr(name, serialize_columns(GRAPH_TOPICS[name][0], columns, len(stamp_ns)), stamp_ns)
+
+    def _write_cdr(self, name: str, datas: list[bytes], stamp_ns: np.ndarray) -> None:
+        self.bag.write_many(f"{self.ns}/{name}", datas, np.maximum(stamp_ns, 0).tolist())  # no log time before 1970
+
     def events(self, events: list[MaintenanceEvent]) -> None:
         """Surveys and grinding events given to the run, on the topic the replayer sends them on."""
         for event in events:
@@ -69,22 +79,19 @@ class BatchBag:
 
     def add(self, result: BatchResult) -> None:
         """One chunk's passes and outputs, and its settled alert events."""
-        sent = [fields.train_pass_fields(result.passes.row(i), self.frame) for i in range(len(result.passes))]
-        by_accepted = [m for m, why in zip(sent, result.reasons, strict=True) if not why]
-        for msg, stamp in zip(sent, result.passes.stamp_ns.tolist(), strict=True):
-            self._put("train_pass", msg, max(stamp, 0))  # a log time cannot be before 1970
-        for i, msg in enumerate(by_accepted):
-            self._put("noise/squeal", fields.squeal_prediction_fields(result.squeal, i, msg["header"],
-                                                                      msg["train_id"]),
-                      int(result.accepted.stamp_ns[i]))
-        for k in range(len(result.trajectory)):
-            snap, fc = result.trajectory.state(k)
-            self._put("corrugation/state", fields.corrugation_state_fields(snap, fc, self.frame), snap.newest_ns)
-        for i, msg in enumerate(by_accepted):
-            for out in result.noise.values():
-                self._put("noise/rolling", fields.rolling_noise_fields(out, i, msg["header"], msg["train_id"],
-                                                                       result.receiver),
-                          int(result.accepted.stamp_ns[i]))
+        passes, accepted, traj = result.passes, result.accepted, result.trajectory
+        self._write("train_pass", fields.train_pass_columns(passes, self.frame), passes.stamp_ns)
+        heads = fields.table_heads_columns(accepted, self.frame)
+        self._write("noise/squeal", fields.squeal_prediction_columns(result.squeal, heads), accepted.stamp_ns)
+        start = 0
+        for columns, n in fields.corrugation_state_columns(traj, self.frame):
+            self._write("corrugation/state", columns, traj.stamp_ns[start:start + n])
+            start += n
+        per_model = [serialize_columns(GRAPH_TOPICS["noise/rolling"][0],
+                                       fields.rolling_noise_columns(out, heads, result.receiver), len(accepted))
+                     for out in result.noise.values()]
+        in_turn = [data for datas in zip(*per_model, strict=True) for data in datas]   # pass by pass, models in turn
+        self._write_cdr("noise/rolling", in_turn, np.repeat(accepted.stamp_ns, len(per_model)))
         self._alerts(result.alerts)
         self.events(result.events)
         self.measured(result.measurements, result.residuals)

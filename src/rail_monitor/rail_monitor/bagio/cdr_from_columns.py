@@ -69,7 +69,7 @@ def _plan(plan: _Plan, typename: str, values: Any, n: int) -> None:
                 rows = np.flatnonzero(phase == p)
                 rec = np.zeros(len(rows), run_dtype(item, p))
                 for name in item.names:
-                    rec[name] = np.asarray(_get(values, name))[rows]
+                    rec[name] = _fitting(name, np.asarray(_get(values, name))[rows], rec.dtype[name])
                 plan.put(rows, rec.view(np.uint8).reshape(len(rows), -1))
             continue
         name, kind, detail = item
@@ -86,6 +86,16 @@ def _plan(plan: _Plan, typename: str, values: Any, n: int) -> None:
                 _strings(plan, value, length)
             else:
                 _numbers(plan, name, value, base_dtype(item_detail[0]), length, n)
+
+
+def _fitting(name: str, value: np.ndarray, dtype: np.dtype) -> np.ndarray:
+    """value, unless an integer field cannot hold one of its values (numpy would wrap it; struct,
+    writing one message, refuses it)."""
+    if dtype.kind in "iu" and value.size:
+        info = np.iinfo(dtype)
+        if value.min() < info.min or value.max() > info.max:
+            raise ValueError(f"field {name}: a value is outside {info.min}-{info.max}")
+    return value
 
 
 def _numbers(plan: _Plan, name: str, value: Any, dtype: np.dtype, length: int | None, n: int) -> None:

@@ -111,9 +111,22 @@ def heads_columns(heads: list[PassHead]) -> Fields:
             "train_id": [h.train_id for h in heads]}
 
 
-def squeal_prediction_columns(values: dict[str, np.ndarray], heads: list[PassHead]) -> Fields:
-    """rail_monitor.squeal.predict.predict's rows as SquealPrediction columns for their passes."""
-    return {**heads_columns(heads), **values}
+def table_heads_columns(table: PassTable, frame_id: str) -> Fields:
+    """heads_columns of the passes of a table, sent with frame_id (their TrainPasses' header and train_id)."""
+    return {"header": {"stamp": time_columns(table.stamp_ns), "frame_id": [frame_id] * len(table)},
+            "train_id": [str(t) for t in table.train_id]}
+
+
+def train_pass_columns(table: PassTable, frame_id: str) -> Fields:
+    """A PassTable as TrainPass columns (train_pass_fields, row by row)."""
+    return {**table_heads_columns(table, frame_id), "vehicle_class": [str(c) for c in table.vehicle_class],
+            **{k: getattr(table, k) for k in PASS_FIELDS if k not in ("train_id", "vehicle_class")}}
+
+
+def squeal_prediction_columns(values: dict[str, np.ndarray], heads: Fields) -> Fields:
+    """rail_monitor.squeal.predict.predict's rows as SquealPrediction columns for their passes
+    (heads: their heads_columns)."""
+    return {**heads, **values}
 
 
 def corrugation_state_fields(snap: StateSnapshot, fc: Forecast, frame_id: str) -> Fields:
@@ -186,18 +199,19 @@ def speed_advisory_fields(advice: SpeedAdvice, stamp_ns: int, frame_id: str) -> 
     return out
 
 
-def rolling_noise_columns(p: NoisePrediction, heads: list[PassHead], receiver: Any) -> Fields:
-    """A NoisePrediction of the passes as RollingNoise columns (rolling_noise_fields, pass by pass)."""
-    n = len(heads)
-    components = [p.components(i) for i in range(n)]
-    return {**heads_columns(heads), "model": [p.model] * n, "speed_mps": p.speed_mps,
+def rolling_noise_columns(p: NoisePrediction, heads: Fields, receiver: Any) -> Fields:
+    """A NoisePrediction of the passes as RollingNoise columns (rolling_noise_fields, pass by pass;
+    heads: the passes' heads_columns)."""
+    n = len(heads["train_id"])
+    names, levels = p.components_of_all()
+    return {**heads, "model": [p.model] * n, "speed_mps": p.speed_mps,
             "receiver_distance_m": np.full(n, float(receiver.distance_m)),
             "receiver_height_m": np.full(n, float(receiver.height_m)),
             "band_centre_hz": np.broadcast_to(p.band_centre_hz, (n, len(p.band_centre_hz))), "lp_db": p.lp_db,
             "lw_db": p.lw_db, "roughness_db": p.roughness_db, "pass_by_time_s": p.pass_by_time_s,
             "lpaeq_tp_dba": p.lpaeq_tp_dba, "lpafmax_dba": p.lpafmax_dba, "tel_dba": p.tel_dba,
             "roughness_growth_increase_db": p.roughness_growth_increase_db,
-            "component_names": [c[0] for c in components], "component_lpaeq_dba": [c[1] for c in components]}
+            "component_names": names, "component_lpaeq_dba": levels}
 
 
 def rolling_noise_fields(p: NoisePrediction, i: int, header: Fields, train_id: str, receiver: Any) -> Fields:

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.bagio.cdr_columns import read_columns
-from rail_monitor.bagio.messages import PassHead, rolling_noise_columns, time_columns_ns
+from rail_monitor.bagio.messages import PassHead, heads_columns, rolling_noise_columns, time_columns_ns
 from rail_monitor.bagio.output_columns import corrugation, corrugation_refusals
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
@@ -155,8 +155,8 @@ class RollingNoisePredictor(PassConsumerNode):
                 first.wavelength_m, np.stack([np.asarray(s.amplitude_m) for s in states[rows]]), first.post_grinding_m)
             passes = ready[rows]
             values = self.model.predict_models(_rows(passes), (), corrugation).values()
-            heads = [p.head for p in passes]
-            per_model = [to_cdr_many(RollingNoise, rolling_noise_columns(v, heads, self.model.receiver), len(heads))
+            head = heads_columns([p.head for p in passes])
+            per_model = [to_cdr_many(RollingNoise, rolling_noise_columns(v, head, self.model.receiver), len(passes))
                          for v in values]
             for datas in zip(*per_model, strict=True):   # pass by pass, models in order
                 for data in datas:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import sys
 from typing import Any
 
-from rail_monitor.bagio.messages import PassHead, squeal_prediction_columns
+from rail_monitor.bagio.messages import PassHead, heads_columns, squeal_prediction_columns
 from rail_monitor.core.passes import PassTable
 from rail_monitor.nodes.base import Sent, declare
 from rail_monitor.nodes.convert import to_cdr_many
@@ -39,7 +39,7 @@ class SquealRiskNode(PassConsumerNode):
 
     def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
         values = predict(self.cfg, self.site, table)
-        for data in to_cdr_many(SquealPrediction, squeal_prediction_columns(values, heads), len(heads)):
+        for data in to_cdr_many(SquealPrediction, squeal_prediction_columns(values, heads_columns(heads)), len(heads)):
             self.sent.send(self.pub, data)
 
     def diagnostic_values(self) -> dict[str, Any]:

@@ -58,6 +58,22 @@ class NoisePrediction:
                  if x > -np.inf]
         return [c for c, _ in pairs], [x for _, x in pairs]
 
+    def components_of_all(self) -> tuple[list[list[str]], np.ndarray | list[np.ndarray]]:
+        """components(i) of every pass: the names per pass, and the levels as one (N, C) array
+        where every pass has the same components, else one array per pass."""
+        has = self.component_lpaeq_dba > -np.inf
+        patterns, inverse = np.unique(has, axis=0, return_inverse=True)
+        inverse = inverse.reshape(-1)
+        names = [[c for c, h in zip(self.component_names, pattern, strict=True) if h] for pattern in patterns.tolist()]
+        if len(patterns) == 1:
+            return [names[0]] * len(self), self.component_lpaeq_dba[:, patterns[0]]
+        values: list[np.ndarray] = [np.empty(0)] * len(self)
+        for k, pattern in enumerate(patterns):
+            rows = np.flatnonzero(inverse == k)
+            for i, row in zip(rows.tolist(), self.component_lpaeq_dba[np.ix_(rows, pattern)], strict=True):
+                values[i] = row
+        return [names[k] for k in inverse.tolist()], values
+
     def per_pass(self) -> dict[str, np.ndarray]:
         """The arrays over passes, by field name."""
         return {f.name: getattr(self, f.name) for f in fields(self) if f.name not in self.CONSTANTS}
