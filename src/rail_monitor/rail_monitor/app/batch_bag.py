@@ -63,6 +63,7 @@ class BatchBag:
         self._write_cdr(name, serialize_columns(GRAPH_TOPICS[name][0], columns, len(stamp_ns)), stamp_ns)
 
     def _write_cdr(self, name: str, datas: list[bytes], stamp_ns: np.ndarray) -> None:
+        """CDR messages of a graph topic, in order, logged at their stamps."""
         self.bag.write_many(f"{self.ns}/{name}", datas, np.maximum(stamp_ns, 0).tolist())  # no log time before 1970
 
     def events(self, events: list[MaintenanceEvent]) -> None:
