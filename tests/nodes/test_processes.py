@@ -259,28 +259,6 @@ def test_the_executables_executor_answers_at_once_when_idle_and_takes_a_burst_in
         node.destroy_node()
 
 
-def test_spinning_freezes_what_set_up_built_and_unfreezes_it_after(ros_context):
-    # spin_guarded: full collections during the spin skip the objects that existed when it began
-    # (gc.freeze); a caller that goes on after the spin gets its collector back whole.
-    import gc
-
-    from rail_monitor.nodes.process import CoalescingExecutor, spin_guarded
-
-    ex = CoalescingExecutor(context=ros_context)
-    frozen: list[int] = []
-
-    def ok() -> bool:
-        frozen.append(gc.get_freeze_count())
-        return len(frozen) < 3
-
-    try:
-        spin_guarded(ex, ok, timeout_sec=0.01)
-    finally:
-        ex.shutdown()
-    assert min(frozen) > 1000, frozen
-    assert gc.get_freeze_count() == 0
-
-
 STUCK_TEARDOWN = """
 import sys, time
 from pathlib import Path

@@ -466,6 +466,8 @@ def test_late_subscriber_sees_the_standing_alerts(ros_context, site_values):
         late.create_subscription(WaysideAlertArray, "alerts/standing", got.append, LATEST_QOS)
         with spinning(ros_context, late):
             assert wait_until(lambda: got and got[-1].alerts, timeout_s=10)
+    for n in (late, src, node):  # its latched alert must not reach a later test's graph on this domain
+        n.destroy_node()
     a = got[-1].alerts[0]
     assert a.kind == KIND_SQUEAL and a.active and a.header.frame_id == "curve_250"
 

@@ -123,15 +123,8 @@ def spin_guarded(executor: Any, ok: Callable[[], bool], timeout_sec: float = 0.1
     """Spin until ok() is False or the context shuts down, surviving any one callback's exception
     (:func:`spin_once_guarded`): the executor.spin of every executable (make ok() False before
     shutting the executor down)."""
-    # What set-up built (imports, typestore, site tables) lives while the process spins: frozen,
-    # full collections skip it (in a replay of the sample 0.18 -> 0.03-0.06 s). Unfrozen after the
-    # spin, so a caller that goes on collects as before.
-    gc.freeze()
-    try:
-        while ok() and spin_once_guarded(executor, timeout_sec):
-            pass
-    finally:
-        gc.unfreeze()
+    while ok() and spin_once_guarded(executor, timeout_sec):
+        pass
 
 
 def use_flow_control_profile() -> None:
