@@ -84,15 +84,9 @@ class BatchBag:
         self._write("train_pass", fields.train_pass_columns(passes, self.frame), passes.stamp_ns)
         heads = fields.table_heads_columns(accepted, self.frame)
         self._write("noise/squeal", fields.squeal_prediction_columns(result.squeal, heads), accepted.stamp_ns)
-        start = 0
-        for columns, n in fields.corrugation_state_columns(traj, self.frame):
-            self._write("corrugation/state", columns, traj.stamp_ns[start:start + n])
-            start += n
-        per_model = [serialize_columns(GRAPH_TOPICS["noise/rolling"][0],
-                                       fields.rolling_noise_columns(out, heads, result.receiver), len(accepted))
-                     for out in result.noise.values()]
-        in_turn = [data for datas in zip(*per_model, strict=True) for data in datas]   # pass by pass, models in turn
-        self._write_cdr("noise/rolling", in_turn, np.repeat(accepted.stamp_ns, len(per_model)))
+        self._write_cdr("corrugation/state", fields.corrugation_state_cdr(traj, self.frame), traj.stamp_ns)
+        self._write_cdr("noise/rolling", fields.rolling_noise_cdr(result.noise.values(), heads, result.receiver),
+                        np.repeat(accepted.stamp_ns, len(result.noise)))
         self._alerts(result.alerts)
         self.events(result.events)
         self.measured(result.measurements, result.residuals)

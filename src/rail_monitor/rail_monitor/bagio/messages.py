@@ -13,12 +13,15 @@ rosbags' deserialised objects alike (the two have the same attribute names);
 from __future__ import annotations
 
 import itertools
+from collections.abc import Iterable
 from dataclasses import fields as dataclass_fields
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from rail_monitor.alerts.manager import Alert
+from rail_monitor.bagio.cdr_from_columns import serialize_columns
+from rail_monitor.bagio.typestore import CORRUGATION_STATE, ROLLING_NOISE
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot, Trajectory
@@ -186,6 +189,12 @@ def corrugation_state_columns(traj: Trajectory, frame_id: str) -> list[tuple[Fie
     return out
 
 
+def corrugation_state_cdr(traj: Trajectory, frame_id: str) -> list[bytes]:
+    """The CDR bytes of the state after each counted pass of a Trajectory, in order."""
+    return [data for columns, n in corrugation_state_columns(traj, frame_id)
+            for data in serialize_columns(CORRUGATION_STATE, columns, n)]
+
+
 def speed_advisory_fields(advice: SpeedAdvice, stamp_ns: int, frame_id: str) -> Fields:
     """Speed advice as SpeedAdvisory fields (the message's fields are the record's)."""
     out: Fields = {"header": header_fields(stamp_ns, frame_id)}
@@ -212,6 +221,14 @@ def rolling_noise_columns(p: NoisePrediction, heads: Fields, receiver: Any) -> F
             "lpaeq_tp_dba": p.lpaeq_tp_dba, "lpafmax_dba": p.lpafmax_dba, "tel_dba": p.tel_dba,
             "roughness_growth_increase_db": p.roughness_growth_increase_db,
             "component_names": names, "component_lpaeq_dba": levels}
+
+
+def rolling_noise_cdr(predictions: Iterable[NoisePrediction], heads: Fields, receiver: Any) -> list[bytes]:
+    """The CDR bytes of every model's RollingNoise of the passes (heads: their heads_columns), pass
+    by pass, the models in turn: the order the graph publishes and records them in."""
+    n = len(heads["train_id"])
+    per_model = [serialize_columns(ROLLING_NOISE, rolling_noise_columns(p, heads, receiver), n) for p in predictions]
+    return [data for datas in zip(*per_model, strict=True) for data in datas]
 
 
 def rolling_noise_fields(p: NoisePrediction, i: int, header: Fields, train_id: str, receiver: Any) -> Fields:

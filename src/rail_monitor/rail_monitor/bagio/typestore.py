@@ -21,6 +21,7 @@ from rail_monitor.core.timeutil import from_sec_nanosec
 SEPARATOR = "=" * 80
 TRAIN_PASS = "rail_msgs/msg/TrainPass"
 CORRUGATION_STATE = "rail_msgs/msg/CorrugationState"
+ROLLING_NOISE = "rail_msgs/msg/RollingNoise"
 ROUGHNESS_SURVEY = "rail_msgs/msg/RoughnessSurvey"
 MEASURED_PASS_NOISE = "rail_msgs/msg/MeasuredPassNoise"
 

@@ -29,7 +29,7 @@ from rail_monitor.advice import plan
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.bagio.messages import (
     PassHead,
-    corrugation_state_columns,
+    corrugation_state_cdr,
     corrugation_state_fields,
     event_from_msg,
     indirect_roughness_fields,
@@ -47,7 +47,6 @@ from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
 from rail_monitor.measured.observer import IndirectObserver, next_cut
 from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
-from rail_monitor.nodes.convert import to_cdr_many
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_SUB_QOS
@@ -164,9 +163,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
             self.save()
         now = time.monotonic()
         if self.params.state_period_s == 0.0:
-            for columns, n in corrugation_state_columns(traj, self.site.site_id):
-                for data in to_cdr_many(CorrugationState, columns, n):
-                    self.sent.send(self.state_pub, data)
+            for data in corrugation_state_cdr(traj, self.site.site_id):
+                self.sent.send(self.state_pub, data)
         elif now - self._last_state_t >= self.params.state_period_s:
             self.publish_state()
             self._last_state_t = now

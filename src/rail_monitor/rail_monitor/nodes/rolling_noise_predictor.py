@@ -26,14 +26,13 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.bagio.cdr_columns import read_columns
-from rail_monitor.bagio.messages import PassHead, heads_columns, rolling_noise_columns, time_columns_ns
+from rail_monitor.bagio.messages import PassHead, heads_columns, rolling_noise_cdr, time_columns_ns
 from rail_monitor.bagio.output_columns import corrugation, corrugation_refusals
 from rail_monitor.bagio.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.nodes.base import Sent, declare, isolate_failures, runs, subscribe_batched, wall_timer
-from rail_monitor.nodes.convert import to_cdr_many
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
@@ -155,12 +154,8 @@ class RollingNoisePredictor(PassConsumerNode):
                 first.wavelength_m, np.stack([np.asarray(s.amplitude_m) for s in states[rows]]), first.post_grinding_m)
             passes = ready[rows]
             values = self.model.predict_models(_rows(passes), (), corrugation).values()
-            head = heads_columns([p.head for p in passes])
-            per_model = [to_cdr_many(RollingNoise, rolling_noise_columns(v, head, self.model.receiver), len(passes))
-                         for v in values]
-            for datas in zip(*per_model, strict=True):   # pass by pass, models in order
-                for data in datas:
-                    self.sent.send(self.pub, data)
+            for data in rolling_noise_cdr(values, heads_columns([p.head for p in passes]), self.model.receiver):
+                self.sent.send(self.pub, data)
 
         isolate_failures(len(ready), predict, lambda i, exc: self.model_error(ready[i].head, exc))
 
