@@ -25,7 +25,7 @@ from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation import forecast as fcst
 from rail_monitor.corrugation.config import CorrugationConfig
 from rail_monitor.corrugation.growth import GrowthTables
-from rail_monitor.corrugation.history import KeptPasses, RowQueue
+from rail_monitor.corrugation.history import KeptPasses, RowQueue, dropped
 from rail_monitor.corrugation.records import Forecast, ForecastInterval, StateSnapshot, Trajectory
 from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
@@ -71,6 +71,9 @@ class CorrugationEstimator:
         # were split into calls (live backlogs, batch chunks).
         self._growth_before = RowQueue(np.zeros((0, *self.log_components.shape)))
         self._growth_total = np.zeros_like(self.log_components)
+        # Axles summed the same way (K,) and after the last; the kept passes' axles are the difference.
+        self._axles_before = RowQueue(np.zeros(0, np.int64))
+        self._axle_total = 0
         self._axle_sum = 0
 
     # -- passes ---------------------------------------------------------------------------------
@@ -105,6 +108,9 @@ class CorrugationEstimator:
         self.season.add(new.stamp_ns, friction, growth, self.k_b, self.engine)
         self._growth_before.append(summed[:-1])
         self._growth_total = summed[-1].copy()
+        axles_summed = self._axle_total + np.concatenate([[0], np.cumsum(new.axle_count)])
+        self._axles_before.append(axles_summed[:-1])
+        self._axle_total = int(axles_summed[-1])
         self._axle_sum += int(new.axle_count.sum())
         m = int(counted.sum())
         self.pass_count += m
@@ -151,23 +157,38 @@ class CorrugationEstimator:
         k = self.kept
         if len(stamps) and (np.any(np.diff(stamps) < 0) or stamps[0] < self.newest_ns):
             return self._history_one_by_one(passes)
-        kept_stamps, kept_axles, kept_before = k.stamp_ns.copy(), k.axles.copy(), self._growth_before.rows
+        # Views, unchanged by the passes counted and dropped below (RowQueue): nothing here costs in
+        # proportion to the passes kept.
+        kept_stamps, kept_axles_before, kept_before = k.stamp_ns, self._axles_before.rows, self._growth_before.rows
+        axle_total, in_time_order = self._axle_total, k.in_time_order
         before = self.snapshot()
         counted, (steps, summed) = self._advance(passes)
         new = passes.take(counted)
         m, k0 = len(new), len(kept_stamps)
-        all_stamps = np.concatenate([kept_stamps, new.stamp_ns])
-        a_prefix = np.concatenate([[0], np.cumsum(np.concatenate([kept_axles, new.axle_count]))])
+        # Pass k's window: the kept then the new passes from the first stamped within history_days.
+        # In time order it starts among the kept passes, or (all of them older) among the new ones.
         end = k0 + np.arange(1, m + 1)                                   # one past pass k
-        start = np.searchsorted(all_stamps, new.stamp_ns - self.history_ns, side="left")
-        axles = (a_prefix[end] - a_prefix[start]).astype(float)
+        opens = new.stamp_ns - self.history_ns
+        if in_time_order:
+            start = np.searchsorted(kept_stamps, opens, side="left")
+            in_new = start == k0
+            start[in_new] = k0 + np.searchsorted(new.stamp_ns, opens[in_new], side="left")
+        else:  # a late pass was kept: searched as one array, as before it was kept
+            start = np.searchsorted(np.concatenate([kept_stamps, new.stamp_ns]), opens, side="left")
+            in_new = start >= k0
+        new_axles_before = axle_total + np.concatenate([[0], np.cumsum(new.axle_count)])
+        axles_at_start = np.where(in_new, new_axles_before[np.where(in_new, start - k0, 0)],
+                                  kept_axles_before[np.minimum(start, k0 - 1)] if k0 else 0)
+        axles = (new_axles_before[1:] - axles_at_start).astype(float)
+        first_stamp = np.where(in_new, new.stamp_ns[np.where(in_new, start - k0, 0)],
+                               kept_stamps[np.minimum(start, k0 - 1)] if k0 else 0)
         kernels = corrugation_kernels(self.engine)
         # Of the kept passes' prefix sums, only the rows where windows start (a live pass: one).
         old = np.unique(start[start < k0])
         g_prefix = np.concatenate([kept_before[old], summed])
         at = np.where(start < k0, np.searchsorted(old, start), len(old) + start - k0)
         growth, growth_max = kernels.window_growth(g_prefix, at, len(old) + end - k0, axles)
-        span_days = (new.stamp_ns - all_stamps[start]) / NS_PER_DAY
+        span_days = (new.stamp_ns - first_stamp) / NS_PER_DAY
         with np.errstate(divide="ignore", invalid="ignore"):
             rate = np.where((span_days > 0) & (span_days >= self.cfg.min_traffic_days),
                             (end - start - 1) / span_days, np.nan)
@@ -196,11 +217,15 @@ class CorrugationEstimator:
 
     def _prune(self) -> None:
         k = self.kept
-        gone = k.stamp_ns < self.newest_ns - self.history_ns
-        if gone.any():
-            self._growth_before.keep(~gone)
+        gone = k.older_than(self.newest_ns - self.history_ns)
+        if dropped(gone):
+            self._growth_before.drop(gone)
             self._axle_sum -= int(k.axles[gone].sum())
             k.drop(gone)
+            if isinstance(gone, slice):
+                self._axles_before.drop(gone)
+            else:  # the window axles are the kept passes' alone
+                self._sum_axles()
 
     def set_k_b(self, k_b: np.ndarray) -> None:
         """Use K_b per friction state (4,) [-/axle pass] from now on (the kept passes' sums follow)."""
@@ -213,7 +238,12 @@ class CorrugationEstimator:
         summed = np.cumsum(np.concatenate([np.zeros((1, *self.log_components.shape)), self._growth(
             k.class_idx, k.friction, k.regime, k.speed, k.axles)]), axis=0)
         self._growth_before, self._growth_total = RowQueue(summed[:-1]), summed[-1].copy()
+        self._sum_axles()
         self._axle_sum = int(k.axles.sum())
+
+    def _sum_axles(self) -> None:
+        axles_summed = np.concatenate([[0], np.cumsum(self.kept.axles)])
+        self._axles_before, self._axle_total = RowQueue(axles_summed[:-1]), int(axles_summed[-1])
 
     # -- state and forecast ---------------------------------------------------------------------
     def flat(self, band_rms: np.ndarray) -> np.ndarray:

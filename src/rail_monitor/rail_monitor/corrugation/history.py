@@ -4,31 +4,42 @@ load and lateral creepage from which the regime follows in another friction stat
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 COLUMNS = ("stamp_ns", "train_id", "class_idx", "friction", "regime", "speed", "axles", "load", "creepage")
 
 
-@dataclass
+DTYPES = {"stamp_ns": np.int64, "train_id": object, "class_idx": np.int64, "friction": np.int64,
+          "regime": np.int64, "speed": np.float64, "axles": np.int64, "load": np.float64, "creepage": np.float64}
+
+
 class KeptPasses:
     """Columns of the kept passes, in the order they were counted; their (stamp [ns], train_id)
-    keys are the passes seen."""
+    keys are the passes seen. Columns: stamp_ns, train_id, class_idx, friction, regime
+    (core.contact.REGIME_*), speed [m/s], axles, load (wheel load [N]) and creepage (lateral [-]).
 
-    stamp_ns: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    train_id: np.ndarray = field(default_factory=lambda: np.zeros(0, object))
-    class_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    friction: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    regime: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))    # core.contact.REGIME_*
-    speed: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))   # [m/s]
-    axles: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    load: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))    # wheel load [N]
-    creepage: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float64))  # lateral [-]
-    _seen: set[tuple[int, str]] | None = field(default=None, repr=False, compare=False)
+    Each column is a :class:`RowQueue`, so a pass counted and the oldest passes leaving the history
+    cost the same however many are kept (a live pass at a busy site with a long history)."""
+
+    def __init__(self, **cols: np.ndarray) -> None:
+        self._columns = {name: RowQueue(np.asarray(cols.get(name, []), DTYPES[name])) for name in COLUMNS}
+        self._seen: set[tuple[int, str]] | None = None
+        stamps = self._columns["stamp_ns"].rows
+        self._newest = int(stamps.max()) if len(stamps) else None
+        self._in_time_order = bool(np.all(np.diff(stamps) >= 0))
+
+    stamp_ns = property(lambda self: self._columns["stamp_ns"].rows)
+    train_id = property(lambda self: self._columns["train_id"].rows)
+    class_idx = property(lambda self: self._columns["class_idx"].rows)
+    friction = property(lambda self: self._columns["friction"].rows)
+    regime = property(lambda self: self._columns["regime"].rows)
+    speed = property(lambda self: self._columns["speed"].rows)
+    axles = property(lambda self: self._columns["axles"].rows)
+    load = property(lambda self: self._columns["load"].rows)
+    creepage = property(lambda self: self._columns["creepage"].rows)
 
     def __len__(self) -> int:
-        return len(self.stamp_ns)
+        return len(self._columns["stamp_ns"])
 
     def seen(self) -> set[tuple[int, str]]:
         """The keys of the kept passes as a set, built when first asked for after a change (passes
@@ -37,21 +48,48 @@ class KeptPasses:
             self._seen = set(zip(self.stamp_ns.tolist(), self.train_id.tolist(), strict=True))
         return self._seen
 
+    @property
+    def in_time_order(self) -> bool:
+        """Whether the kept passes' stamps never decrease in counting order (a late pass breaks it)."""
+        return self._in_time_order
+
     def newest_ns(self) -> int | None:
         """The newest kept stamp [ns] (None: none kept)."""
-        return int(self.stamp_ns.max()) if len(self.stamp_ns) else None
+        return self._newest
 
     def extend(self, **cols: np.ndarray) -> None:
         """Append passes."""
+        stamps = np.asarray(cols["stamp_ns"], np.int64)
+        if len(stamps):
+            self._in_time_order &= bool((self._newest is None or stamps[0] >= self._newest)
+                                        and np.all(np.diff(stamps) >= 0))
+            self._newest = max(int(stamps.max()), self._newest if self._newest is not None else int(stamps.max()))
         for name in COLUMNS:
-            setattr(self, name, np.concatenate([getattr(self, name), cols[name]]))
+            self._columns[name].append(np.asarray(cols[name], DTYPES[name]))
         self._seen = None
 
-    def drop(self, gone: np.ndarray) -> None:
-        """Forget the passes of a boolean mask."""
+    def older_than(self, stamp_ns: int) -> slice | np.ndarray:
+        """The kept passes stamped before stamp_ns: a leading slice when the kept passes are in time
+        order (found by bisection), else a boolean mask."""
+        if self._in_time_order:
+            return slice(0, int(np.searchsorted(self.stamp_ns, stamp_ns, side="left")))
+        return self.stamp_ns < stamp_ns
+
+    def drop(self, gone: slice | np.ndarray) -> None:
+        """Forget the passes of a leading slice or a boolean mask."""
         for name in COLUMNS:
-            setattr(self, name, getattr(self, name)[~gone])
+            self._columns[name].drop(gone)
+        stamps = self.stamp_ns
+        if not len(stamps):
+            self._newest, self._in_time_order = None, True
+        elif not isinstance(gone, slice):
+            self._newest, self._in_time_order = int(stamps.max()), bool(np.all(np.diff(stamps) >= 0))
         self._seen = None
+
+
+def dropped(gone: slice | np.ndarray) -> int:
+    """How many rows a leading slice or a boolean mask (KeptPasses.older_than) selects."""
+    return gone.stop if isinstance(gone, slice) else int(np.count_nonzero(gone))
 
 
 class RowQueue:
@@ -61,7 +99,7 @@ class RowQueue:
     earlier (``rows``) keeps its values whatever is appended or dropped later."""
 
     def __init__(self, rows: np.ndarray) -> None:
-        self._buf, self._lo, self._hi = np.array(rows, float), 0, len(rows)
+        self._buf, self._lo, self._hi = np.array(rows), 0, len(rows)
 
     @property
     def rows(self) -> np.ndarray:
@@ -76,11 +114,18 @@ class RowQueue:
     def append(self, rows: np.ndarray) -> None:
         n, live = len(rows), len(self)
         if self._hi + n > len(self._buf):
-            buf = np.empty((2 * live + n, *self._buf.shape[1:]))
+            buf = np.empty((2 * live + n, *self._buf.shape[1:]), self._buf.dtype)
             buf[:live] = self.rows
             self._buf, self._lo, self._hi = buf, 0, live
         self._buf[self._hi:self._hi + n] = rows
         self._hi += n
+
+    def drop(self, gone: slice | np.ndarray) -> None:
+        """Drop a leading slice of rows (nothing moves) or the rows of a boolean mask."""
+        if isinstance(gone, slice):
+            self._lo += gone.stop
+        else:
+            self.keep(~gone)
 
     def keep(self, mask: np.ndarray) -> None:
         """Keep the rows of a boolean mask (dropping a leading run costs nothing)."""
