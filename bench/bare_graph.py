@@ -9,7 +9,9 @@ source, executor and flow control are the real ones.
 
 ``python -m bench.bare_graph NODE --site SITE`` runs one stand-in as its own process, as the
 model's executable runs (its session, executor and flow control): the separate-process layout of
-the no-op graph for bench.live.
+the no-op graph for bench.live. ``python -m bench.bare_graph wayside_monitor --site SITE
+--ros-args ...`` runs every stand-in and the real recorder in one process through
+``wayside_monitor.run_graph`` (``-p listen:=true``: the one-process layout of the no-op graph).
 """
 
 from __future__ import annotations
@@ -154,16 +156,21 @@ def main() -> None:
     from rail_monitor.core.node_params import BATCH_SPECS
     from rail_monitor.core.params import resolve
     from rail_monitor.nodes.process import run_node
+    from rail_monitor.nodes.wayside_monitor import run_graph
     from rail_monitor.site_file import load_parameter_file
 
-    ap = argparse.ArgumentParser(description="Run one stand-in of the no-op graph as its own process.")
-    ap.add_argument("node", choices=MODEL_EXECUTABLES)
+    ap = argparse.ArgumentParser(description="Run one stand-in of the no-op graph as its own process, or "
+                                 "(wayside_monitor) all of them and the real recorder in one process.")
+    ap.add_argument("node", choices=(*MODEL_EXECUTABLES, "wayside_monitor"))
     ap.add_argument("--site", default="src/rail_monitor/config/curve_250.yaml")
     ap.add_argument("--source", default="bags/sample")
-    ns = ap.parse_args()
+    ns, ros_args = ap.parse_known_args()
     values = load_parameter_file(ns.site)
-    make = stand_ins(read_passes(ns.source), values, resolve(BATCH_SPECS, values)["max_batch"])[ns.node]
-    raise SystemExit(run_node(make, ["bare_" + ns.node, "--ros-args", "--log-level", "warn"]))
+    makers = stand_ins(read_passes(ns.source), values, resolve(BATCH_SPECS, values)["max_batch"])
+    if ns.node == "wayside_monitor":
+        run_graph(["bare_wayside_monitor", *ros_args], make_models=lambda: [make() for make in makers.values()])
+        return
+    raise SystemExit(run_node(makers[ns.node], ["bare_" + ns.node, "--ros-args", "--log-level", "warn"]))
 
 
 if __name__ == "__main__":

@@ -10,9 +10,9 @@ on a one-pass history, from its spawn to the probe's receipt of its first output
 resident memory then (its replayer waits for the probe's subscription, as for its own nodes').
 The same idle and rate measurements are then made of the no-op graph in the separate-process layout
 (bench.bare_graph's stand-ins, each its own process, and the real recorder: what rclpy and DDS cost
-with no model; its outputs carry a fixed train id, so it has no latency), and of the one-process
-graph as a site would run it with its own detector driver: wayside_monitor with listen:=true, the
-probe publishing the passes.
+with no model; its outputs carry a fixed train id, so it has no latency), of the one-process
+graph as a site would run it with its own detector driver (wayside_monitor with listen:=true, the
+probe publishing the passes), and of the no-op graph in that one-process layout.
 Both graphs' corrugation estimators resume from a checkpoint holding what a busy site's keeps
 (``--kept-days`` of its traffic up to now, default the site's corrugation.history_days), so a
 pass costs what it costs at a site that has run for a while; 0: an empty state.
@@ -166,10 +166,11 @@ def busy_checkpoint(site: str, days: float, path: Path) -> int:
 def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle_s: float,
                layout: str = "separate", state: Path | None = None) -> dict[str, Any]:
     """A graph's idle CPU, then per rate its CPU share and latency percentiles. layout: "separate"
-    (a process per node, as the launch file), "one" (wayside_monitor listening) or "bare" (the
-    separate layout with bench.bare_graph's no-op stand-ins for the models and the real recorder).
+    (a process per node, as the launch file), "one" (wayside_monitor listening), "bare" (the
+    separate layout with bench.bare_graph's no-op stand-ins for the models and the real recorder)
+    or "bare-one" (those stand-ins and the real recorder in one process, listening).
     state: a checkpoint the estimator resumes from (copied: the node writes its own)."""
-    timed = layout != "bare"  # the stand-ins' outputs carry a fixed train id: no latency to time
+    timed = not layout.startswith("bare")  # the stand-ins' outputs carry a fixed train id: no latency to time
     with tempfile.TemporaryDirectory() as tmp:
         bag = f"output:={Path(tmp) / 'bag'}"
         resume = []
@@ -179,6 +180,11 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
             resume = [f"corrugation_estimator:checkpoint_path:={Path(tmp) / 'state.npz'}"]
         if layout == "one":
             procs, names = [_spawn("wayside_monitor", site, "listen:=true", bag, *resume)], ["wayside_monitor"]
+        elif layout == "bare-one":
+            procs = [subprocess.Popen([sys.executable, "-m", "bench.bare_graph", "wayside_monitor", "--site", site,
+                                       "--ros-args", "--params-file", site, "-p", "listen:=true", "-p", bag,
+                                       "--log-level", "warn"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+            names = ["wayside_monitor"]
         elif layout == "bare":
             procs = [subprocess.Popen([sys.executable, "-m", "bench.bare_graph", exe, "--site", site],
                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -255,6 +261,7 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             g = live_graph(site, probe, rates, seconds, idle_s, state=state)
             bare = live_graph(site, probe, rates, seconds, idle_s, layout="bare")
             one = live_graph(site, probe, rates, seconds, idle_s, layout="one", state=state)
+            bare_one = live_graph(site, probe, rates, seconds, idle_s, layout="bare-one")
     finally:
         probe.close()
     out = [("wayside_monitor start-up to first output", f"{s['seconds']:.2f} s",
@@ -279,6 +286,9 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
                 f"over {idle_s:g} s with no passes"))
     out += [_rate_row(f"one-process graph, {rate:g} passes/s arriving one at a time", one[rate],
                       "; wayside_monitor listen:=true, the passes from the probe's process") for rate in rates]
+    out += [_rate_row(f"no-op one-process graph, {rate:g} passes/s arriving one at a time", bare_one[rate],
+                      "; the no-op graph's stand-ins and the real recorder in one process, listening as "
+                      "wayside_monitor listen:=true does", latency=False) for rate in rates]
     return out
 
 
