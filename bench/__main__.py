@@ -33,6 +33,7 @@ from bench import noise as bn
 from bench import recorder as br
 from bench import sites as bsites
 from bench import squeal as bs
+from bench.timing import first_touch_s
 from rail_monitor.app.batch import run_models
 from rail_monitor.app.batch_bag import run_to_bag, write_bag
 from rail_monitor.bagio.passes_bag import write_passes_bag
@@ -72,7 +73,11 @@ def graph_rows(source: str, site: str, keep: Path, repeat: int) -> list[Row]:
 
 
 def batch_rows(values: dict, site: str, sizes: list[int]) -> list[Row]:
-    rows: list[Row] = [("batch set-up (site tables, compiled kernels; once per process)",
+    fresh, again = first_touch_s()
+    rows: list[Row] = [("filling 256 MB new to this process", f"{fresh:.2f} s",
+                        f"{again:.2f} s again once freed: memory new to the machine costs more the first time "
+                        "(a first batch run pays it)"),
+                       ("batch set-up (site tables, compiled kernels; once per process)",
                         f"{bb.set_up_s(values):.2f} s", "")]
     for size in sizes:
         n, t, _ = bb.timed(values, size)

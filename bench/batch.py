@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from bench.timing import peak_rss_mb
+from bench.timing import first_touch_s, peak_rss_mb
 from rail_monitor.app.batch import BatchResult, run_models
 from rail_monitor.app.batch_bag import run_to_bag
 from rail_monitor.app.simulator import simulate, simulator_config
@@ -141,6 +141,8 @@ def main() -> None:
     if ns.streamed:
         print(*streamed(values, int(ns.streamed)))
         return
+    fresh, again = first_touch_s()
+    print(f"filling 256 MB new to this process: {fresh:.2f} s; again, reused: {again:.2f} s")
     print(f"set-up (site tables, kernels; once per process): {set_up_s(values):.2f} s")
     for size in (int(float(x)) for x in ns.sizes.split(",")):
         for _ in range(ns.repeat):

@@ -50,3 +50,17 @@ def peak_rss_mb(pid: int | str = "self") -> float:
             if line.startswith("VmHWM:"):
                 return int(line.split()[1]) / 1024.0
     raise RuntimeError(f"no VmHWM for process {pid}")
+
+
+def first_touch_s(mb: int = 256) -> tuple[float, float]:
+    """Wall time to fill mb MB this process has not used, then the same size again after freeing
+    it [s]. Where the first is much longer, memory new to the machine is dear (a virtual machine's
+    host maps each page at its first use): a first run that allocates much pays it, a second run
+    in the same process reuses its memory."""
+    times = []
+    for _ in range(2):
+        t = time.perf_counter()
+        a = np.ones(mb * 2**20 // 8)
+        times.append(time.perf_counter() - t)
+        del a
+    return times[0], times[1]

@@ -29,6 +29,9 @@ def test_the_benchmark_harness_runs_and_batch_equals_the_live_graph(tmp_path):
                      r"corrugation_estimator [0-9]+ %", text), text
     assert re.search(r"\| no-op graph, 20 passes/s arriving one at a time \| [0-9]+ % of a core \| over 40 passes",
                      text), text
+    assert re.search(r"\| no-op one-process graph, 20 passes/s arriving one at a time \| [0-9]+ % of a core \| over 40 "
+                     r"passes", text), text
+    assert re.search(r"\| filling 256 MB new to this process \| [0-9.]+ s \| [0-9.]+ s again", text), text
     assert re.search(r"\| batch streamed to a bag, [0-9,]+ passes \| [0-9,]+ MB \|", text), text
     assert re.search(r"\| export to Parquet, [0-9,]+ passes, in parts of 5,000 passes \| [0-9,]+ MB \|", text), text
     ratio = re.search(r"\| real / ceiling \| ([0-9.]+) \|", text)

@@ -26,7 +26,7 @@ import numpy as np
 from rosbags.interfaces import Nodetype
 
 from rail_monitor.bagio.cdr import CdrError, deserialize, message_view
-from rail_monitor.bagio.cdr_layout import ENCAPSULATION, Run, base_dtype, layout, run_dtype
+from rail_monitor.bagio.cdr_layout import ENCAPSULATION, Run, base_dtype, column_dtype, layout, run_dtype
 
 
 @dataclass
@@ -209,18 +209,12 @@ FEW = 12  # fewer messages than this are read one by one (a numpy step per field
 
 
 @functools.cache
-def _packed_dtype(run: Run) -> np.dtype:
-    """A record of a run's fields, as their columns are typed (bools as bool)."""
-    return np.dtype([(name, bool if code == "?" else np.dtype(code).newbyteorder("<"))
-                     for name, code in zip(run.names, run.codes, strict=True)])
-
-
 def _stack(typename: str, views: list[SimpleNamespace]) -> SimpleNamespace:
     """The columns of messages read one by one (bagio.cdr.message_view), as read_columns gives them."""
     out = SimpleNamespace()
     for item in layout(typename):
         if isinstance(item, Run):  # one record array per run, its fields the columns
-            rec = np.array([tuple(getattr(v, name) for name in item.names) for v in views], _packed_dtype(item))
+            rec = np.array([tuple(getattr(v, name) for name in item.names) for v in views], column_dtype(item))
             vars(out).update({name: rec[name] for name in item.names})
             continue
         name, kind, detail = item

@@ -96,3 +96,10 @@ def run_dtype(run: Run, phase: int) -> np.dtype:
         offsets.append(at - phase)
         at += dtype.itemsize
     return np.dtype({"names": names, "formats": formats, "offsets": offsets, "itemsize": at - phase})
+
+
+@functools.cache
+def column_dtype(run: Run) -> np.dtype:
+    """A packed record of a run's fields as their columns are typed (bools as bool, little-endian)."""
+    return np.dtype([(name, bool if code == "?" else np.dtype(code).newbyteorder("<"))
+                     for name, code in zip(run.names, run.codes, strict=True)])

@@ -54,14 +54,14 @@ class NoisePrediction:
     def components(self, i: int) -> tuple[list[str], list[float]]:
         """Pass i's source components and their LpAeq,Tp [dB(A)]: those its class has (the
         superstructure term is for freight only), in component_names order."""
-        pairs = [(c, float(x)) for c, x in zip(self.component_names, self.component_lpaeq_dba[i], strict=True)
-                 if x > -np.inf]
-        return [c for c, _ in pairs], [x for _, x in pairs]
+        levels = self.component_lpaeq_dba[i]
+        has = _present(levels)
+        return [c for c, h in zip(self.component_names, has.tolist(), strict=True) if h], levels[has].tolist()
 
     def components_of_all(self) -> tuple[list[list[str]], np.ndarray | list[np.ndarray]]:
         """components(i) of every pass: the names per pass, and the levels as one (N, C) array
         where every pass has the same components, else one array per pass."""
-        has = self.component_lpaeq_dba > -np.inf
+        has = _present(self.component_lpaeq_dba)
         patterns, inverse = np.unique(has, axis=0, return_inverse=True)
         inverse = inverse.reshape(-1)
         names = [[c for c, h in zip(self.component_names, pattern, strict=True) if h] for pattern in patterns.tolist()]
@@ -84,6 +84,11 @@ class NoisePrediction:
         return replace(parts[0], **{k: np.concatenate([p.per_pass()[k] for p in parts])
                                     for k in parts[0].per_pass()})
 
+
+
+def _present(levels: np.ndarray) -> np.ndarray:
+    """Which source components a pass has: a component its class does not have is at -inf dB(A)."""
+    return levels > -np.inf
 
 
 class NoiseRows:
