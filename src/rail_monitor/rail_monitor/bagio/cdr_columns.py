@@ -16,7 +16,6 @@ not read this way (TypeError).
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from types import SimpleNamespace
@@ -208,7 +207,6 @@ def _rows(value: Any, keep: np.ndarray) -> Any:
 FEW = 12  # fewer messages than this are read one by one (a numpy step per field costs more than a message)
 
 
-@functools.cache
 def _stack(typename: str, views: list[SimpleNamespace]) -> SimpleNamespace:
     """The columns of messages read one by one (bagio.cdr.message_view), as read_columns gives them."""
     out = SimpleNamespace()
