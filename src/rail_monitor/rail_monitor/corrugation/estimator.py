@@ -74,7 +74,6 @@ class CorrugationEstimator:
         # Axles summed the same way (K,) and after the last; the kept passes' axles are the difference.
         self._axles_before = RowQueue(np.zeros(0, np.int64))
         self._axle_total = 0
-        self._axle_sum = 0
 
     # -- passes ---------------------------------------------------------------------------------
     def advance(self, passes: PassTable) -> np.ndarray:
@@ -111,7 +110,6 @@ class CorrugationEstimator:
         axles_summed = self._axle_total + np.concatenate([[0], np.cumsum(new.axle_count)])
         self._axles_before.append(axles_summed[:-1])
         self._axle_total = int(axles_summed[-1])
-        self._axle_sum += int(new.axle_count.sum())
         m = int(counted.sum())
         self.pass_count += m
         self.total_pass_count += m
@@ -220,7 +218,6 @@ class CorrugationEstimator:
         gone = k.older_than(self.newest_ns - self.history_ns)
         if dropped(gone):
             self._growth_before.drop(gone)
-            self._axle_sum -= int(k.axles[gone].sum())
             k.drop(gone)
             if isinstance(gone, slice):
                 self._axles_before.drop(gone)
@@ -239,11 +236,15 @@ class CorrugationEstimator:
             k.class_idx, k.friction, k.regime, k.speed, k.axles)]), axis=0)
         self._growth_before, self._growth_total = RowQueue(summed[:-1]), summed[-1].copy()
         self._sum_axles()
-        self._axle_sum = int(k.axles.sum())
 
     def _sum_axles(self) -> None:
         axles_summed = np.concatenate([[0], np.cumsum(self.kept.axles)])
         self._axles_before, self._axle_total = RowQueue(axles_summed[:-1]), int(axles_summed[-1])
+
+    @property
+    def _kept_axles(self) -> int:
+        """The kept passes' axles (the running sum's difference)."""
+        return self._axle_total - int(self._axles_before.rows[0]) if len(self._axles_before) else 0
 
     # -- state and forecast ---------------------------------------------------------------------
     def flat(self, band_rms: np.ndarray) -> np.ndarray:
@@ -277,19 +278,19 @@ class CorrugationEstimator:
 
     def recent_growth(self) -> np.ndarray:
         """g per component (B, P) [1/axle pass]: the kept passes' growth, averaged per axle pass."""
-        if self._axle_sum == 0:
+        if self._kept_axles == 0:
             return np.zeros((len(self.bands), self.points))
-        return (self._growth_total - self._growth_before.rows[0]) / self._axle_sum
+        return (self._growth_total - self._growth_before.rows[0]) / self._kept_axles
 
     def recent_growth_by_state(self) -> np.ndarray:
         """recent_growth() split by friction state (4, B, P) [1/axle pass of all kept passes]."""
         k, out = self.kept, np.zeros((4, *self.log_components.shape))
-        if self._axle_sum == 0:
+        if self._kept_axles == 0:
             return out
         growth = self._growth(k.class_idx, k.friction, k.regime, k.speed, k.axles)
         for f in range(4):
             out[f] = growth[k.friction == f + 1].sum(axis=0)
-        return out / self._axle_sum
+        return out / self._kept_axles
 
     def forecast_interval(self) -> ForecastInterval:
         """P10, P50 and P90 of the days to threshold over the K_b posterior and the level variance
