@@ -121,8 +121,9 @@ class Probe:
         self.thread.join(timeout=5)
 
 
-def _spawn(exe: str, site: str, *params: str) -> subprocess.Popen:
-    args = [exe, "--ros-args", "--params-file", site, "--log-level", "warn"]
+def _spawn(exe: str | list[str], site: str, *params: str) -> subprocess.Popen:
+    """An executable (or a command line) with the site's parameters file and params (NAME:=VALUE)."""
+    args = [*([exe] if isinstance(exe, str) else exe), "--ros-args", "--params-file", site, "--log-level", "warn"]
     for p in params:
         args += ["-p", p]
     return subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -181,9 +182,8 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
         if layout == "one":
             procs, names = [_spawn("wayside_monitor", site, "listen:=true", bag, *resume)], ["wayside_monitor"]
         elif layout == "bare-one":
-            procs = [subprocess.Popen([sys.executable, "-m", "bench.bare_graph", "wayside_monitor", "--site", site,
-                                       "--ros-args", "--params-file", site, "-p", "listen:=true", "-p", bag,
-                                       "--log-level", "warn"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+            procs = [_spawn([sys.executable, "-m", "bench.bare_graph", "wayside_monitor", "--site", site], site,
+                            "listen:=true", bag)]
             names = ["wayside_monitor"]
         elif layout == "bare":
             procs = [subprocess.Popen([sys.executable, "-m", "bench.bare_graph", exe, "--site", site],

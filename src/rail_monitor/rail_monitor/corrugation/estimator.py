@@ -174,12 +174,15 @@ class CorrugationEstimator:
         else:  # a late pass was kept: searched as one array, as before it was kept
             start = np.searchsorted(np.concatenate([kept_stamps, new.stamp_ns]), opens, side="left")
             in_new = start >= k0
+
+        def at_start(kept_column: np.ndarray, new_column: np.ndarray) -> np.ndarray:
+            """Each window's first pass's value, of the kept then the new passes."""
+            return np.where(in_new, new_column[np.where(in_new, start - k0, 0)],
+                            kept_column[np.minimum(start, k0 - 1)] if k0 else 0)
+
         new_axles_before = axle_total + np.concatenate([[0], np.cumsum(new.axle_count)])
-        axles_at_start = np.where(in_new, new_axles_before[np.where(in_new, start - k0, 0)],
-                                  kept_axles_before[np.minimum(start, k0 - 1)] if k0 else 0)
-        axles = (new_axles_before[1:] - axles_at_start).astype(float)
-        first_stamp = np.where(in_new, new.stamp_ns[np.where(in_new, start - k0, 0)],
-                               kept_stamps[np.minimum(start, k0 - 1)] if k0 else 0)
+        axles = (new_axles_before[1:] - at_start(kept_axles_before, new_axles_before)).astype(float)
+        first_stamp = at_start(kept_stamps, new.stamp_ns)
         kernels = corrugation_kernels(self.engine)
         # Of the kept passes' prefix sums, only the rows where windows start (a live pass: one).
         old = np.unique(start[start < k0])

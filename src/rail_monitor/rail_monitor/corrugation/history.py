@@ -63,7 +63,8 @@ class KeptPasses:
         if len(stamps):
             self._in_time_order &= bool((self._newest is None or stamps[0] >= self._newest)
                                         and np.all(np.diff(stamps) >= 0))
-            self._newest = max(int(stamps.max()), self._newest if self._newest is not None else int(stamps.max()))
+            top = int(stamps.max())
+            self._newest = top if self._newest is None else max(top, self._newest)
         for name in COLUMNS:
             self._columns[name].append(np.asarray(cols[name], DTYPES[name]))
         self._seen = None
