@@ -34,10 +34,10 @@ from bench import recorder as br
 from bench import sites as bsites
 from bench import squeal as bs
 from bench.timing import first_touch_s
-from rail_monitor.app.batch import run_models
-from rail_monitor.app.batch_bag import run_to_bag, write_bag
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_passes
+from rail_monitor.batch.bag import run_to_bag, write_bag
+from rail_monitor.batch.run import run_models
 from rail_monitor.site_file import load_parameter_file
 
 Row = tuple[str, str, str]  # what, figure, note

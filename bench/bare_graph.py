@@ -23,9 +23,9 @@ from typing import Any
 
 from rclpy.node import Node
 
-from rail_monitor.app.batch import run_models
-from rail_monitor.bagio import messages as fields
+from rail_monitor.batch.run import run_models
 from rail_monitor.core.passes import PassTable
+from rail_monitor.messages import fields
 from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
 from rail_monitor.nodes.convert import to_cdr
 from rail_monitor.nodes.mcap_recorder import McapRecorder

@@ -19,12 +19,13 @@ from typing import Any
 import numpy as np
 
 from bench.timing import first_touch_s, peak_rss_mb
-from rail_monitor.app.batch import BatchResult, run_models
-from rail_monitor.app.batch_bag import run_to_bag
-from rail_monitor.app.simulator import simulate, simulator_config
+from rail_monitor.batch.bag import run_to_bag
+from rail_monitor.batch.run import BatchResult, run_models
 from rail_monitor.core.passes import PassTable
+from rail_monitor.core.simulator_params import simulator_config
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns, parse_iso_ns
+from rail_monitor.simulation.simulator import simulate
 
 BUSY_YEAR = 100_000  # train passes a year at a busy site
 
@@ -66,7 +67,7 @@ def timed(values: Mapping[str, Any], passes: int, threads: int = 0) -> tuple[int
 def live_equality(bag: str, values: Mapping[str, Any]) -> dict[str, float]:
     """Largest differences between a live graph's bag and batch mode on the passes it recorded:
     relative for corrugation amplitudes, absolute in dB for levels; and alert events live - batch."""
-    from rail_monitor.app.report import load_run
+    from rail_monitor.report.run_data import load_run
 
     run = load_run(bag)
     r = run_models(run.passes, values)

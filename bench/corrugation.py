@@ -13,14 +13,15 @@ from pathlib import Path
 import numpy as np
 
 from bench.timing import best_of, header, parser
+from rail_monitor.advice import growth as advice
 from rail_monitor.advice import plan
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.core.passes import PassTable, with_class_defaults
 from rail_monitor.core.site import site_from_values
-from rail_monitor.corrugation import advice, checkpoint
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.growth import GrowthTables, _rail_receptance
+from rail_monitor.engine import checkpoint
 from rail_monitor.site_file import load_parameter_file
 
 

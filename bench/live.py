@@ -58,7 +58,7 @@ class Probe:
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
 
-        from rail_monitor.bagio.messages import train_pass_fields
+        from rail_monitor.messages.fields import train_pass_fields
         from rail_monitor.nodes.convert import TOPICS, to_msg
 
         self.rclpy = rclpy
@@ -151,9 +151,9 @@ def busy_checkpoint(site: str, days: float, path: Path) -> int:
     """Write to path the corrugation state of a busy site (bench.batch's) after ``days`` of traffic
     ending a minute ago, as the estimator node checkpoints it; returns the passes it keeps."""
     from bench.batch import BUSY_YEAR, busy_history
-    from rail_monitor.app.batch import run_models
+    from rail_monitor.batch.run import run_models
     from rail_monitor.core.timeutil import NS_PER_DAY, NS_PER_S, format_iso_ns
-    from rail_monitor.corrugation.checkpoint import save
+    from rail_monitor.engine.checkpoint import save
     from rail_monitor.site_file import load_parameter_file
 
     values = load_parameter_file(site)

@@ -17,7 +17,7 @@ from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
-from rail_monitor.bagio.typestore import header_stamp_ns, schema_text
+from rail_monitor.codec.typestore import header_stamp_ns, schema_text
 
 CHUNK = 1 << 20  # mcap_recorder's default chunk_size
 

@@ -1,4 +1,4 @@
-"""Many sites on the Dask cluster of rail_monitor.app.sites: the same manifest of busy sites on a
+"""Many sites on the Dask cluster of rail_monitor.batch.sites: the same manifest of busy sites on a
 local cluster of 1 worker and of 2 workers, in one run (passes per second over all sites, the
 cluster's start included, and the speed-up).
 
@@ -16,8 +16,8 @@ from typing import Any
 
 import bench  # noqa: F401  (private DDS domain, one maths thread)
 from bench.batch import busy_history
-from rail_monitor.app.sites import SiteJob, run_sites
 from rail_monitor.bagio.passes_bag import write_passes_bag
+from rail_monitor.batch.sites import SiteJob, run_sites
 from rail_monitor.site_file import load_parameter_file
 
 Row = tuple[str, str, str]

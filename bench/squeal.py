@@ -17,7 +17,7 @@ from rail_monitor.models import squeal, squeal_ode
 from rail_monitor.site_file import load_parameter_file
 from rail_monitor.squeal.config import squeal_config
 from rail_monitor.squeal.predict import predict
-from rail_monitor.squeal.whatif import rig_case
+from rail_monitor.whatif.squeal import rig_case
 
 
 def costs(site_file: str, ode_cases: int = 3) -> dict[str, float]:

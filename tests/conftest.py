@@ -48,9 +48,9 @@ def _random_value(rng: np.random.Generator, node) -> object:
 
 
 def random_fields(rng: np.random.Generator, typename: str) -> dict:
-    """Random plain fields of every field of a message type (bagio.cdr's input): random string
+    """Random plain fields of every field of a message type (codec.cdr's input): random string
     lengths, sequence lengths and values, over each type's whole range."""
-    from rail_monitor.bagio.typestore import typestore
+    from rail_monitor.codec.typestore import typestore
 
     return {name: _random_value(rng, node) for name, node in typestore().fielddefs[typename][1]}
 

@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 
-from rail_monitor.app.batch import run_models
+from rail_monitor.batch.run import run_models
 from rail_monitor.core.passes import PassTable
 
 from conftest import TOP
@@ -54,7 +54,7 @@ def test_batch_of_an_empty_history_gives_empty_outputs(site_values):
 def test_batch_in_chunks_equals_one_call(site_values, sample_passes, monkeypatch):
     # Batch mode bounds its memory by advancing the corrugation state and predicting the noise in
     # chunks of passes; the state carries over, so the chunks give the one call's numbers exactly.
-    import rail_monitor.app.batch as batch
+    import rail_monitor.batch.run as batch
 
     whole = run_models(sample_passes, site_values)
     monkeypatch.setattr(batch, "HISTORY_CHUNK", 700)

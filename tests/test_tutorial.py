@@ -12,10 +12,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rail_monitor.app.report import load_run
 from rail_monitor.bagio.csv_io import read_csv, write_csv
 from rail_monitor.cli import main
 from rail_monitor.core.timeutil import format_local_ns
+from rail_monitor.report.run_data import load_run
 
 from conftest import TOP
 

@@ -19,9 +19,9 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.passes_bag import pass_cdr, write_passes_bag
 from rail_monitor.bagio.reader import bag_info, read_bag_passes, read_passes, salvage_mcap
-from rail_monitor.bagio.topics import qos_dict
-from rail_monitor.bagio.typestore import TRAIN_PASS, msg_file, type_hash, typestore
+from rail_monitor.codec.typestore import TRAIN_PASS, msg_file, type_hash, typestore
 from rail_monitor.core.errors import InputError
+from rail_monitor.messages.topics import qos_dict
 
 from conftest import SAMPLE, TOP, run_cmd
 
@@ -63,7 +63,7 @@ def test_written_bag_decodes_with_rosbags_and_mcap_ros2(tmp_path: Path, sample_p
 
 
 def test_schema_carries_full_dependency_text():
-    from rail_monitor.bagio.typestore import schema_text
+    from rail_monitor.codec.typestore import schema_text
 
     text = schema_text(TRAIN_PASS)
     assert "float64 speed_mps" in text and "[m/s]" in text
@@ -268,7 +268,7 @@ def test_killed_writer_process_leaves_readable_chunks(tmp_path: Path):
 
 
 def test_header_stamp_read_from_cdr(sample_passes):
-    from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
+    from rail_monitor.codec.typestore import header_stamp_ns, starts_with_header
 
     assert starts_with_header(TRAIN_PASS) and starts_with_header("diagnostic_msgs/msg/DiagnosticArray")
     assert not starts_with_header("rosgraph_msgs/msg/Clock")

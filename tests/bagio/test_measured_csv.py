@@ -51,11 +51,11 @@ def test_a_bad_row_names_its_line_or_is_skipped_and_counted(tmp_path):
 
 
 def test_batch_pairs_a_station_csv_as_it_pairs_a_bag_s_measurements(tmp_path, site_values, sample_passes, capsys):
-    from rail_monitor.app.batch import run_models
-    from rail_monitor.app.simulated_measurements import simulate_measurements
     from rail_monitor.bagio.passes_bag import write_passes_bag
     from rail_monitor.bagio.reader import read_messages
+    from rail_monitor.batch.run import run_models
     from rail_monitor.cli import main
+    from rail_monitor.simulation.measurements import simulate_measurements
 
     passes = sample_passes.sorted().take(slice(0, 600))
     first = run_models(passes, site_values)

@@ -11,13 +11,13 @@ import yaml
 from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
-from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.integrity import check_bag
 from rail_monitor.bagio.mcap_bag import McapBagWriter
-from rail_monitor.bagio.messages import train_pass_fields
 from rail_monitor.bagio.reader import read_bag_passes, salvage_bag_passes
+from rail_monitor.codec.cdr import serialize
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.timeutil import NS_PER_DAY, NS_PER_S
+from rail_monitor.messages.fields import train_pass_fields
 
 TOPIC = "/curve_250/train_pass"
 TYPE = "rail_msgs/msg/TrainPass"

@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
+from rail_monitor.advice import growth as advice
 from rail_monitor.cli import main
 from rail_monitor.core.passes import FRICTION_DRY
-from rail_monitor.corrugation import advice
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 

@@ -9,11 +9,11 @@ import numpy as np
 
 def test_indirect_roughness_from_a_bag_s_measurements_is_labelled_and_equals_the_library(tmp_path, site_values,
                                                                                           sample_passes, capsys):
-    from rail_monitor.app.batch import run_models
-    from rail_monitor.app.indirect_roughness import indirect_of_run
-    from rail_monitor.app.simulated_measurements import simulate_measurements
     from rail_monitor.bagio.passes_bag import write_passes_bag
+    from rail_monitor.batch.run import run_models
     from rail_monitor.cli import main
+    from rail_monitor.simulation.measurements import simulate_measurements
+    from rail_monitor.whatif.roughness import indirect_of_run
 
     passes = sample_passes.sorted().take(slice(0, 1500))
     first = run_models(passes, site_values)

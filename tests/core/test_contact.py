@@ -11,7 +11,7 @@ import pytest
 from rail_monitor.core.contact import REGIME_FULL_SLIDING, contact_state
 from rail_monitor.core.passes import FRICTION_NAMES, PassTable, with_class_defaults
 from rail_monitor.models import hertz, squeal
-from rail_monitor.squeal.whatif import RIG, RIG_RADII_M
+from rail_monitor.whatif.squeal import RIG, RIG_RADII_M
 
 
 def _passes(site, aoa_mrad, friction, cls="emu", load=0.0, speed=19.0) -> PassTable:

@@ -88,7 +88,7 @@ def _recent(est):
 
 
 def test_the_daily_growth_survives_a_checkpoint(site_, tables, tmp_path):
-    from rail_monitor.corrugation import checkpoint
+    from rail_monitor.engine import checkpoint
 
     est = _estimator(site_, tables)
     passes = _passes(site_, RNG.normal(19.0, 1.0, 900), friction=RNG.integers(1, 5, 900))

@@ -30,15 +30,16 @@ def test_the_fit_recovers_a_rail_energy_change_from_a_mix_of_wheels():
 
 
 def test_a_simulated_station_reads_the_true_rail_roughness(site_values):
-    from rail_monitor.app.batch import run_models
-    from rail_monitor.app.indirect_roughness import indirect_of_run
-    from rail_monitor.app.simulated_measurements import simulate_measurements
-    from rail_monitor.app.simulated_surveys import true_estimator
-    from rail_monitor.app.simulator import simulate, simulator_config
+    from rail_monitor.batch.run import run_models
+    from rail_monitor.core.simulator_params import simulator_config
     from rail_monitor.core.site import site_from_values
     from rail_monitor.noise.config import noise_config
     from rail_monitor.noise.predict import RollingNoiseModel
     from rail_monitor.noise.records import Corrugation
+    from rail_monitor.simulation.measurements import simulate_measurements
+    from rail_monitor.simulation.simulator import simulate
+    from rail_monitor.simulation.surveys import true_estimator
+    from rail_monitor.whatif.roughness import indirect_of_run
 
     site = site_from_values(site_values)
     passes = simulate(site, simulator_config({**site_values, "simulator.days": 300.0, "simulator.seed": 20}))

@@ -36,10 +36,10 @@ def test_the_sums_do_not_depend_on_how_passes_are_grouped():
 def _station(site_values, passes, k_b_factor: float, seed: int, defective: int = 4):
     """Measured pass-bys of a rail whose K_b is k_b_factor x the configured one (the CNOSSOS-EU
     prediction on that rail plus the simulator's deviations)."""
-    from rail_monitor.app.batch import run_models
-    from rail_monitor.app.simulated_measurements import simulate_measurements
-    from rail_monitor.app.simulated_surveys import true_estimator
+    from rail_monitor.batch.run import run_models
     from rail_monitor.core.site import site_from_values
+    from rail_monitor.simulation.measurements import simulate_measurements
+    from rail_monitor.simulation.surveys import true_estimator
 
     site = site_from_values(site_values)
     truth = run_models(passes, site_values, estimator=true_estimator(site, site_values, k_b_factor))
@@ -54,8 +54,9 @@ def test_a_noise_station_alone_calibrates_kb(site):
     wheel spread, 0.5 dB weather, 4 wheel-flat vehicles), 28-day windows (seed 20 of the study in
     docs/models.md): the P10-P90 of every friction state's K_b brackets the truth at days 90, 180
     and 270, and K_b is within 20 % of it at day 270, where the configured K_b is 3x off."""
-    from rail_monitor.app.batch import run_models
-    from rail_monitor.app.simulator import simulate, simulator_config
+    from rail_monitor.batch.run import run_models
+    from rail_monitor.core.simulator_params import simulator_config
+    from rail_monitor.simulation.simulator import simulate
     from rail_monitor.site_file import load_parameter_file
 
     from conftest import SITE_FILE
@@ -94,10 +95,10 @@ def measured_history(sample_passes):
 
 
 def test_any_chunking_and_a_checkpoint_give_the_one_call_state(measured_history, tmp_path):
-    from rail_monitor.app.batch import BatchRun, run_models
-    from rail_monitor.corrugation import checkpoint
+    from rail_monitor.batch.run import BatchRun, run_models
     from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.corrugation.estimator import CorrugationEstimator
+    from rail_monitor.engine import checkpoint
 
     history, measurements, values = measured_history
     whole = run_models(history, values, measurements=measurements)
@@ -135,7 +136,7 @@ def test_any_chunking_and_a_checkpoint_give_the_one_call_state(measured_history,
 
 def _observer_counts(values, history, measurements):
     """The observer's counts after one call."""
-    from rail_monitor.app.batch import BatchRun
+    from rail_monitor.batch.run import BatchRun
 
     run = BatchRun(values, measurements=measurements)
     run.feed(history)
@@ -144,7 +145,7 @@ def _observer_counts(values, history, measurements):
 
 
 def test_bad_measurements_are_not_fitted_and_change_nothing(measured_history):
-    from rail_monitor.app.batch import run_models
+    from rail_monitor.batch.run import run_models
 
     history, measurements, values = measured_history
     good = [m for m in measurements if m.train_id != "NO-SUCH-TRAIN" and np.isfinite(m.leq_db).all()]
@@ -163,7 +164,7 @@ def test_bad_measurements_are_not_fitted_and_change_nothing(measured_history):
 def test_after_a_survey_the_windows_are_published_not_taken(measured_history):
     """Surveys calibrate where they come: from a survey until the next grinding the windows are
     fitted and published but leave the state as the run without them leaves it (bit for bit)."""
-    from rail_monitor.app.batch import run_models
+    from rail_monitor.batch.run import run_models
     from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.corrugation.estimator import CorrugationEstimator
     from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent

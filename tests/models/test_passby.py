@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 
-from rail_monitor.models import levels, passby
+from rail_monitor.models import levels, passby, passby_kernel
 
 RECEIVER = passby.Receiver(7.5, 1.2, 0.05, 0.0, 1.0)
 
@@ -18,13 +18,13 @@ def test_kernel_antiderivatives_match_quadrature(d, r):
     """Closed forms against adaptive quadrature of the point-source kernel (independent method), 1e-9."""
     for x in (0.5, 7.0, 40.0):
         val, _ = quad(_g, 0.0, x, args=(d, r), epsabs=1e-14, epsrel=1e-12)
-        assert passby.kernel_antiderivative(x, d, r) == pytest.approx(val, rel=1e-9)
+        assert passby_kernel.kernel_antiderivative(x, d, r) == pytest.approx(val, rel=1e-9)
     total, _ = quad(_g, -np.inf, np.inf, args=(d, r), epsabs=1e-14, epsrel=1e-12)
-    assert passby.kernel_total(d, r) == pytest.approx(total, rel=1e-9)
+    assert passby_kernel.kernel_total(d, r) == pytest.approx(total, rel=1e-9)
     length = 60.0
-    g = passby.kernel_antiderivative
+    g = passby_kernel.kernel_antiderivative
     mean, _ = quad(lambda s: float(g(s, d, r) - g(s - length, d, r)), 0.0, length, epsabs=1e-14, epsrel=1e-12)
-    assert passby.kernel_window_mean(length, d, r) == pytest.approx(mean / length, rel=1e-8)
+    assert passby_kernel.kernel_window_mean(length, d, r) == pytest.approx(mean / length, rel=1e-8)
 
 
 def test_a_long_train_approaches_the_infinite_line_and_tel_exceeds_the_window_level():
@@ -34,7 +34,7 @@ def test_a_long_train_approaches_the_infinite_line_and_tel_exceeds_the_window_le
     long_ = passby.pass_by(lw, band, [20000.0], [20.0], RECEIVER)
     # Infinite incoherent line: p^2 / p0^2 = W' (T_direct + T_image), T in closed form.
     (r1, _), (r2, _) = RECEIVER.paths()
-    line = 90.0 + 10 * np.log10(passby.kernel_total(7.5, r1) + passby.kernel_total(7.5, r2))
+    line = 90.0 + 10 * np.log10(passby_kernel.kernel_total(7.5, r1) + passby_kernel.kernel_total(7.5, r2))
     assert long_.lpaeq_tp_dba[0] == pytest.approx(line, abs=0.01)
     assert long_.lpafmax_dba[0] == pytest.approx(line, abs=0.01)
     assert short.tel_dba[0] == pytest.approx(line, abs=1e-9)       # TEL: exposure over Tp, any length
@@ -63,10 +63,10 @@ def test_f_time_weighting_matches_a_time_integration():
 
     def x(t):
         s = speed * t
-        g = passby.kernel_antiderivative
+        g = passby_kernel.kernel_antiderivative
         return float(g(s, d, r1) - g(s - length, d, r1) + g(s, d, r2) - g(s - length, d, r2))
 
-    sol = solve_ivp(lambda t, y: (x(t) - y) / passby.F_TIME_CONSTANT_S, (-10.0, 10.0), [0.0], max_step=0.002,
+    sol = solve_ivp(lambda t, y: (x(t) - y) / passby_kernel.F_TIME_CONSTANT_S, (-10.0, 10.0), [0.0], max_step=0.002,
                     rtol=1e-9, atol=1e-14)
     got = passby.pass_by(np.array([[0.0]]), np.array([0]), [length], [speed], RECEIVER).lpafmax_dba[0]
     assert got == pytest.approx(10 * np.log10(sol.y[0].max()), abs=0.05)
@@ -88,7 +88,7 @@ def test_the_exponential_average_is_lfilter_step_for_step():
     from scipy.signal import lfilter
 
     a = np.exp(-1.0 / 8)
-    for rows in (1, passby.FEW_ROWS, 40):  # plain floats for a few series, numpy rows for many
+    for rows in (1, passby_kernel.FEW_ROWS, 40):  # plain floats for a few series, numpy rows for many
         x = np.random.default_rng(rows).lognormal(0.0, 2.0, (rows, 73))
         want, _ = lfilter([1.0 - a], [1.0, -a], x, axis=1, zi=a * x[:, :1])
-        assert np.array_equal(passby.exponential_average(x, a), want)
+        assert np.array_equal(passby_kernel.exponential_average(x, a), want)

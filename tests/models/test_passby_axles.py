@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 
-from rail_monitor.models import levels, passby, passby_axles
+from rail_monitor.models import axle_layout, levels, passby, passby_axles, passby_kernel
 
 RECEIVER = passby.Receiver(7.5, 1.2, 0.5, 0.0, 1.0)
 (R1, _), (R2, _) = RECEIVER.paths()
@@ -14,7 +14,7 @@ D = RECEIVER.distance_m
 
 
 def _layout(length, vehicles, axles, ratio=16.0 / 23.0, semi=1.25):
-    return passby_axles.axle_layout([length], [vehicles], [axles], ratio, semi)
+    return axle_layout.axle_layout([length], [vehicles], [axles], ratio, semi)
 
 
 def test_axle_layout_puts_bogies_about_the_vehicle_middle():
@@ -22,7 +22,7 @@ def test_axle_layout_puts_bogies_about_the_vehicle_middle():
     np.testing.assert_allclose(_layout(23.0, 1, 6).offsets_m[0], [2.25, 3.5, 4.75, 18.25, 19.5, 20.75], atol=1e-12)
     np.testing.assert_allclose(_layout(15.0, 1, 2, 0.6, 1.0).offsets_m[0], [3.0, 12.0], atol=1e-12)   # at the pivots
     np.testing.assert_allclose(_layout(12.0, 1, 3).offsets_m[0], [2.0, 6.0, 10.0], atol=1e-12)          # odd: evenly
-    mixed = passby_axles.axle_layout([46.0, 30.0], [2, 3], [8, 6], 0.7, 1.0)
+    mixed = axle_layout.axle_layout([46.0, 30.0], [2, 3], [8, 6], 0.7, 1.0)
     assert mixed.offsets_m.shape == (2, 4) and list(mixed.axles_per_vehicle) == [4.0, 2.0]
     assert np.isnan(mixed.offsets_m[1, 2:]).all()
 
@@ -33,7 +33,7 @@ def _all_axle_history(layout, length, speed, t):
     s = (m[:, None] * layout.pitch_m[0] + layout.offsets_m[0][None, :]).ravel()
     x = 0.5 * length + speed * np.asarray(t, float)[..., None] - s          # front at L/2 + v t
     w = layout.pitch_m[0] / layout.axles_per_vehicle[0]
-    return w * (passby.point_kernel(x, D, R1) + passby.point_kernel(x, D, R2)).sum(axis=-1)
+    return w * (passby_kernel.point_kernel(x, D, R1) + passby_kernel.point_kernel(x, D, R2)).sum(axis=-1)
 
 
 @pytest.mark.parametrize("vehicles, speed", [(1, 22.2), (6, 22.2), (30, 14.0)])
@@ -53,7 +53,7 @@ def test_f_weighted_peak_matches_a_time_integration_over_every_axle(vehicles, sp
     train exercises the far vehicles taken as line segments), 0.02 dB."""
     length = 23.0 * vehicles
     layout = _layout(length, vehicles, 4 * vehicles)
-    tau = passby.F_TIME_CONSTANT_S
+    tau = passby_kernel.F_TIME_CONSTANT_S
     span = (-(0.5 * length + 200.0) / speed, (0.5 * length + 200.0) / speed)
     sol = solve_ivp(lambda t, y: (_all_axle_history(layout, length, speed, t) - y) / tau, span, [0.0],
                     max_step=0.002, rtol=1e-9, atol=1e-16)
@@ -64,9 +64,9 @@ def test_f_weighted_peak_matches_a_time_integration_over_every_axle(vehicles, sp
 def test_a_slow_single_axle_peaks_at_its_closest_approach():
     """One axle passing slowly (v tau << d): the F-weighted peak is the squared pressure at x = 0,
     W (g_direct(0) + g_image(0)), within 0.01 dB."""
-    layout = passby_axles.axle_layout([4.0], [1], [1], 0.0, 0.0)
+    layout = axle_layout.axle_layout([4.0], [1], [1], 0.0, 0.0)
     got = passby_axles.f_weighted_peak([(np.ones(1), R1), (np.ones(1), R2)], layout, [4.0], [0.5], D)
-    want = 4.0 * (passby.point_kernel(0.0, D, R1) + passby.point_kernel(0.0, D, R2))
+    want = 4.0 * (passby_kernel.point_kernel(0.0, D, R1) + passby_kernel.point_kernel(0.0, D, R2))
     assert 10 * np.log10(got[0]) == pytest.approx(10 * np.log10(want), abs=0.01)
 
 
@@ -91,8 +91,8 @@ def test_extreme_but_valid_trains_cost_bounded_memory_and_give_finite_levels():
     import tracemalloc
 
     length, vehicles, axles, speed = [5000.0, 50.0, 5000.0], [1, 500, 500], [2000, 2000, 2000], [1.0, 1.0, 120.0]
-    layout = passby_axles.axle_layout(length, vehicles, axles, 0.7, 1.0)
-    assert layout.offsets_m.shape[1] == passby_axles.MAX_AXLES_PER_VEHICLE
+    layout = axle_layout.axle_layout(length, vehicles, axles, 0.7, 1.0)
+    assert layout.offsets_m.shape[1] == axle_layout.MAX_AXLES_PER_VEHICLE
     tracemalloc.start()
     peak = passby_axles.f_weighted_peak([(np.ones(3), R1), (np.ones(3), R2)], layout, length, speed, D)
     mean = passby_axles.window_kernel(layout, length, D, R1)
@@ -147,7 +147,7 @@ def _mixed_trains(n: int, seed: int = 3):
     rng = np.random.default_rng(seed)
     vehicles = rng.integers(1, 31, n)
     length = vehicles * rng.uniform(10.0, 26.0, n)
-    layout = passby_axles.axle_layout(length, vehicles, vehicles * rng.choice([2, 3, 4, 6], n), 0.7, 1.25)
+    layout = axle_layout.axle_layout(length, vehicles, vehicles * rng.choice([2, 3, 4, 6], n), 0.7, 1.25)
     return layout, length, rng.uniform(5.0, 45.0, n), rng
 
 
@@ -207,12 +207,12 @@ def test_the_compiled_window_kernel_gives_the_numpy_engines():
 def test_near_axle_terms_over_a_common_denominator_are_the_direct_quotients():
     # One division per pair of path distances against the direct directivity / (x^2 + R^2) of
     # each: the same numbers to a few ulps, for a pair and for an odd last radius.
-    from rail_monitor.models.passby import _BROADSIDE, _OMNI
+    from rail_monitor.models.passby_kernel import BROADSIDE, OMNI
 
     x2 = np.random.default_rng(6).uniform(0.0, 1e5, 2000) ** 2 / 1e3
     r2 = [R1 * R1, R2 * R2, float(np.hypot(D, 2.8)) ** 2]
-    broad = _BROADSIDE * D * D
-    direct = (broad / (x2 + D * D) + _OMNI)
+    broad = BROADSIDE * D * D
+    direct = (broad / (x2 + D * D) + OMNI)
     for got, rk in zip(passby_axles.near_axle_terms(x2, D, r2, broad), r2, strict=True):
         np.testing.assert_allclose(got, direct / (x2 + rk), rtol=2e-15, atol=0.0)
 
@@ -230,6 +230,6 @@ def test_passes_of_one_train_share_its_window_kernel_to_the_bit(engine):
     alone = np.stack([passby_axles.window_kernels(passby_axles._take(layout, np.array([i])), length[i:i + 1], D,
                                                   [R1, R2], engine)[:, 0] for i in rows], axis=1)
     np.testing.assert_array_equal(got, alone)
-    nudged = passby_axles.AxleLayout(many.vehicles, many.pitch_m, many.offsets_m.copy())
+    nudged = axle_layout.AxleLayout(many.vehicles, many.pitch_m, many.offsets_m.copy())
     nudged.offsets_m[7, 0] = np.nextafter(nudged.offsets_m[7, 0], np.inf)
     assert len(passby_axles.distinct_trains(nudged, length[rows])[0]) == len(first) + 1

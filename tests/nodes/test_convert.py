@@ -1,4 +1,4 @@
-"""What the nodes publish (rail_monitor.nodes.convert.to_cdr: bagio.cdr's bytes, sent as they are)
+"""What the nodes publish (rail_monitor.nodes.convert.to_cdr: codec.cdr's bytes, sent as they are)
 against rclpy's own serialisation of the message to_msg builds from the same fields."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
 
-from rail_monitor.bagio.topics import GRAPH_TOPICS
 from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.messages.topics import GRAPH_TOPICS
 from rail_monitor.nodes.convert import TOPICS, message_class, to_cdr, to_msg, typename_of
 
 from conftest import random_fields

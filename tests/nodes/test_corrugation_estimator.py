@@ -9,13 +9,14 @@ from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
+from rail_monitor.advice import growth as advice
 from rail_monitor.advice import plan
 from rail_monitor.advice.consequences import Consequences
-from rail_monitor.bagio.messages import train_pass_fields
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
-from rail_monitor.corrugation import advice, surveys
+from rail_monitor.corrugation import surveys
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.messages.fields import train_pass_fields
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STREAM_QOS

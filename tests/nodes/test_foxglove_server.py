@@ -16,8 +16,8 @@ import time
 
 import pytest
 
-from rail_monitor.bagio.topics import GRAPH_TOPICS
-from rail_monitor.bagio.typestore import typestore
+from rail_monitor.codec.typestore import typestore
+from rail_monitor.messages.topics import GRAPH_TOPICS
 
 from conftest import SAMPLE, TOP, run_cmd, wait_until
 

@@ -24,12 +24,12 @@ from rclpy.parameter import Parameter
 from rclpy.serialization import serialize_message
 from rosgraph_msgs.msg import Clock
 
-from rail_monitor.bagio.messages import measured_pass_noise_fields, train_pass_fields
 from rail_monitor.bagio.reader import read_messages
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.measured.records import Measurement
+from rail_monitor.messages.fields import measured_pass_noise_fields, train_pass_fields
 from rail_monitor.nodes import process
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.convert import time_msg, to_msg

@@ -10,10 +10,10 @@ import pytest
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 
-from rail_monitor.app.batch import run_models
-from rail_monitor.app.batch_bag import write_bag
 from rail_monitor.bagio.csv_io import read_csv
 from rail_monitor.bagio.reader import read_bag_passes
+from rail_monitor.batch.bag import write_bag
+from rail_monitor.batch.run import run_models
 from rail_monitor.cli import main
 from rail_monitor.core.errors import InputError
 from rail_monitor.core.passes import ahead_reason
@@ -104,7 +104,7 @@ def _estimator(ctx, site_values, **extra):
 
 def _send(ctx, node, table, *, sim_time: bool = True):
     """Publish the rows of table to node's train_pass, in order; wait until it took them all."""
-    from rail_monitor.bagio.messages import train_pass_fields
+    from rail_monitor.messages.fields import train_pass_fields
     from rail_monitor.nodes.convert import to_msg
 
     pub_node = Node("hostile", context=ctx, namespace="/curve_250")

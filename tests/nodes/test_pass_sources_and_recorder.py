@@ -16,7 +16,7 @@ from rclpy.parameter import Parameter
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.reader import read_bag_passes
-from rail_monitor.bagio.typestore import TRAIN_PASS, type_hash
+from rail_monitor.codec.typestore import TRAIN_PASS, type_hash
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.pass_replayer import PassReplayer
@@ -182,7 +182,7 @@ def test_simulator_publishes_live_into_the_recorder(tmp_path: Path, ros_context)
 
 
 def test_train_pass_message_conversion_round_trips(sample_passes):
-    from rail_monitor.bagio.messages import pass_row, train_pass_fields
+    from rail_monitor.messages.fields import pass_row, train_pass_fields
     from rail_monitor.nodes.convert import to_msg
     from rail_msgs.msg import TrainPass
 

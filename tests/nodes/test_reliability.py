@@ -16,10 +16,10 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rcl_interfaces.msg import ParameterType
 from rclpy.node import Node
 
-from rail_monitor.app.simulator import simulate, simulator_config
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_bag_passes, salvage_bag_passes, salvage_mcap
 from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.simulator_params import simulator_config
 from rail_monitor.core.site import site_from_values
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
@@ -29,6 +29,7 @@ from rail_monitor.nodes.pass_simulator import PassSimulator
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
+from rail_monitor.simulation.simulator import simulate
 from rail_monitor.site_file import load_parameter_file
 
 from conftest import SAMPLE, SITE_FILE, TOP, run_cmd, spinning, wait_until

@@ -9,7 +9,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from squeal.test_predict import _passes
 
-from rail_monitor.bagio.messages import train_pass_fields
+from rail_monitor.messages.fields import train_pass_fields
 from rail_monitor.nodes.convert import to_msg
 from rail_monitor.nodes.qos import STREAM_QOS
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode

@@ -16,10 +16,10 @@ from typing import Any
 import yaml
 
 from rail_monitor.alerts.config import ALERT_SPECS
-from rail_monitor.app.simulator import SIMULATOR_SPECS
 from rail_monitor.core import node_params
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, flatten, refuse_unknown
+from rail_monitor.core.simulator_params import SIMULATOR_SPECS
 from rail_monitor.core.site import (
     CONTACT_SPECS,
     SITE_SPECS,

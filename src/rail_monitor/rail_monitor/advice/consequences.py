@@ -16,13 +16,12 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.core.passes import PassTable, with_class_defaults
+from rail_monitor.core.passes import PassTable, synthetic_passes, with_class_defaults
 from rail_monitor.core.site import Site
 from rail_monitor.corrugation.history import KeptPasses
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation
-from rail_monitor.noise.whatif import synthetic_passes
 from rail_monitor.squeal.config import RISK_MEDIUM, SquealConfig, squeal_config
 from rail_monitor.squeal.predict import risk_at_speeds
 

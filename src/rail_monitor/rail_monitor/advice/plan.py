@@ -1,7 +1,7 @@
 """Speed advice per vehicle class: shares of each class's trains in speed bands an operator can
 publish ("emu 60-70 km/h: 40 %"), at each class's recent mean speed, that cut the peak corrugation
 growth without raising the pass-weighted mean rolling noise by more than a limit or the share of
-passes at a squeal risk (:func:`rail_monitor.models.speed_plan.optimise_speed_plan`).
+passes at a squeal risk (:func:`rail_monitor.advice.speed_plan.optimise_speed_plan`).
 
 Bands are ``advice_band_kmh`` wide on a grid from 0, clipped to each class's speed range (its
 speed_min/speed_max, within the advice's limits); a band's growth, noise and squeal are averaged
@@ -21,10 +21,10 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.advice.consequences import Consequences
+from rail_monitor.advice.growth import growth_at_speeds
+from rail_monitor.advice.speed_plan import optimise_speed_plan, plan_growth
 from rail_monitor.core.passes import KMH_PER_MPS
-from rail_monitor.corrugation.advice import growth_at_speeds
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.models.speed_plan import optimise_speed_plan, plan_growth
 from rail_monitor.noise.records import Corrugation
 
 POINTS_PER_BAND = 5  # speeds across a band over which its growth, noise and squeal are averaged

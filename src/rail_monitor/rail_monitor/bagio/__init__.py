@@ -1,1 +1,3 @@
-"""Reading and writing pass histories and recordings: rosbag2 bags (MCAP, sqlite3) and CSV."""
+"""The file formats: MCAP bags written and read (mcap_bag, reader), their integrity and salvage
+(integrity), the site stored in a bag (site_record), detector and station CSVs (csv_io,
+measured_csv), a bag of passes (passes_bag), output folders and their retention."""

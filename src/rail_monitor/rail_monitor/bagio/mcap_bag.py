@@ -26,10 +26,10 @@ from mcap.writer import CompressionType, Writer
 from rail_monitor.bagio.direct_file import DirectFile
 from rail_monitor.bagio.output_folder import new_output_folder
 from rail_monitor.bagio.retention import Retention
-from rail_monitor.bagio.topics import qos_dict
-from rail_monitor.bagio.typestore import schema_text, type_hash
+from rail_monitor.codec.typestore import schema_text, type_hash
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.timeutil import format_iso_ns
+from rail_monitor.messages.topics import qos_dict
 
 # metadata.yaml custom_data key naming the file being written when the metadata was last written
 # (a recording that splits rewrites metadata.yaml at every split: a power cut leaves the finished

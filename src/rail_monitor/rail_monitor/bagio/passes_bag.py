@@ -6,14 +6,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from rail_monitor.bagio.cdr import serialize
 from rail_monitor.bagio.mcap_bag import McapBagWriter
-from rail_monitor.bagio.messages import measured_pass_noise_fields, roughness_survey_fields, train_pass_fields
-from rail_monitor.bagio.topics import EVENT, STREAM
-from rail_monitor.bagio.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS
+from rail_monitor.codec.cdr import serialize
+from rail_monitor.codec.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
+from rail_monitor.messages.fields import measured_pass_noise_fields, roughness_survey_fields, train_pass_fields
+from rail_monitor.messages.topics import EVENT, STREAM
 
 
 def pass_cdr(table: PassTable, frame_id: str) -> list[bytes]:

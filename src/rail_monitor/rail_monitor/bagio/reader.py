@@ -15,12 +15,12 @@ from typing import Any
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.integrity import Claims, ScannedMessage, check_bag, scan_mcap
-from rail_monitor.bagio.messages import event_from_msg, measurement_from_msg, pass_row
-from rail_monitor.bagio.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS, typestore
+from rail_monitor.codec.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS, typestore
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
 from rail_monitor.measured.records import Measurement
+from rail_monitor.messages.fields import event_from_msg, measurement_from_msg, pass_row
 
 
 def _one_line(exc: BaseException) -> str:

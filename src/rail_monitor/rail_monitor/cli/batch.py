@@ -56,7 +56,7 @@ def run(ns: argparse.Namespace) -> int:
         return _many_sites(ns)
     if ns.chunk < 1:
         raise RailMonitorError(f"--chunk must be a positive number of passes, not {ns.chunk}")
-    from rail_monitor.app.batch_bag import record_history
+    from rail_monitor.batch.bag import record_history
 
     t0 = time.monotonic()
     values = site_values(ns.site)
@@ -88,7 +88,7 @@ def run(ns: argparse.Namespace) -> int:
 
 
 def _many_sites(ns: argparse.Namespace) -> int:
-    from rail_monitor.app.sites import read_manifest, run_sites
+    from rail_monitor.batch.sites import read_manifest, run_sites
 
     jobs = read_manifest(ns.manifest)
     t0 = time.monotonic()

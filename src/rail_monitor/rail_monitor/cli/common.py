@@ -195,7 +195,8 @@ def report_dir(bag: str, report: str | None) -> Path:
 
 def print_report(bag: str, site: str | None, report: str | None) -> None:
     """Print the run summary and write the report folder."""
-    from rail_monitor.app.report import build_report, load_run, summary_lines
+    from rail_monitor.report.run_data import load_run
+    from rail_monitor.report.summary import build_report, summary_lines
 
     values, site_text = bag_site_values(bag, site)
     run = load_run(bag)

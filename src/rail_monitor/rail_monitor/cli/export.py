@@ -10,7 +10,7 @@ from rail_monitor.cli.common import add_site_option, bag_site_values, fresh_outp
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from rail_monitor.app.export import FORMATS
+    from rail_monitor.report.export import FORMATS
 
     s = sub.add_parser("export", help="write a recorded run as tables: passes (every model output per pass) and "
                        "alerts, as CSV, Parquet or an Excel workbook")
@@ -29,10 +29,10 @@ def run(ns: argparse.Namespace) -> int:
     import shutil
 
     from rail_monitor import __version__
-    from rail_monitor.app.export import export_run
     from rail_monitor.bagio.output_folder import new_output_folder
     from rail_monitor.bagio.site_record import read_site_record
     from rail_monitor.core.text import printable
+    from rail_monitor.report.export import export_run
 
     values, _ = bag_site_values(ns.bag, ns.site)
     record = read_site_record(ns.bag) or {}

@@ -21,7 +21,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.reader import bag_info, is_csv, read_passes
     from rail_monitor.bagio.site_record import describe, read_site_record
-    from rail_monitor.bagio.typestore import TRAIN_PASS
+    from rail_monitor.codec.typestore import TRAIN_PASS
     from rail_monitor.core.text import printable
     from rail_monitor.core.timeutil import NS_PER_DAY, NS_PER_S, format_iso_ns
 

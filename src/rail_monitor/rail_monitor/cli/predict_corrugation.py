@@ -37,7 +37,7 @@ def add_parser(models: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.corrugation.whatif import predict_corrugation, summary
+    from rail_monitor.whatif.corrugation import predict_corrugation, summary
 
     values = site_values(ns.site)
     history, events = None, []
@@ -84,8 +84,8 @@ def _print_table(r, data: dict) -> None:
 
 
 def _plot_receptance(r, path: str) -> None:
-    from rail_monitor.app.plots import track_receptance
-    from rail_monitor.corrugation.whatif import receptance_curves
+    from rail_monitor.whatif.corrugation import receptance_curves
+    from rail_monitor.whatif.plots import track_receptance
 
     site = r.estimator.site
     f, curves = receptance_curves(site)
@@ -93,8 +93,8 @@ def _plot_receptance(r, path: str) -> None:
 
 
 def _plot_growth(r, path: str) -> None:
-    from rail_monitor.app.plots import corrugation_growth
-    from rail_monitor.corrugation.advice import evaluate
+    from rail_monitor.advice.growth import evaluate
+    from rail_monitor.whatif.plots import corrugation_growth
 
     curves = {"current speeds": r.evaluation.growth_per_axle_pass}
     if r.advice is not None:

@@ -45,7 +45,7 @@ def add_parser(models: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.noise.whatif import predict_noise, summary
+    from rail_monitor.whatif.noise import predict_noise, summary
 
     values = site_values(ns.site)
     values.update({key: getattr(ns, dest) for dest, key in OVERRIDES.items() if getattr(ns, dest) is not None})
@@ -74,8 +74,8 @@ def _print_table(r) -> None:
 
 
 def _plot(r, path: str) -> None:
-    from rail_monitor.app.plots import noise_spectra
     from rail_monitor.models.levels import a_weighted
+    from rail_monitor.whatif.plots import noise_spectra
 
     model = r.model
     name = model.models[0]

@@ -23,9 +23,9 @@ def add_parser(models: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.app.batch import run_models
-    from rail_monitor.app.indirect_roughness import indirect_of_run
     from rail_monitor.bagio.reader import read_history_inputs, read_passes
+    from rail_monitor.batch.run import run_models
+    from rail_monitor.whatif.roughness import indirect_of_run
 
     values = site_values(ns.site)
     history = Path(ns.history)

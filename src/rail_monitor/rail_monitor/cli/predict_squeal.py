@@ -50,7 +50,7 @@ def run(ns: argparse.Namespace) -> int:
     from rail_monitor.alerts.config import RISK_NAMES
     from rail_monitor.models.squeal import REGIME_NAMES
     from rail_monitor.squeal.config import squeal_config
-    from rail_monitor.squeal.whatif import crabbing_velocities, squeal_case, sweep
+    from rail_monitor.whatif.squeal import crabbing_velocities, squeal_case, sweep
 
     if ns.history:
         return _friction_table(ns)
@@ -85,7 +85,7 @@ def run(ns: argparse.Namespace) -> int:
                 line += f" {RISK_NAMES[int(rows['risk'][i])]:<6}"
             print(line + (f" {rows['ode_amplitude_mps'][i]:9.4f}" if ns.ode else ""))
     if ns.plot:
-        from rail_monitor.app.plots import squeal_sweep
+        from rail_monitor.whatif.plots import squeal_sweep
 
         print(f"plot: {squeal_sweep(rows, ns.plot, title=where)}", file=sys.stderr)
     return 0
@@ -96,7 +96,7 @@ def _friction_table(ns: argparse.Namespace) -> int:
 
     from rail_monitor.bagio.reader import read_passes
     from rail_monitor.core.errors import RailMonitorError
-    from rail_monitor.squeal.whatif import friction_states
+    from rail_monitor.whatif.squeal import friction_states
 
     if ns.rig:
         raise RailMonitorError("--history is a site's: leave out --rig")

@@ -35,10 +35,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.app.simulator import simulate, simulator_config
     from rail_monitor.bagio.csv_io import write_csv
     from rail_monitor.bagio.passes_bag import write_passes_bag
+    from rail_monitor.core.simulator_params import simulator_config
     from rail_monitor.core.site import site_from_values
+    from rail_monitor.simulation.simulator import simulate
 
     values = site_values(ns.site)
     if ns.days is not None:
@@ -68,8 +69,8 @@ def _measured_site(ns: argparse.Namespace, values: dict, site: Site, table: Pass
     """The true rail's surveys and the station's measurements the options ask for."""
     events, measured = [], []
     if ns.surveys_every_days > 0:
-        from rail_monitor.app.simulated_surveys import simulate_surveys
         from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
+        from rail_monitor.simulation.surveys import simulate_surveys
 
         series = simulate_surveys(site, values, table, ns.k_b_factor, ns.surveys_every_days, 1.0,
                                   int(values["simulator.seed"]) + 100)
@@ -78,7 +79,7 @@ def _measured_site(ns: argparse.Namespace, values: dict, site: Site, table: Pass
         print(f"true rail: K_b x {ns.k_b_factor:g} = {', '.join(f'{k:.3g}' for k in series.true_k_b)} "
               "(dry, wet, modifier, contaminated)")
     if ns.measured or ns.measured_csv:
-        from rail_monitor.app.simulated_measurements import station_on_true_rail
+        from rail_monitor.simulation.measurements import station_on_true_rail
 
         station = station_on_true_rail(table, values, ns.k_b_factor, int(values["simulator.seed"]))
         measured = station.measurements

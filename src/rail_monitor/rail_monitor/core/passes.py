@@ -24,7 +24,7 @@ from rail_monitor.core.friction import (  # noqa: F401  (re-exported: the pass t
     FRICTION_UNSET,
     FRICTION_WET,
 )
-from rail_monitor.core.site import Site
+from rail_monitor.core.site import Site, VehicleClass
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, fits_time_msg
 
 KMH_PER_MPS = 3.6  # speeds for people (CSV columns, exports, report) are in km/h
@@ -306,3 +306,13 @@ def with_class_defaults(table: PassTable, site: Site) -> PassTable:
     out.wheel_load_n = np.where(out.wheel_load_n == 0.0, load, out.wheel_load_n)
     out.train_length_m = np.where(out.train_length_m == 0.0, out.vehicle_count * length, out.train_length_m)
     return out
+
+
+def synthetic_passes(site: Site, cls: VehicleClass, speeds: np.ndarray, vehicles: int) -> PassTable:
+    """One train of the class per speed [m/s], of ``vehicles`` vehicles, on dry rail, class defaults
+    filled (the what-if's and the report's reference passes)."""
+    n = len(speeds)
+    return with_class_defaults(PassTable(
+        stamp_ns=np.arange(1, n + 1), train_id=[f"speed {v:g}" for v in speeds], vehicle_class=[cls.name] * n,
+        vehicle_count=[vehicles] * n, axle_count=[0] * n, speed_mps=speeds, angle_of_attack_rad=[0.0] * n,
+        wheel_load_n=[0.0] * n, friction_state=[FRICTION_BY_NAME["dry"]] * n, train_length_m=[0.0] * n), site)

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.models import calibration
 
@@ -65,24 +64,6 @@ def split_before(stamps_ns: np.ndarray, event_ns: int) -> int:
 def in_time_order(events: Sequence[MaintenanceEvent]) -> list[MaintenanceEvent]:
     """The events sorted by stamp (a stable sort: equal stamps keep their order)."""
     return sorted(events, key=lambda e: e.stamp_ns)
-
-
-def advance_with_events(est: CorrugationEstimator, passes: PassTable, events: Sequence[MaintenanceEvent]
-                        ) -> dict[str, int]:
-    """Advance est over passes (valid, class defaults filled, in stream order) with each event
-    applied before the first pass stamped later than it (those after every pass at the end);
-    returns the events refused, by reason (a refused event changes nothing)."""
-    refused: dict[str, int] = {}
-    for event in in_time_order(events):
-        n = split_before(passes.stamp_ns, event.stamp_ns)
-        est.advance(passes.take(slice(0, n)))
-        passes = passes.take(slice(n, None))
-        try:
-            apply_event(est, event)
-        except ValueError as exc:
-            refused[str(exc)] = refused.get(str(exc), 0) + 1
-    est.advance(passes)
-    return refused
 
 
 def match_bands(bands: np.ndarray, wavelength: np.ndarray, amplitude: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -26,7 +26,7 @@ Two additions to the UQ paper's kernel, both cited where they are defined:
   is not missed.
 
 Grinding limits (Grassie, Saxon & Smith, J. Sound Vib. 227 (1999) 949-964) are here too; the
-speed plan (a linear programme) is :mod:`rail_monitor.models.speed_plan`.
+speed plan (a linear programme) is :mod:`rail_monitor.advice.speed_plan`.
 
 References
 ----------

@@ -40,21 +40,22 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from rail_monitor.models import passby_axles
+from rail_monitor.models.axle_layout import AxleLayout
 from rail_monitor.models.ground import spherical_reflection
 from rail_monitor.models.iec61260 import exact_centre
 from rail_monitor.models.levels import a_weighted, level, power
-
-if TYPE_CHECKING:
-    from rail_monitor.models.passby_axles import AxleLayout
-
-FloatArray = NDArray[np.float64]
-
-F_TIME_CONSTANT_S = 0.125   # IEC 61672-1:2013, 5.8: time weighting F
+from rail_monitor.models.passby_kernel import (
+    FloatArray,
+    Paths,
+    kernel_total,
+    kernel_window_mean,
+    line_f_weighted_peak,
+)
 
 # The pass-by metrics as this module computes them (for every report that shows them).
 METRIC_DEFINITIONS = {
@@ -66,7 +67,6 @@ METRIC_DEFINITIONS = {
                "(ISO 3095:2013, 3.8) [dB(A) re 20 uPa]",
     "pass_by_time_s": "Tp = train length / speed [s]",
 }
-_OMNI, _BROADSIDE = 0.01, 0.99
 
 
 @dataclass(frozen=True)
@@ -98,65 +98,6 @@ class Receiver:
         dz_image = self.height_m + self.source_height_m + 2.0 * self.ground_depth_m
         return ((float(np.hypot(d, dz_direct)), float(np.arctan2(dz_direct, d))),
                 (float(np.hypot(d, dz_image)), float(np.arctan2(-dz_image, d))))
-
-
-def _atan_over(x: FloatArray, c: float) -> FloatArray:
-    """Antiderivative of 1 / (c^2 + x^2): atan(x / c) / c."""
-    return np.arctan(x / c) / c
-
-
-def _atan_over_integral(x: FloatArray, c: float) -> FloatArray:
-    """Antiderivative of atan(x / c) / c: (x atan(x / c) - (c / 2) ln(c^2 + x^2)) / c."""
-    return (x * np.arctan(x / c) - 0.5 * c * np.log(c * c + x * x)) / c
-
-
-def _close(d: float, r: float) -> bool:
-    return r * r - d * d < 1e-6 * d * d
-
-
-def point_kernel(x: ArrayLike, d: float, r: float) -> FloatArray:
-    """g(x) [1/m^2]: the squared pressure re rho c of a unit point source at x along the track."""
-    x2 = np.asarray(x, float) ** 2
-    q = d * d + x2
-    return (_OMNI * q + _BROADSIDE * d * d) / (q * (r * r + x2) * (4.0 * np.pi))
-
-
-def kernel_antiderivative(x: ArrayLike, d: float, r: float) -> FloatArray:
-    """G(x) = integral of g from 0 to x [1/m] for horizontal distance d and path distance R [m]."""
-    x = np.asarray(x, float)
-    return _antiderivative_with(x, d, r, _atan_over(x, d))
-
-
-def _antiderivative_with(x: FloatArray, d: float, r: float, at_d: FloatArray) -> FloatArray:
-    """G(x) given at_d = _atan_over(x, d), which the direct and image paths share at the same x
-    (the arctangents are most of a pass-by's cost; each is computed once)."""
-    at_r = _atan_over(x, r)
-    # R = d: d^2 / (d^2 + x^2)^2 integrates to x / (2 (d^2 + x^2)) + atan(x/d) / (2 d)
-    broad = (0.5 * x / (d * d + x * x) + 0.5 * at_d if _close(d, r)
-             else d * d * (at_d - at_r) / (r * r - d * d))
-    return (_OMNI * at_r + _BROADSIDE * broad) / (4.0 * np.pi)
-
-
-def kernel_second_antiderivative(x: ArrayLike, d: float, r: float) -> FloatArray:
-    """GG(x), an antiderivative of G(x) [-] (even in x)."""
-    x = np.asarray(x, float)
-    if _close(d, r):
-        broad = 0.25 * np.log(d * d + x * x) + 0.5 * _atan_over_integral(x, d)
-    else:
-        broad = d * d * (_atan_over_integral(x, d) - _atan_over_integral(x, r)) / (r * r - d * d)
-    return (_OMNI * _atan_over_integral(x, r) + _BROADSIDE * broad) / (4.0 * np.pi)
-
-
-def kernel_total(d: float, r: float) -> float:
-    """Integral of g over all x [1/m]: [0.01 / R + 0.99 d / (R (d + R))] / 4."""
-    return (_OMNI / r + _BROADSIDE * d / (r * (d + r))) / 4.0
-
-
-def kernel_window_mean(length_m: ArrayLike, d: float, r: float) -> FloatArray:
-    """Mean over the pass-by time of the kernel of a line of length L [m] [1/m]."""
-    length = np.asarray(length_m, float)
-    gg = kernel_second_antiderivative
-    return (gg(length, d, r) - 2.0 * gg(0.0, d, r) + gg(-length, d, r)) / length
 
 
 @dataclass(frozen=True)
@@ -194,8 +135,6 @@ def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, re
     """The PassGeometry of passes of these lengths [m] and speeds [m/s] (IEC 61260-1 band numbers):
     a moving point source per axle of the layout (its kernels by engine, models.passby_axles), or
     without one the uniform line source."""
-    from rail_monitor.models import passby_axles
-
     length = np.atleast_1d(np.asarray(length_m, float))
     d = receiver.distance_m
     (r1, _), (r2, _) = receiver.paths()
@@ -259,8 +198,6 @@ def _per_line(terms: Iterator[FloatArray]) -> FloatArray:
     return out if len(terms) == 2 else out + (terms[2] + terms[3])
 
 
-# The paths of a pass-by: (A-weighted power per metre per pass [any unit], perpendicular distance [m]).
-Paths = list[tuple[FloatArray, float]]
 # A path per band: (power per metre per pass and band [W/m-like], its kernel window mean [1/m], its
 # kernel total [1/m], its perpendicular distance [m]).
 BandPaths = list[tuple[FloatArray, FloatArray, float, float]]
@@ -295,63 +232,5 @@ def f_weighted_peaks(g: PassGeometry, paths_of: list[Paths], engine: str = "nump
     same trains (line or axles; several spectra share the axles' time histories, over windows set
     by the source line's paths, g's, whatever other lines the sets hold)."""
     if g.axles is None:
-        return np.stack([_f_weighted_peak(paths, g.length, g.speed, g.d) for paths in paths_of])
-    from rail_monitor.models import passby_axles
-
+        return np.stack([line_f_weighted_peak(paths, g.length, g.speed, g.d) for paths in paths_of])
     return passby_axles.f_weighted_peaks(paths_of, g.axles, g.length, g.speed, g.d, engine, max(g.r1, g.r2))
-
-
-def _f_weighted_peak(paths: Paths, length: FloatArray, speed: FloatArray, d: float,
-                     steps_per_tau: int = 8) -> FloatArray:
-    """Peak of the F-time-weighted squared pressure sum_i c_i x_i(t), x_i(t) = G_i(vt) - G_i(vt - L),
-    over the paths (c_i, R_i).
-
-    Exponential averaging (IEC 61672-1 eq. 7, tau = 0.125 s) from 6 tau before to 3 tau after the
-    unweighted peak (the train's middle at the perpendicular), started in steady state: the
-    truncated history weighs e^-6 of a level no higher than the peak's.
-    """
-    tau = F_TIME_CONSTANT_S
-    t = (np.arange(-6 * steps_per_tau, 3 * steps_per_tau + 1) / steps_per_tau) * tau
-    s = 0.5 * length[:, None] + speed[:, None] * t[None, :]     # front position along the track [m]
-    g = _antiderivative_with
-    rear = s - length[:, None]
-    front_d, rear_d = _atan_over(s, d), _atan_over(rear, d)  # shared by every path
-    x = None
-    for c, r in paths:
-        term = c[:, None] * (g(s, d, r, front_d) - g(rear, d, r, rear_d))
-        x = term if x is None else x + term
-    return exponential_average(x, np.exp(-1.0 / steps_per_tau)).max(axis=1)
-
-
-def exponential_average(x: FloatArray, a: float | FloatArray) -> FloatArray:
-    """y_n = (1 - a) x_n + a y_(n-1) along the last axis, started in steady state (y_(-1) = x_0):
-    the sampled exponential time weighting of IEC 61672-1 eq. 7 with a = exp(-dt / tau), one a
-    for all series or one per series (x's leading shape).
-
-    The arithmetic of scipy.signal.lfilter([1 - a], [1, -a], x, zi=a x_0), step for step (the tests
-    compare the bits), without importing scipy.signal (44 MB and 0.4 s at a node's start-up).
-    """
-    rows = np.asarray(x, float).reshape(-1, np.shape(x)[-1])
-    a_rows = np.broadcast_to(np.asarray(a, float), np.shape(x)[:-1]).reshape(-1)
-    b0 = 1.0 - a_rows
-    if len(rows) <= FEW_ROWS:  # a live pass: plain floats, the same IEEE operations
-        out = []
-        for row, ar, br in zip(rows.tolist(), a_rows.tolist(), b0.tolist(), strict=True):
-            state, ys = ar * row[0], []
-            for v in row:
-                y = br * v + state
-                ys.append(y)
-                state = ar * y
-            out.append(ys)
-        return np.array(out, float).reshape(np.shape(x))
-    xt = np.ascontiguousarray(rows.T)  # time-major: each step is one contiguous row
-    yt = np.empty_like(xt)
-    state = a_rows * xt[0]
-    for n in range(len(xt)):
-        np.multiply(b0, xt[n], out=yt[n])
-        yt[n] += state
-        state = a_rows * yt[n]
-    return yt.T.reshape(np.shape(x))
-
-
-FEW_ROWS = 8  # below this many series a Python loop beats numpy's per-call overhead

@@ -36,16 +36,16 @@ References
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rail_monitor.models.axle_layout import AxleLayout
 from rail_monitor.models.engine import check_engine
-from rail_monitor.models.passby import (
-    _BROADSIDE,
-    _OMNI,
+from rail_monitor.models.passby_kernel import (
+    BROADSIDE,
     F_TIME_CONSTANT_S,
+    OMNI,
     Paths,
     exponential_average,
     kernel_antiderivative,
@@ -56,58 +56,12 @@ FloatArray = NDArray[np.float64]
 NEAR_PATH_DISTANCES = 8.0   # vehicles this many path distances from the receiver are summed axle by axle
 STEPS_PER_TAU = 8           # time steps per F time constant, at least
 SAMPLES_PER_DISTANCE = 16   # time steps per horizontal distance travelled, at least
-MAX_AXLES_PER_VEHICLE = 16  # a vehicle given more axles is laid out with this many (the same power)
 PASS_CHUNK = 4096           # passes per block of the exact window kernel
 # Points (times x path distances, over a block's passes) per block of the numpy time history, and
 # per step of its axle columns: each temporary (<= 128 kB) stays in a core's L2 cache (16,000 and
 # 64,000 were 1.2x slower on the sample's batches of 200 passes, 200,000 4x). The blocks change no
 # bit: the terms are elementwise and a pass's axles are summed one at a time in a fixed order.
 HISTORY_ELEMENTS = 32_000
-
-
-@dataclass(frozen=True)
-class AxleLayout:
-    """The axles of each pass's train: identical vehicles of pitch P, each with the same axle
-    offsets from its front (NaN past the pass's k axles)."""
-
-    vehicles: NDArray[np.int64]   # (passes,) [-]
-    pitch_m: FloatArray           # (passes,) P = train length / vehicles [m]
-    offsets_m: FloatArray         # (passes, k_max) from the vehicle's front [m]
-
-    @property
-    def axles_per_vehicle(self) -> FloatArray:
-        return np.sum(np.isfinite(self.offsets_m), axis=1).astype(float)
-
-    @property
-    def length_per_axle_m(self) -> FloatArray:
-        """P / k: the length of train whose power each axle radiates [m] (passes,)."""
-        return self.pitch_m / self.axles_per_vehicle
-
-
-def axle_layout(length_m: ArrayLike, vehicle_count: ArrayLike, axle_count: ArrayLike, bogie_centre_ratio: ArrayLike,
-                semi_wheelbase_m: ArrayLike) -> AxleLayout:
-    """The AxleLayout of trains [m, -, -, -, m per pass]: k = axles / vehicles (rounded, at least
-    1); bogie centres bogie_centre_ratio x P apart; axles of a bogie semi_wheelbase_m either side
-    of its centre (k / 2 = 3: one at the centre too)."""
-    length = np.atleast_1d(np.asarray(length_m, float))
-    vehicles = np.maximum(np.atleast_1d(np.asarray(vehicle_count, np.int64)), 1)
-    k = np.clip(np.rint(np.atleast_1d(np.asarray(axle_count, float)) / vehicles).astype(np.int64), 1,
-                MAX_AXLES_PER_VEHICLE)
-    pitch = length / vehicles
-    ratio = np.broadcast_to(np.asarray(bogie_centre_ratio, float), length.shape)
-    semi = np.broadcast_to(np.asarray(semi_wheelbase_m, float), length.shape)
-    offsets = np.full((len(length), int(k.max(initial=1))), np.nan)
-    for kk in np.unique(k):
-        rows = k == kk
-        p, half = pitch[rows, None], kk // 2
-        if kk % 2:                                            # odd: evenly along the vehicle
-            offsets[rows, :kk] = p * (np.arange(kk) + 0.5) / kk
-            continue
-        spread = np.linspace(-1.0, 1.0, half) if half > 1 else np.zeros(1)
-        bogie = 0.5 * p + 0.5 * ratio[rows, None] * p * np.array([-1.0, 1.0])   # bogie centres (rows, 2)
-        axles = bogie[:, :, None] + semi[rows, None, None] * spread[None, None, :]
-        offsets[rows, :kk] = np.clip(axles.reshape(-1, kk), 0.0, p)
-    return AxleLayout(vehicles, pitch, offsets)
 
 
 def _axle_offsets(layout: AxleLayout, first: NDArray[np.int64], count: NDArray[np.int64], width: int):
@@ -289,7 +243,7 @@ def near_axle_terms(x2: FloatArray, d: float, r2: Sequence[float], broad: float)
     gives the same bits alone as with others. models.passby_axles_jit does these operations in
     this order."""
     d0 = x2 + d * d
-    num = _OMNI * d0
+    num = OMNI * d0
     num += broad
     out = []
     for a in range(0, len(r2), 2):   # in place where a temporary is not needed again: the same operations
@@ -320,7 +274,7 @@ def _histories(radii: list[float], layout: AxleLayout, length: FloatArray, speed
     ends = np.cumsum(samples)
     n = np.arange(int(ends[-1])) - (ends - samples)[rep]
     front = 0.5 * length[rep] + speed[rep] * ((n - before[rep]) * dt[rep])     # [m]
-    broad, r2 = _BROADSIDE * d * d, [r * r for r in radii]
+    broad, r2 = BROADSIDE * d * d, [r * r for r in radii]
     k = layout.axles_per_vehicle.astype(np.int64)
     near = (hi - lo + 1) * k
     total = np.zeros((len(radii), len(front)))

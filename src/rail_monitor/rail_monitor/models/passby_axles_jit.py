@@ -23,8 +23,8 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from rail_monitor.models.passby import _BROADSIDE, _OMNI, _close
-from rail_monitor.models.passby_axles import AxleLayout
+from rail_monitor.models.axle_layout import AxleLayout
+from rail_monitor.models.passby_kernel import BROADSIDE, OMNI, same_path
 
 FloatArray = NDArray[np.float64]
 _FOUR_PI = 4.0 * np.pi
@@ -32,10 +32,10 @@ _FOUR_PI = 4.0 * np.pi
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _antiderivative(x: float, d: float, r: float, close: bool, at_d: float) -> float:
-    """models.passby._antiderivative_with at one x (at_d = atan(x / d) / d, shared by the radii)."""
+    """models.passby_kernel._antiderivative_with at one x (at_d = atan(x / d) / d, shared by the radii)."""
     at_r = np.arctan(x / r) / r
     broad = 0.5 * x / (d * d + x * x) + 0.5 * at_d if close else d * d * (at_d - at_r) / (r * r - d * d)
-    return (_OMNI * at_r + _BROADSIDE * broad) / _FOUR_PI
+    return (OMNI * at_r + BROADSIDE * broad) / _FOUR_PI
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -43,7 +43,7 @@ def _peaks(length, speed, dt, decay, before, samples, lo, hi, vehicles, pitch, o
            use, count, c, out):  # pragma: no cover  (compiled; its twin is the numpy engine)
     n_r, n_m = len(radii), out.shape[0]
     r2 = radii * radii
-    broad = _BROADSIDE * d * d
+    broad = BROADSIDE * d * d
     longest = samples.max() if len(samples) else 0
     front = np.empty(longest)
     x = np.empty((n_r, longest))
@@ -67,14 +67,14 @@ def _peaks(length, speed, dt, decay, before, samples, lo, hi, vehicles, pitch, o
                             xa = front[n] - s
                             x2 = xa * xa
                             d0 = x2 + d * d
-                            x[a, n] += (broad + _OMNI * d0) / (d0 * (x2 + ra))
+                            x[a, n] += (broad + OMNI * d0) / (d0 * (x2 + ra))
                         continue
                     rb = r2[a + 1]
                     for n in range(n_t):
                         xa = front[n] - s
                         x2 = xa * xa
                         d0, da, db = x2 + d * d, x2 + ra, x2 + rb
-                        q = (broad + _OMNI * d0) / (d0 * da * db)
+                        q = (broad + OMNI * d0) / (d0 * da * db)
                         x[a, n] += q * db
                         x[a + 1, n] += q * da
         for k in range(n_r):
@@ -132,7 +132,7 @@ def window_sums(layout: AxleLayout, length: FloatArray, d: float, radii: list[fl
     path distance (radii x passes)."""
     out = np.empty((len(radii), len(length)))
     _window_sums(length, layout.vehicles, layout.pitch_m, np.ascontiguousarray(layout.offsets_m), float(d),
-                 np.asarray(radii, float), np.array([_close(d, rk) for rk in radii]), out)
+                 np.asarray(radii, float), np.array([same_path(d, rk) for rk in radii]), out)
     return out
 
 
@@ -151,7 +151,7 @@ def f_weighted_peaks(length: FloatArray, speed: FloatArray, dt: FloatArray, deca
             c_a[m, p] = ci
     out = np.empty((len(use), n))
     r = np.asarray(radii, float)
-    close = np.array([_close(d, rk) for rk in radii])
+    close = np.array([same_path(d, rk) for rk in radii])
     _peaks(length, speed, dt, decay, before, samples, lo, hi, layout.vehicles, layout.pitch_m,
            np.ascontiguousarray(layout.offsets_m), weight, float(d), r, close, use_a,
            np.array([len(u) for u in use], np.int64), c_a, out)

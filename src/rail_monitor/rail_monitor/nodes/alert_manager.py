@@ -26,15 +26,20 @@ from rclpy.parameter import Parameter
 
 from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, SEVERITY_CRITICAL, alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager, describe
-from rail_monitor.bagio.cdr_columns import read_columns
-from rail_monitor.bagio.messages import (
+from rail_monitor.codec.cdr_columns import read_columns
+from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.passes import PassTable
+from rail_monitor.corrugation.config import LEAD_TIME
+from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
+from rail_monitor.measured.residuals import Predicted, Residual, ResidualTracker
+from rail_monitor.messages.fields import (
     measurement_from_msg,
     noise_residual_fields,
     time_columns_ns,
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
-from rail_monitor.bagio.output_columns import (
+from rail_monitor.messages.output_columns import (
     band_runs,
     corrugation_series,
     noise_refusals,
@@ -42,12 +47,7 @@ from rail_monitor.bagio.output_columns import (
     squeal_refusals,
     state_refusals,
 )
-from rail_monitor.bagio.topics import GRAPH_TOPICS
-from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.passes import PassTable
-from rail_monitor.corrugation.config import LEAD_TIME
-from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
-from rail_monitor.measured.residuals import Predicted, Residual, ResidualTracker
+from rail_monitor.messages.topics import GRAPH_TOPICS
 from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node

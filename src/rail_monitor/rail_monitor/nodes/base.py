@@ -230,7 +230,7 @@ class Sent(Counter):
     """Messages published per topic (resolved name): wayside_monitor drains the recorder against it."""
 
     def publish(self, pub: Any, fields: Mapping[str, Any]) -> None:
-        """Publish the message of these plain fields (bagio.messages) as its CDR bytes."""
+        """Publish the message of these plain fields (messages.fields) as its CDR bytes."""
         self.send(pub, to_cdr(pub.msg_type, fields))
 
     def send(self, pub: Any, data: bytes) -> None:

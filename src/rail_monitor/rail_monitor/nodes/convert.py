@@ -1,5 +1,5 @@
 """rclpy messages, and the CDR bytes the nodes publish, of the plain fields of
-:mod:`rail_monitor.bagio.messages` (the one place each message's fields are written), and the
+:mod:`rail_monitor.messages.fields` (the one place each message's fields are written), and the
 graph's topic table with rclpy types and profiles."""
 
 from __future__ import annotations
@@ -11,11 +11,11 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 
-from rail_monitor.bagio import messages
-from rail_monitor.bagio.cdr import serialize
-from rail_monitor.bagio.cdr_from_columns import serialize_columns
-from rail_monitor.bagio.topics import GRAPH_TOPICS
+from rail_monitor.codec.cdr import serialize
+from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.messages import fields as messages
+from rail_monitor.messages.topics import GRAPH_TOPICS
 from rail_monitor.nodes.qos import profile
 
 _SCALARS = {"boolean": bool, "float": float, "double": float, "string": str}
@@ -72,13 +72,13 @@ def typename_of(cls: type) -> str:
 
 
 def to_cdr(cls: type, fields: Mapping[str, Any]) -> bytes:
-    """The CDR bytes of to_msg(cls, fields), packed by bagio.cdr's compiled encoder: what the nodes
+    """The CDR bytes of to_msg(cls, fields), packed by codec.cdr's compiled encoder: what the nodes
     publish (rclpy sends bytes as they are), so no rclpy message is built and converted per output."""
     return serialize(typename_of(cls), fields)
 
 
 def to_cdr_many(cls: type, columns: Any, n: int) -> list[bytes]:
-    """The CDR bytes of n messages given as columns (bagio.cdr_from_columns), as to_cdr gives each."""
+    """The CDR bytes of n messages given as columns (codec.cdr_from_columns), as to_cdr gives each."""
     return serialize_columns(typename_of(cls), columns, n)
 
 

@@ -25,9 +25,21 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from rail_monitor.advice import plan
+from rail_monitor.advice import growth, plan
 from rail_monitor.advice.consequences import Consequences
-from rail_monitor.bagio.messages import (
+from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
+from rail_monitor.core.params import values_of
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.timeutil import format_iso_ns
+from rail_monitor.corrugation import surveys
+from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_config
+from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.engine import checkpoint
+from rail_monitor.engine.corrugation_site import CorrugationSite
+from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
+from rail_monitor.measured.observer import IndirectObserver, Observation
+from rail_monitor.messages.fields import (
     PassHead,
     corrugation_state_cdr,
     corrugation_state_fields,
@@ -36,16 +48,7 @@ from rail_monitor.bagio.messages import (
     measurement_from_msg,
     speed_advisory_fields,
 )
-from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
-from rail_monitor.core.params import values_of
-from rail_monitor.core.passes import PassTable
-from rail_monitor.core.timeutil import format_iso_ns
-from rail_monitor.corrugation import advice, checkpoint, surveys
-from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_config
-from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.corrugation.surveys import MaintenanceEvent
-from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
-from rail_monitor.measured.observer import IndirectObserver, next_cut
+from rail_monitor.models.calibration import KbPosterior
 from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
@@ -61,6 +64,8 @@ from rail_msgs.msg import (
     SpeedAdvisory,
 )
 from rail_msgs.srv import EvaluateSpeedDistribution
+
+CLOSE_TIMEOUT_S = 30.0  # the last checkpoint's write at shutdown (a year kept: about 0.1 s)
 
 
 class CorrugationEstimatorNode(PassConsumerNode):
@@ -80,12 +85,17 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self._consequences: Consequences | None = None
         self._noise_model: RollingNoiseModel | None = None
         residual_cfg = residual_config(declare(self, RESIDUAL_SPECS, prefix="residual."), prefix="")
-        self.observer = IndirectObserver(self.noise_model(), residual_cfg, self.est.bands) \
+        observer = IndirectObserver(self.noise_model(), residual_cfg, self.est.bands) \
             if residual_cfg.indirect_days > 0 else None
+        # Events are checked on arrival (stamp_ahead, with the live clock): none at the moment they fall due.
+        self.corrugation = CorrugationSite(self.est, observer)
+        self.corrugation.on_event = self._on_event
+        self.corrugation.on_observation = self._on_observation
+        self.observer = observer
         self.checkpoint = self.params.checkpoint_path
         self.counts: Counter[str] = Counter()
         self.sent = Sent()
-        self.surveys_rejected: Counter[str] = Counter()
+        self.surveys_rejected = self.corrugation.refused  # on arrival or when applied, by reason
         self.checkpoint_skipped: list[str] = []
         if self.checkpoint:
             # An unreadable checkpoint falls back to the previous one; none readable is a ConfigError
@@ -96,11 +106,12 @@ class CorrugationEstimatorNode(PassConsumerNode):
             if used is not None:
                 self.get_logger().info(f"resumed from {used}: {self.est.total_pass_count} passes")
         self.stream_ns = self.est.newest_ns  # the stamp margin counts from the resumed history
+        self.writer = checkpoint.CheckpointWriter(self.checkpoint, on_error=self._checkpoint_failed) \
+            if self.checkpoint else None
         self._since_checkpoint = 0
         self._last_state_t = float("-inf")
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
-        self.pending: list[MaintenanceEvent] = []  # surveys and grinding waiting for a later pass, by stamp
         self.survey_sub = self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
         self.measured_sub = self.indirect_pub = None
         if self.observer is not None:
@@ -128,31 +139,16 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.observer.add_measurements([measurement_from_msg(m) for m in msgs])
 
     def on_passes(self, table: PassTable, heads: list[PassHead]) -> None:
-        start = 0
-        while (cut := next_cut(table.stamp_ns[start:], self.pending, self.observer)) is not None:
-            n, window = cut
-            self._count(table.take(slice(start, start + n)))
-            if window:
-                self._observe()
-            else:
-                self._apply(self.pending.pop(0))
-            start += n
-        self._count(table.take(slice(start, None)) if start else table)
+        for part in self.corrugation.segments(table):
+            self._count(part)
 
-    def _observe(self) -> None:
-        """Close the indirect roughness window: publish its fit, and take it as an observation."""
-        obs = self.observer.observe(self.est)
-        if obs is None:
-            return
+    def _on_observation(self, obs: Observation) -> None:
+        """A closed indirect roughness window: its fit published (then taken as a survey)."""
         self.sent.publish(self.indirect_pub, indirect_roughness_fields(obs, self.site.site_id))
-        if obs.event is not None:
-            self._apply(obs.event)
 
     def _count(self, table: PassTable) -> None:
         # The state and forecast after each counted pass, as advancing one pass at a time gives them.
-        traj = self.est.advance_history(table)
-        if self.observer is not None:
-            self.observer.add_counted(table, traj)
+        traj = self.corrugation.advance(table)
         if len(traj) < len(table):
             self.counts["not counted (already counted, or older than the history)"] += len(table) - len(traj)
         if not len(traj):
@@ -197,46 +193,36 @@ class CorrugationEstimatorNode(PassConsumerNode):
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         event = event_from_msg(msg)
         why = self.stamp_ahead(event.stamp_ns)  # one far-future survey would refuse every later one
-        if not why and event.stamp_ns <= max([self.est.last_survey_ns, *(e.stamp_ns for e in self.pending)]):
+        pending = self.corrugation.pending
+        if not why and event.stamp_ns <= max([self.est.last_survey_ns, *(e.stamp_ns for e in pending)]):
             why = "not newer than the last survey or grinding applied"
         if why:
-            self._refuse(why)
+            self.corrugation.refused[why] += 1
+            self._log_refusal(why)
         elif event.stamp_ns >= self.est.newest_ns:
-            self.pending.append(event)  # stamps rise (checked above)
+            pending.append(event)  # stamps rise (checked above)
         else:
             self.counts["applied late (passes after its stamp already counted)"] += 1
-            if self._apply(event):
+            if self.corrugation.apply(event):
                 self.publish_state()
 
-    def _apply(self, event: MaintenanceEvent) -> bool:
-        """Apply a survey or grinding to the state (refusals counted); whether it was applied."""
-        try:
-            fit = surveys.apply_event(self.est, event)
-        except ValueError as exc:
-            self._refuse(str(exc))
-            return False
-        if self.observer is not None:
-            self.observer.note(event)
-        if event.kind == surveys.KIND_GRINDING:
-            self.counts["grindings"] += 1
-        elif event.kind == surveys.KIND_INDIRECT:
-            self.counts["indirect observations"] += 1
-        else:
-            self.counts["surveys"] += 1
-            if fit is not None:
-                self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
-                                       f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
+    def _on_event(self, event: MaintenanceEvent, fit: KbPosterior | None, why: str) -> None:
+        """A survey, grinding or indirect observation applied (checkpointed) or refused (logged)."""
+        if why:
+            self._log_refusal(why)
+            return
+        if fit is not None and event.kind == surveys.KIND_SURVEY:
+            self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
+                                   f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
         self.save()
-        return True
 
-    def _refuse(self, why: str) -> None:
-        self.surveys_rejected[why] += 1
+    def _log_refusal(self, why: str) -> None:
         self.get_logger().warning(f"roughness survey rejected: {why}")
 
     def _on_evaluate(self, req: EvaluateSpeedDistribution.Request,
                      res: EvaluateSpeedDistribution.Response) -> EvaluateSpeedDistribution.Response:
         try:
-            ev = advice.evaluate(self.est, req.speed_mps, req.probability, req.friction_state, req.passes_per_day)
+            ev = growth.evaluate(self.est, req.speed_mps, req.probability, req.friction_state, req.passes_per_day)
             side = plan.evaluate_consequences(self.est, self.consequences(), req.speed_mps, req.probability)
         except ValueError as exc:
             res.success, res.message = False, str(exc)
@@ -251,33 +237,36 @@ class CorrugationEstimatorNode(PassConsumerNode):
         return res
 
     def save(self) -> None:
-        if not self.checkpoint:
+        """Encode the state here; the writer's thread writes it (the passes behind do not wait)."""
+        if self.writer is None:
             return
-        try:
-            checkpoint.save(self.est, self.checkpoint, self.observer)
-            self.counts["checkpoints"] += 1
-        except OSError as exc:
-            self.counts["checkpoint failures"] += 1
-            self.get_logger().error(f"checkpoint to {self.checkpoint} failed: {exc}", throttle_duration_sec=60.0)
+        self.writer.submit(checkpoint.encode(self.est, self.observer))
         self._since_checkpoint = 0
+
+    def _checkpoint_failed(self, exc: OSError) -> None:  # on the writer's thread
+        self.get_logger().error(f"checkpoint to {self.checkpoint} failed: {exc}", throttle_duration_sec=60.0)
 
     def close(self) -> None:
         """The surveys and grinding later than every pass applied, and a final checkpoint (run_node
         calls it at shutdown)."""
-        while self.pending:
-            self._apply(self.pending.pop(0))
+        self.corrugation.finish()
         if self._since_checkpoint:
             self.save()
+        if self.writer is not None and not self.writer.close(CLOSE_TIMEOUT_S):
+            self.get_logger().error(f"checkpoint to {self.checkpoint} not written within {CLOSE_TIMEOUT_S:g} s")
 
     def diagnostic_values(self) -> dict[str, Any]:
         fc = self.est.forecast()
-        values = {**super().diagnostic_values(), **self.counts,
+        values = {**super().diagnostic_values(), **self.counts, **self.corrugation.applied,
                   "amplitude_worst_um": f"{1e6 * self.est.amplitude[fc.worst_band]:.3g}",
                   "days_to_threshold": f"{fc.days_to_threshold:.4g}",
                   "grinding_due": fc.grinding_due,
                   "state_age_s": f"{(time.time_ns() - self.est.newest_ns) / 1e9:.0f}" if self.est.newest_ns else "",
                   "last_grinding": format_iso_ns(self.est.last_grinding_ns) if self.est.last_grinding_ns else ""}
-        values["surveys pending"] = len(self.pending)
+        values["surveys pending"] = len(self.corrugation.pending)
+        if self.writer is not None:
+            values.update({"checkpoints": self.writer.written, "checkpoint failures": self.writer.failed,
+                           "checkpoints coalesced": self.writer.coalesced})
         if self.observer is not None:
             values.update({f"indirect {k}": v for k, v in sorted(self.observer.counts.items())})
         values.update({f"survey rejected: {why}": n for why, n in sorted(self.surveys_rejected.items())})

@@ -19,9 +19,9 @@ from collections import Counter
 import foxglove
 from rclpy.qos import QoSProfile
 
-from rail_monitor.bagio.topics import GRAPH_TOPICS
-from rail_monitor.bagio.typestore import schema_text
+from rail_monitor.codec.typestore import schema_text
 from rail_monitor.core.node_params import FOXGLOVE_SPECS, FoxgloveParams
+from rail_monitor.messages.topics import GRAPH_TOPICS
 from rail_monitor.nodes.base import Diagnostics, RateMeter, announce, wall_timer
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TapNode, TopicTap

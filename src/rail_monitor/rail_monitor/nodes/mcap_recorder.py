@@ -25,7 +25,7 @@ from rclpy.qos import QoSProfile
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data, describe, site_record
-from rail_monitor.bagio.typestore import header_stamp_ns, starts_with_header
+from rail_monitor.codec.typestore import header_stamp_ns, starts_with_header
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import RECORDER_SPECS, RecorderParams
 from rail_monitor.core.timeutil import NS_PER_S

@@ -21,13 +21,13 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.parameter import Parameter
 
-from rail_monitor.bagio.cdr_columns import read_columns
-from rail_monitor.bagio.messages import PassHead, passes_from_columns
-from rail_monitor.bagio.typestore import TRAIN_PASS
+from rail_monitor.codec.cdr_columns import read_columns
+from rail_monitor.codec.typestore import TRAIN_PASS
 from rail_monitor.core.node_params import BATCH_SPECS, STAMP_SPECS, StampParams
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, reject_ahead, rejection_reasons, with_class_defaults
 from rail_monitor.core.timeutil import format_iso_ns
+from rail_monitor.messages.fields import PassHead, passes_from_columns
 from rail_monitor.nodes.base import (
     SITE_PARAMETERS,
     Diagnostics,

@@ -9,15 +9,16 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable
 
-from rail_monitor.app.simulator import SIMULATOR_SPECS, simulate, simulator_config
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import MODE_SPECS, ModeParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
+from rail_monitor.core.simulator_params import SIMULATOR_SPECS, simulator_config
 from rail_monitor.nodes.base import SITE_PARAMETERS, declare, declare_site
 from rail_monitor.nodes.pass_source import PassSourceNode
 from rail_monitor.nodes.process import run_node
+from rail_monitor.simulation.simulator import simulate
 
 
 class PassSimulator(PassSourceNode):

@@ -16,7 +16,6 @@ from rclpy.duration import Duration
 from rosgraph_msgs.msg import Clock
 from tqdm import tqdm
 
-from rail_monitor.bagio.messages import measured_pass_noise_fields, roughness_survey_fields, train_pass_fields
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import PUBLISH_SPECS, STAMP_SPECS, PublishParams, StampParams
 from rail_monitor.core.params import ParamGroups, values_of
@@ -24,6 +23,7 @@ from rail_monitor.core.passes import PassTable, publishable
 from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
+from rail_monitor.messages.fields import measured_pass_noise_fields, roughness_survey_fields, train_pass_fields
 from rail_monitor.nodes.base import DIAGNOSTICS_PERIOD_S, Diagnostics, RailNode, RateMeter, announce, declare
 from rail_monitor.nodes.convert import time_msg, to_cdr
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STREAM_QOS

@@ -1,4 +1,4 @@
-"""rclpy QoS profiles of the graph's topics (from :mod:`rail_monitor.bagio.topics`), and the
+"""rclpy QoS profiles of the graph's topics (from :mod:`rail_monitor.messages.topics`), and the
 profile a recorder subscribes with."""
 
 from __future__ import annotations
@@ -7,8 +7,8 @@ from typing import Any
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-from rail_monitor.bagio import topics
-from rail_monitor.bagio.topics import qos_dict
+from rail_monitor.messages import topics
+from rail_monitor.messages.topics import qos_dict
 
 
 def profile(q: topics.Qos) -> QoSProfile:

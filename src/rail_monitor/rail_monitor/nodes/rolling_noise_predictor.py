@@ -25,13 +25,13 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.bagio.cdr_columns import read_columns
-from rail_monitor.bagio.messages import PassHead, heads_columns, rolling_noise_cdr, time_columns_ns
-from rail_monitor.bagio.output_columns import corrugation, corrugation_refusals
-from rail_monitor.bagio.typestore import CORRUGATION_STATE
+from rail_monitor.codec.cdr_columns import read_columns
+from rail_monitor.codec.typestore import CORRUGATION_STATE
 from rail_monitor.core.node_params import PREDICTOR_SPECS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
+from rail_monitor.messages.fields import PassHead, heads_columns, rolling_noise_cdr, time_columns_ns
+from rail_monitor.messages.output_columns import corrugation, corrugation_refusals
 from rail_monitor.nodes.base import Sent, declare, isolate_failures, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node

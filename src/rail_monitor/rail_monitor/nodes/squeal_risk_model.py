@@ -11,8 +11,8 @@ from __future__ import annotations
 import sys
 from typing import Any
 
-from rail_monitor.bagio.messages import PassHead, heads_columns, squeal_prediction_columns
 from rail_monitor.core.passes import PassTable
+from rail_monitor.messages.fields import PassHead, heads_columns, squeal_prediction_columns
 from rail_monitor.nodes.base import Sent, declare
 from rail_monitor.nodes.convert import to_cdr_many
 from rail_monitor.nodes.pass_consumer import PassConsumerNode

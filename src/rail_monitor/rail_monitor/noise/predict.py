@@ -36,6 +36,7 @@ from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_rail_noise as wrn
+from rail_monitor.models.axle_layout import AxleLayout, axle_layout
 from rail_monitor.models.levels import level, power
 from rail_monitor.models.passby import (
     BandPaths,
@@ -47,7 +48,6 @@ from rail_monitor.models.passby import (
     pass_geometry,
     power_paths,
 )
-from rail_monitor.models.passby_axles import AxleLayout, axle_layout
 from rail_monitor.noise.class_terms import (
     AERODYNAMIC_COMPONENTS,
     SOURCE_B_COMPONENTS,

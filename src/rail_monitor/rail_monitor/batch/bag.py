@@ -1,0 +1,221 @@
+"""Recording batch outputs as mcap_recorder records the live graph: the same topics, types and QoS,
+log time = header stamp; chunk by chunk, so a long history is never held whole (no rclpy)."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rail_monitor.advice.plan import SpeedAdvice
+from rail_monitor.alerts.manager import Alert
+from rail_monitor.bagio.mcap_bag import McapBagWriter
+from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
+from rail_monitor.batch.run import BatchResult, BatchRun
+from rail_monitor.codec.cdr import serialize
+from rail_monitor.codec.cdr_from_columns import serialize_columns
+from rail_monitor.core.errors import PassOrderError
+from rail_monitor.core.passes import PassTable
+from rail_monitor.core.text import printable
+from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.measured.records import Measurement
+from rail_monitor.measured.residuals import Residual
+from rail_monitor.messages import fields
+from rail_monitor.messages.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
+
+
+class BatchBag:
+    """A bag folder taking BatchRun's results one chunk at a time (``add``), then the held-back
+    events and the advice (``finish``). site: the site record stored with the bag
+    (bagio.site_record), as the recorder stores it."""
+
+    def __init__(self, folder: str | Path, namespace: str, frame: str, compression: str = "zstd",
+                 site: dict[str, str] | None = None) -> None:
+        self.ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
+        self.frame = frame
+        stored = {"records": {SITE_RECORD: site}, "custom_data": custom_data(site)} if site else {}
+        self.bag = McapBagWriter(Path(folder), compression=compression, **stored)
+        for name, (typename, qos) in GRAPH_TOPICS.items():
+            self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
+        self._standing: dict[tuple[int, str], Alert] = {}
+
+    def __enter__(self) -> BatchBag:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.bag.close()
+
+    def _put(self, name: str, msg: dict[str, Any], stamp_ns: int) -> None:
+        if name in GRAPH_TOPICS:
+            typename = GRAPH_TOPICS[name][0]
+        else:  # declared with its first message, as the recorder records it once it is published
+            typename, qos = OPTIONAL_TOPICS[name]
+            self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
+        self.bag.write(f"{self.ns}/{name}", serialize(typename, msg), max(stamp_ns, 0))
+
+    def _write(self, name: str, columns: dict[str, Any], stamp_ns: np.ndarray) -> None:
+        """Messages of a graph topic given as columns, one per stamp (codec.cdr_from_columns)."""
+        self._write_cdr(name, serialize_columns(GRAPH_TOPICS[name][0], columns, len(stamp_ns)), stamp_ns)
+
+    def _write_cdr(self, name: str, datas: list[bytes], stamp_ns: np.ndarray) -> None:
+        """CDR messages of a graph topic, in order, logged at their stamps."""
+        self.bag.write_many(f"{self.ns}/{name}", datas, np.maximum(stamp_ns, 0).tolist())  # no log time before 1970
+
+    def events(self, events: list[MaintenanceEvent]) -> None:
+        """Surveys and grinding events given to the run, on the topic the replayer sends them on."""
+        for event in events:
+            self._put("roughness_survey", fields.roughness_survey_fields(event, self.frame), event.stamp_ns)
+
+    def measured(self, measurements: list[Measurement], residuals: list[Residual]) -> None:
+        """Measurements given to the run (as the replayer sends them) and the residuals computed."""
+        for m in measurements:
+            self._put("noise/measured", fields.measured_pass_noise_fields(m, self.frame), m.stamp_ns)
+        for r in residuals:
+            self._put("noise/residual", fields.noise_residual_fields(r, self.frame), r.stamp_ns)
+
+    def add(self, result: BatchResult) -> None:
+        """One chunk's passes and outputs, and its settled alert events."""
+        passes, accepted, traj = result.passes, result.accepted, result.trajectory
+        self._write("train_pass", fields.train_pass_columns(passes, self.frame), passes.stamp_ns)
+        heads = fields.table_heads_columns(accepted, self.frame)
+        self._write("noise/squeal", fields.squeal_prediction_columns(result.squeal, heads), accepted.stamp_ns)
+        self._write_cdr("corrugation/state", fields.corrugation_state_cdr(traj, self.frame), traj.stamp_ns)
+        self._write_cdr("noise/rolling", fields.rolling_noise_cdr(result.noise.values(), heads, result.receiver),
+                        np.repeat(accepted.stamp_ns, len(result.noise)))
+        self._alerts(result.alerts)
+        self.events(result.events)
+        self.measured(result.measurements, result.residuals)
+        for obs in result.observations:
+            self._put("corrugation/indirect_roughness", fields.indirect_roughness_fields(obs, self.frame), obs.stamp_ns)
+
+    def _alerts(self, events: list[Alert]) -> None:
+        for a in events:
+            self._put("alerts", fields.wayside_alert_fields(a, self.frame), a.stamp_ns)
+            if a.active:
+                self._standing[(a.kind, a.key)] = a
+            else:
+                self._standing.pop((a.kind, a.key), None)
+            self._put("alerts/standing", fields.wayside_alert_array_fields(list(self._standing.values()),
+                                                                           a.stamp_ns, self.frame), a.stamp_ns)
+
+    def finish(self, held: list[Alert], advice: SpeedAdvice | None, newest_ns: int) -> None:
+        """The events held back for a later chunk and the advice on the final state (stamped with its
+        newest pass)."""
+        self._alerts(held)
+        if advice is not None:
+            self._put("speed_advisory", fields.speed_advisory_fields(advice, newest_ns, self.frame), newest_ns)
+
+
+def write_bag(result: BatchResult, folder: str | Path, namespace: str, compression: str = "zstd",
+              site: dict[str, str] | None = None) -> Path:
+    """Record a whole history's outputs (run_models) in a new bag folder."""
+    with BatchBag(folder, namespace, result.site.site_id, compression, site) as bag:
+        bag.add(result)  # its events include those after the last pass (run_models)
+        bag.finish([], result.advice, result.estimator.newest_ns)
+    return Path(folder)
+
+
+@dataclass
+class Recorded:
+    """What a batch run recorded: passes read, rejected, alert events, the final forecast [day]
+    (inf: none), passes left out by reason, and lines for the user (what was skipped or salvaged)."""
+
+    passes: int = 0
+    rejected: int = 0
+    alert_events: int = 0
+    days_to_threshold: float = math.inf
+    left_out: dict[str, int] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    events: int = 0                                               # surveys and grinding events read
+    events_refused: dict[str, int] = field(default_factory=dict)  # of those, refused by reason
+    measurements: int = 0                                         # measured pass-bys read
+    measurements_refused: dict[str, int] = field(default_factory=dict)
+
+
+def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: str | Path, namespace: str,
+               site: dict[str, str] | None = None, events: Sequence[MaintenanceEvent] = (),
+               measurements: Sequence[Measurement] = ()) -> Recorded:
+    """BatchRun over an iterable of PassTable chunks in time order (and the history's surveys and
+    grinding events, and its measured pass-bys), each recorded as it is done (memory: one chunk's
+    outputs)."""
+    run = BatchRun(values, events=events, measurements=measurements)
+    out = Recorded()
+    with BatchBag(folder, namespace, run.site.site_id, site=site) as bag:
+        for chunk in chunks:
+            result = run.feed(chunk)
+            bag.add(result)
+            out.passes += len(chunk)
+            out.rejected += int((result.reasons != "").sum())
+            out.alert_events += len(result.alerts)
+            if len(result.trajectory):
+                out.days_to_threshold = float(result.trajectory.forecast.days_to_threshold[-1])
+        held, advice = run.finish()
+        bag.events(run.trailing_events)
+        bag.measured(run.trailing_measurements, [])
+        bag.finish(held, advice, run.estimator.newest_ns)
+    out.alert_events += len(held)
+    out.left_out = dict(run.left_out)
+    out.events, out.events_refused = len(events), dict(run.events_refused)
+    out.measurements, out.measurements_refused = len(measurements), dict(run.tracker.refused)
+    return out
+
+
+def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
+                   site: dict[str, str] | None = None, topic: str | None = None, chunk: int = 5_000,
+                   skip_bad_rows: bool = False, salvage: bool = False, measured: str | Path | None = None
+                   ) -> Recorded:
+    """The batch run of a history file recorded to a new bag folder. A bag is read and recorded chunk
+    by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
+    time order is read whole and sorted. Its measured pass-bys are measured's (a noise station's
+    CSV or a bag), else a bag history's own. A run that fails leaves no output behind."""
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_history_inputs
+
+    existed = folder.exists()
+    try:
+        events, ms = read_history_inputs(source, measured, skip_bad_rows, salvage)
+        if not (salvage or is_csv(Path(source))):
+            try:
+                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms)
+            except PassOrderError as exc:
+                note = f"{printable(str(source))}: {exc}; read whole to sort it"
+                _discard(folder, existed)
+                rec = _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, events, ms)
+                rec.notes.insert(0, note)
+                return rec
+        return _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, events, ms)
+    except BaseException:
+        _discard(folder, existed)
+        raise
+
+
+def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
+           site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool,
+           events: list[MaintenanceEvent], measured: list[Measurement]) -> Recorded:
+    from rail_monitor.bagio.reader import read_passes
+
+    passes = read_passes(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
+    notes = [printable(passes.salvage.line(source)), "surveys, grinding and the bag's measured noise are not "
+             "salvaged"] if salvage else []
+    skipped = getattr(passes, "skipped_rows", [])
+    if skipped:
+        notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "
+                     + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
+    rec = run_to_bag([passes], values, folder, namespace, site, events, measured)
+    rec.notes = notes
+    return rec
+
+
+def _discard(folder: Path, existed: bool) -> None:
+    """Remove what this run wrote: the folder it made, or the files it put in an empty one."""
+    if not folder.exists():
+        return
+    if not existed:
+        shutil.rmtree(folder)
+        return
+    for f in folder.iterdir():
+        shutil.rmtree(f) if f.is_dir() else f.unlink()

@@ -1,0 +1,138 @@
+"""Batch mode over many sites: a manifest of (site file, history) pairs, one task per site on a
+Dask cluster, outputs per site.
+
+Sites are independent (each has its own state, traffic and alerts), so a site is the unit of
+work: a task reads the site's history, runs the models (rail_monitor.batch.run), records the bag
+next to the history (or where the manifest says) with the site file stored in it, and returns a
+one-line summary. Dask was chosen over Ray: pure-Python wheels, no daemon of its own, a local
+cluster in two lines, and ``dask scheduler`` / ``dask worker`` to spread the same tasks over many
+machines. By default a local cluster of one single-threaded worker process per core runs the
+tasks; ``scheduler`` connects to a running cluster instead.
+
+The manifest (YAML; paths relative to the manifest's folder)::
+
+    sites:
+      - site: curve_250.yaml          # site parameter file
+        history: curve_250.csv        # bag folder, .mcap, .db3 or .csv
+        output: out/curve_250_batch   # optional; default <history>_batch beside the history
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+
+import yaml
+
+from rail_monitor.bagio.output_folder import beside
+from rail_monitor.core.errors import ConfigError, RailMonitorError
+
+
+# One site of a manifest: its site file, its history, and the bag folder to write.
+class SiteJob(NamedTuple):
+    site: Path
+    history: Path
+    output: Path
+
+
+@dataclass(frozen=True)
+class SiteResult:
+    """What a site's task reports (seconds: its own run; worker: where it ran)."""
+
+    site_id: str
+    output: str
+    passes: int
+    rejected: int
+    alert_events: int
+    days_to_threshold: float
+    seconds: float
+    worker: str
+
+
+def read_manifest(path: str | Path) -> list[SiteJob]:
+    """The jobs of a manifest (ConfigError with one line naming the entry at fault)."""
+    path = Path(path)
+    try:
+        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        raise ConfigError(f"{path}: cannot read the manifest: {str(exc).splitlines()[0]}") from None
+    entries = doc.get("sites") if isinstance(doc, dict) else None
+    if not isinstance(entries, list) or not entries:
+        raise ConfigError(f"{path}: expected 'sites:' with a list of entries (site:, history:, output:)")
+    jobs, outputs = [], set()
+    base = path.parent.resolve()  # absolute: a worker on another host has its own working folder
+    for i, entry in enumerate(entries):
+        where = f"{path}: sites[{i}]"
+        if not isinstance(entry, dict) or not {"site", "history"} <= set(entry) or set(entry) - {"site", "history",
+                                                                                                     "output"}:
+            raise ConfigError(f"{where}: expected the keys site and history (and optionally output)")
+        site, history = (base / str(entry[k]) for k in ("site", "history"))
+        for p in (site, history):
+            if not p.exists():
+                raise ConfigError(f"{where}: {p} not found")
+        output = base / str(entry["output"]) if entry.get("output") else beside(history, "_batch")
+        if output.resolve() in outputs:
+            raise ConfigError(f"{where}: output {output} is another site's too")
+        outputs.add(output.resolve())
+        jobs.append(SiteJob(site, history, output))
+    return jobs
+
+
+def run_site(job: SiteJob) -> SiteResult:
+    """One site's batch run, recorded to its output (a task: imports inside, runs on a worker)."""
+    from rail_monitor.bagio.site_record import site_record
+    from rail_monitor.batch.bag import record_history
+    from rail_monitor.site_file import load_parameter_file
+
+    t0 = time.monotonic()
+    values = load_parameter_file(job.site)
+    if job.output.exists():
+        raise RailMonitorError(f"{job.output} exists: remove it or give another output")
+    site_id = str(values.get("site_id", ""))
+    rec = record_history(job.history, values, job.output, site_id, site=site_record(job.site))
+    return SiteResult(site_id, str(job.output), rec.passes, rec.rejected, rec.alert_events, rec.days_to_threshold,
+                      time.monotonic() - t0, _worker_name())
+
+
+def _worker_name() -> str:
+    try:
+        from distributed import get_worker
+
+        return str(get_worker().address)
+    except (ImportError, ValueError):
+        return f"pid {os.getpid()}"
+
+
+def run_sites(jobs: list[SiteJob], workers: int = 0, scheduler: str = "") -> list[SiteResult]:
+    """Every job as a Dask task, results in the manifest's order. workers: processes of the local
+    cluster (0: one per core); scheduler: the address of a running cluster (then workers is
+    not used). A failed site is a RailMonitorError naming it, after the others have finished."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        client, cluster = Client(scheduler), None
+    else:
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.WARNING)
+        client = Client(cluster)
+    try:
+        futures = [client.submit(run_site, job, pure=False, key=f"site-{i}-{job.site.stem}")
+                   for i, job in enumerate(jobs)]
+        results, failures = [], []
+        for job, fut in zip(jobs, futures, strict=True):
+            try:
+                results.append(fut.result())
+            except RailMonitorError as exc:
+                failures.append(f"{job.site.name} ({job.history.name}): {exc}")
+        if failures:
+            raise RailMonitorError(f"{len(failures)} of {len(jobs)} sites failed: " + "; ".join(failures))
+        return results
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

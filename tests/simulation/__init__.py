@@ -1,0 +1,1 @@
+"""Tests of rail_monitor.simulation."""
