@@ -5,21 +5,35 @@ from pathlib import Path
 from setuptools import find_packages, setup
 
 package_name = "rail_monitor"
+here = Path(__file__).resolve().parent
 # The version is package.xml's (the one place it is set, as ament expects).
-version = re.search(r"<version>([^<]+)</version>", (Path(__file__).parent / "package.xml").read_text()).group(1)
+version = re.search(r"<version>([^<]+)</version>", (here / "package.xml").read_text()).group(1)
+# What the ROS-free core (predict, simulate, batch, report, export) imports, at the versions pinned in
+# ros2_ws/requirements.txt (the one place versions are set), for `pip install ./src/rail_monitor`
+# without ROS 2. colcon installs with --single-version-externally-managed, which installs none.
+CORE = ("numpy", "scipy", "numba", "matplotlib", "PyYAML", "ruamel.yaml", "rosbags", "mcap", "pandas", "pyarrow",
+        "openpyxl", "tqdm", "threadpoolctl", "dask", "distributed", "tzdata")
+pins = dict(line.split("==") for line in (here.parent.parent / "ros2_ws" / "requirements.txt").read_text().split()
+            if "==" in line and not line.startswith("#"))
+missing = [name for name in CORE if name not in pins]
+if missing:
+    raise SystemExit(f"ros2_ws/requirements.txt pins none of {missing}")
 
 setup(
     name=package_name,
     version=version,
     packages=find_packages(exclude=["test", "tests"]),
-    package_data={package_name: ["data/*.csv"]},
+    # msg/ and site_files/ are links to rail_msgs' definitions and the shipped site file (their one
+    # place), copied into the package so that a plain pip install can write bags and find a site.
+    package_data={package_name: ["data/*.csv", "msg/*.msg", "site_files/*.yaml"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{package_name}"]),
         (f"share/{package_name}", ["package.xml"]),
         (f"share/{package_name}/config", glob("config/*.yaml") + glob("config/*.xml") + glob("config/*.json")),
         (f"share/{package_name}/launch", glob("launch/*.py")),
     ],
-    install_requires=["setuptools"],
+    install_requires=["setuptools", *(f"{name}=={pins[name]}" for name in CORE)],
+    python_requires=">=3.11",
     zip_safe=True,
     maintainer="rail_monitor developers",
     maintainer_email="rail-monitor@example.com",

@@ -19,7 +19,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.passes_bag import pass_cdr, write_passes_bag
 from rail_monitor.bagio.reader import bag_info, read_bag_passes, read_passes, salvage_mcap
-from rail_monitor.codec.typestore import TRAIN_PASS, msg_file, type_hash, typestore
+from rail_monitor.codec.typestore import TRAIN_PASS, type_hash, typestore
 from rail_monitor.core.errors import InputError
 from rail_monitor.messages.topics import qos_dict
 
@@ -27,7 +27,11 @@ from conftest import SAMPLE, TOP, run_cmd
 
 
 def _rosidl_hash(typename: str) -> str:
-    doc = json.loads(msg_file(typename).with_suffix(".json").read_text())
+    """The hash rosidl generated for the type (its .json beside the .msg that colcon installed)."""
+    from ament_index_python.packages import get_package_share_directory
+
+    pkg, _, name = typename.split("/")
+    doc = json.loads((Path(get_package_share_directory(pkg)) / "msg" / f"{name}.json").read_text())
     return next(h["hash_string"] for h in doc["type_hashes"] if h["type_name"] == typename)
 
 

@@ -41,3 +41,39 @@ def test_nested_yaml_flattens_to_the_dotted_names_ros_uses():
     flat = flatten({"a": 1, "b": {"c": 2, "d": {"e": [3]}}})
     assert flat == {"a": 1, "b.c": 2, "b.d.e": [3]}
     assert section(flat, "b.") == {"c": 2, "d.e": [3]}
+
+
+def _values_classes():
+    from rail_monitor.alerts.config import ALERT_SPECS, AlertConfig
+    from rail_monitor.core import node_params as n
+    from rail_monitor.core.site import CONTACT_SPECS, WheelRailContact
+    from rail_monitor.corrugation.config import CORRUGATION_SPECS, CorrugationConfig
+    from rail_monitor.measured.config import RESIDUAL_SPECS, ResidualConfig
+    from rail_monitor.noise.config import NOISE_SPECS, NoiseConfig
+    from rail_monitor.squeal.config import SQUEAL_SPECS, SquealConfig
+
+    return [(SquealConfig, SQUEAL_SPECS, ()), (CorrugationConfig, CORRUGATION_SPECS, ()),
+            (NoiseConfig, NOISE_SPECS, ()), (ResidualConfig, RESIDUAL_SPECS, ()),
+            (AlertConfig, ALERT_SPECS, (("lead_time_days", "float"),)),
+            (WheelRailContact, CONTACT_SPECS, ()), (n.PublishParams, n.PUBLISH_SPECS, ()),
+            (n.ReplayerParams, n.REPLAYER_SPECS, ()), (n.ModeParams, n.MODE_SPECS, ()),
+            (n.RecorderParams, n.RECORDER_SPECS, ()), (n.MonitorParams, (*n.MONITOR_SPECS, n.SOURCE), ()),
+            (n.StampParams, n.STAMP_SPECS, ()), (n.FoxgloveParams, n.FOXGLOVE_SPECS, ()),
+            (n.EstimatorParams, n.ESTIMATOR_SPECS, ())]
+
+
+def test_every_values_class_has_one_typed_field_per_spec():
+    """The static config classes (fields an editor sees) hold exactly their specs, in spec order, with
+    the specs' types: a spec added without its field, or a field of another type, fails here."""
+    import dataclasses
+
+    from rail_monitor.core.params import attribute
+
+    classes = _values_classes()
+    for klass, specs, extra in classes:
+        want = [(attribute(s.name), str(s.annotation) if isinstance(s.default, list) else s.kind.__name__)
+                for s in specs] + list(extra)
+        got = [(f.name, f.type if isinstance(f.type, str) else f.type.__name__) for f in dataclasses.fields(klass)]
+        assert got == want, klass.__name__
+        assert klass.__dataclass_params__.frozen, klass.__name__
+    assert len(classes) == 14

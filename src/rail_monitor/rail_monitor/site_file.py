@@ -134,10 +134,9 @@ def check_parameter_file(path: str | Path) -> None:
 
 
 def shipped_site_file() -> Path:
-    """The installed example site file, curve_250.yaml: the default wherever no site is given."""
-    from ament_index_python.packages import get_package_share_directory
-
-    return Path(get_package_share_directory("rail_monitor")) / "config" / "curve_250.yaml"
+    """The example site file, curve_250.yaml, shipped with the package: the default wherever no site
+    is given (also installed to the package's share/config for ros2 launch)."""
+    return Path(__file__).parent / "site_files" / "curve_250.yaml"
 
 
 def load_site(path: str | Path) -> Site:

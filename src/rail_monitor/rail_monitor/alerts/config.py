@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 
 # WaysideAlert.KIND_* and SEVERITY_* values.
 (KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED, KIND_WHEEL_DEFECT,
@@ -74,9 +74,35 @@ ALERT_SPECS: tuple[ParamSpec, ...] = (
 ALERT_SPECS = tuple(replace(s, tunable=True) for s in ALERT_SPECS)
 
 
-AlertConfig = values_type("AlertConfig", ALERT_SPECS, "The site's alert parameters (names and units as in "
-                          "ALERT_SPECS), with the corrugation lead time [day].", __name__,
-                          extra=(("lead_time_days", float),))
+@dataclass(frozen=True)
+class AlertConfig:
+    """The site's alert parameters (names and units as in ALERT_SPECS), with the corrugation lead time [day]."""
+
+    grinding_clear_fraction: float
+    forecast_clear_factor: float
+    noise_metric: str
+    noise_limit_dba: float
+    noise_hysteresis_db: float
+    noise_window_passes: int
+    noise_raise_count: int
+    noise_clear_count: int
+    squeal_min_risk: str
+    squeal_window_passes: int
+    squeal_raise_share: float
+    squeal_clear_share: float
+    rejected_window_passes: int
+    rejected_raise_share: float
+    rejected_clear_share: float
+    residual_model: str
+    wheel_defect_raise_db: float
+    wheel_defect_clear_db: float
+    wheel_defect_vehicle_db: float
+    drift_raise_db: float
+    drift_clear_db: float
+    squeal_mismatch_window_passes: int
+    squeal_mismatch_raise_share: float
+    squeal_mismatch_clear_share: float
+    lead_time_days: float
 
 
 def alert_config(values: Mapping[str, Any], lead_time_days: float, prefix: str = "alerts.") -> AlertConfig:

@@ -7,7 +7,9 @@ line's options and the nodes share one list of names, units and ranges.
 
 from __future__ import annotations
 
-from rail_monitor.core.params import ParamSpec, values_type
+from dataclasses import dataclass
+
+from rail_monitor.core.params import ParamSpec
 from rail_monitor.core.site import SITE_ID
 
 # Pass sources (pass_replayer, pass_simulator): what they publish and how fast.
@@ -152,14 +154,100 @@ STAMP_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
-# Their checked values, by attribute (rail_monitor.core.params.values_type).
-PublishParams = values_type("PublishParams", PUBLISH_SPECS, "A pass source's publishing parameters.", __name__)
-ReplayerParams = values_type("ReplayerParams", REPLAYER_SPECS, "pass_replayer's history parameters.", __name__)
-ModeParams = values_type("ModeParams", MODE_SPECS, "pass_simulator's mode parameters.", __name__)
-RecorderParams = values_type("RecorderParams", RECORDER_SPECS, "mcap_recorder's parameters.", __name__)
-MonitorParams = values_type("MonitorParams", (*MONITOR_SPECS, SOURCE), "wayside_monitor's process parameters.",
-                            __name__)
-StampParams = values_type("StampParams", STAMP_SPECS, "The stamp plausibility margins.", __name__)
-FoxgloveParams = values_type("FoxgloveParams", FOXGLOVE_SPECS, "foxglove_server's parameters.", __name__)
-EstimatorParams = values_type("EstimatorParams", ESTIMATOR_SPECS, "corrugation_estimator's own parameters.",
-                              __name__)
+# Their checked values, by attribute (rail_monitor.core.params.values_of; tests/core/test_params.py holds
+# each class's fields to its specs).
+@dataclass(frozen=True)
+class PublishParams:
+    """A pass source's publishing parameters."""
+
+    site_id: str
+    rate: float
+    start_offset_s: float
+    end_offset_s: float
+    publish_clock: bool
+    clock_period_s: float
+    wait_for_subscribers: int
+    wait_timeout_s: float
+    ack_batch: int
+    ack_timeout_s: float
+    max_backlog: int
+    progress: bool
+
+
+@dataclass(frozen=True)
+class ReplayerParams:
+    """pass_replayer's history parameters."""
+
+    source: str
+    source_topic: str
+    skip_bad_rows: bool
+    salvage: bool
+    measured_source: str
+
+
+@dataclass(frozen=True)
+class ModeParams:
+    """pass_simulator's mode parameters."""
+
+    mode: str
+    output: str
+
+
+@dataclass(frozen=True)
+class RecorderParams:
+    """mcap_recorder's parameters."""
+
+    stop_timeout_s: float
+    output: str
+    site_file: str
+    topics: list[str]
+    compression: str
+    chunk_size: int
+    max_bag_size: int
+    max_bag_duration_s: float
+    max_total_bytes: int
+    max_age_s: float
+    flush_period_s: float
+    log_time: str
+    discovery_period_s: float
+
+
+@dataclass(frozen=True)
+class MonitorParams:
+    """wayside_monitor's process parameters."""
+
+    stop_timeout_s: float
+    record: bool
+    listen: bool
+    drain_timeout_s: float
+    executor: str
+    threads: int
+    source: str
+
+
+@dataclass(frozen=True)
+class StampParams:
+    """The stamp plausibility margins."""
+
+    max_ahead_of_stream_s: float
+    max_ahead_of_clock_s: float
+
+
+@dataclass(frozen=True)
+class FoxgloveParams:
+    """foxglove_server's parameters."""
+
+    host: str
+    port: int
+    topics: list[str]
+    discovery_period_s: float
+
+
+@dataclass(frozen=True)
+class EstimatorParams:
+    """corrugation_estimator's own parameters."""
+
+    checkpoint_path: str
+    checkpoint_every_passes: int
+    state_period_s: float
+    advisory_period_s: float

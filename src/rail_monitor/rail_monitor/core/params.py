@@ -7,7 +7,6 @@ the command line and batch mode agree on every default and every range.
 
 from __future__ import annotations
 
-import dataclasses
 import difflib
 import math
 from collections.abc import Collection, Mapping, Sequence
@@ -130,18 +129,9 @@ def attribute(name: str) -> str:
     return name.replace(".", "_")
 
 
-def values_type(name: str, specs: Sequence[ParamSpec], doc: str, module: str,
-                extra: Sequence[tuple[str, type]] = (), **members: Any) -> type:
-    """A frozen dataclass with one typed field per spec (in spec order, dots as underscores) and
-    the extra fields, for a section's checked values; members are its methods and properties.
-    Build an instance from resolved values with :func:`values_of`."""
-    fields = [(attribute(s.name), s.annotation) for s in specs] + list(extra)
-    return dataclasses.make_dataclass(name, fields, frozen=True, namespace={"__doc__": doc, "__module__": module,
-                                                                             **members})
-
-
 def values_of(cls: type, values: Mapping[str, Any]) -> Any:
-    """An instance of a values type from values by dotted name."""
+    """An instance of a section's values class (a frozen dataclass with one field per spec, dots as
+    underscores: tests/core/test_params.py holds each to its specs) from values by dotted name."""
     return cls(**{attribute(k): v for k, v in values.items()})
 
 

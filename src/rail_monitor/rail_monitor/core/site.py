@@ -15,7 +15,7 @@ import numpy as np
 
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.friction import FRICTION_NAMES
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 from rail_monitor.core.timeutil import time_zone
 from rail_monitor.models import hertz
 from rail_monitor.models.cnossos import BRAKE_TYPES, TRACTION_TYPES
@@ -167,20 +167,35 @@ class VehicleClass:
         return self.axles_per_vehicle * self.mean_vehicles
 
 
-def _creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """k1, k2 [-] per pass for TrainPass.FRICTION_* values (NaN for an unknown value)."""
-    k1 = np.full(np.shape(friction_state), np.nan)
-    k2 = np.full(np.shape(friction_state), np.nan)
-    for code, name in FRICTION_NAMES.items():
-        sel = np.asarray(friction_state) == code
-        k1[sel], k2[sel] = getattr(self, f"creep_{name}_k1"), getattr(self, f"creep_{name}_k2")
-    return k1, k2
+@dataclass(frozen=True)
+class WheelRailContact:
+    """Materials, transverse radii and creep curves of the wheel-rail contact (units as in CONTACT_SPECS;
+    creep.dry.k1 is creep_dry_k1), and creep(friction_state), the creep curve of each pass."""
 
+    young_modulus_pa: float
+    poisson_ratio: float
+    rail_head_radius_m: float
+    wheel_transverse_radius_m: float
+    k3_convention: str
+    creep_reduction_factor: float
+    k3_n: float
+    creep_dry_k1: float
+    creep_dry_k2: float
+    creep_wet_k1: float
+    creep_wet_k2: float
+    creep_friction_modifier_k1: float
+    creep_friction_modifier_k2: float
+    creep_contaminated_k1: float
+    creep_contaminated_k2: float
 
-WheelRailContact = values_type(
-    "WheelRailContact", CONTACT_SPECS, "Materials, transverse radii and creep curves of the wheel-rail contact "
-    "(units as in CONTACT_SPECS; creep.dry.k1 is creep_dry_k1), and creep(friction_state), the creep curve of each "
-    "pass.", __name__, creep=_creep)
+    def creep(self, friction_state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """k1, k2 [-] per pass for TrainPass.FRICTION_* values (NaN for an unknown value)."""
+        k1 = np.full(np.shape(friction_state), np.nan)
+        k2 = np.full(np.shape(friction_state), np.nan)
+        for code, name in FRICTION_NAMES.items():
+            sel = np.asarray(friction_state) == code
+            k1[sel], k2[sel] = getattr(self, f"creep_{name}_k1"), getattr(self, f"creep_{name}_k2")
+        return k1, k2
 
 
 @dataclass(frozen=True)

@@ -12,12 +12,13 @@ contamination less still. They are starting values: a pair of roughness surveys 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 from rail_monitor.core.passes import FRICTION_NAMES, MAX_SPEED_MPS
 
 SPEED_STEP_MPS = 0.1          # speed grid of the growth tables [m/s]
@@ -70,14 +71,39 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
-def _k_b(self) -> np.ndarray:
-    """K_b per friction state, index TrainPass.FRICTION_* - 1 [-/axle pass]."""
-    return np.array([getattr(self, f"k_b_{name}") for name in FRICTION_NAMES.values()])
+@dataclass(frozen=True)
+class CorrugationConfig:
+    """The site's corrugation parameters (names and units as in CORRUGATION_SPECS; k_b.dry is k_b_dry), and
+    k_b, the K_b of every friction state."""
 
+    shortest_wavelength_m: float
+    longest_wavelength_m: float
+    points_per_band: int
+    k_b_dry: float
+    k_b_wet: float
+    k_b_friction_modifier: float
+    k_b_contaminated: float
+    kb_prior_scale_sd: float
+    kb_prior_ratio_sd: float
+    survey_uncertainty_db: float
+    post_grinding_uncertainty_db: float
+    sliding_wear_ratio: float
+    acceptance_factor: float
+    intervention_factor: float
+    post_grinding_fraction: float
+    lead_time_days: float
+    history_days: float
+    min_traffic_days: float
+    advice_min_speed_mps: float
+    advice_max_speed_mps: float
+    advice_band_kmh: float
+    advice_max_share: float
+    advice_noise_rise_dba: float
 
-CorrugationConfig = values_type(
-    "CorrugationConfig", CORRUGATION_SPECS, "The site's corrugation parameters (names and units as in "
-    "CORRUGATION_SPECS; k_b.dry is k_b_dry), and k_b, the K_b of every friction state.", __name__, k_b=property(_k_b))
+    @property
+    def k_b(self) -> np.ndarray:
+        """K_b per friction state, index TrainPass.FRICTION_* - 1 [-/axle pass]."""
+        return np.array([getattr(self, f"k_b_{name}") for name in FRICTION_NAMES.values()])
 
 
 def corrugation_config(values: Mapping[str, Any], prefix: str = "corrugation.") -> CorrugationConfig:

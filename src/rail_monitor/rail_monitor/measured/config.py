@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 
 RESIDUAL_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("prediction_sd_db", 2.0, "Standard uncertainty of a predicted 1/3-octave band level [dB] (the "
@@ -23,8 +24,17 @@ RESIDUAL_SPECS: tuple[ParamSpec, ...] = (
               "kept waiting for their passes' predictions [-].", 10, 10_000_000),
 )
 
-ResidualConfig = values_type("ResidualConfig", RESIDUAL_SPECS, "Residual parameters (names and units as in "
-                             "RESIDUAL_SPECS).", __name__)
+@dataclass(frozen=True)
+class ResidualConfig:
+    """Residual parameters (names and units as in RESIDUAL_SPECS)."""
+
+    prediction_sd_db: float
+    baseline_passes: int
+    baseline_min_passes: int
+    outlier_db: float
+    receiver_tolerance_m: float
+    indirect_days: float
+    held_predictions: int
 
 
 def residual_config(values: Mapping[str, Any], prefix: str = "residual.") -> ResidualConfig:

@@ -4,12 +4,13 @@ CNOSSOS-EU track terms, receiver and ground, mechanics radiators."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
 from rail_monitor.models import wheel_rail_noise as wrn
@@ -106,19 +107,49 @@ def band_centres_hz() -> np.ndarray:
     return cn.tables().band_hz
 
 
-def _receiver(self) -> Receiver:
-    return Receiver(self.receiver_distance_m, self.receiver_height_m, self.source_height_m, self.ground_depth_m,
-                    self.ground_reflection, 1.0e3 * self.ground_flow_resistivity_kpa_s_m2)
+@dataclass(frozen=True)
+class NoiseConfig:
+    """The site's noise parameters (names and units as in NOISE_SPECS), with the receiver and the mechanics
+    model's radiators they describe."""
 
+    model: str
+    cnossos_edition: str
+    interpolation: str
+    rail_roughness: str
+    rail_roughness_wavelength_m: list[float]
+    rail_roughness_db: list[float]
+    cnossos_catalogue: str
+    track_transfer: str
+    sleeper_type: str
+    bridge: str
+    bridge_constant_db: float
+    joints_per_100m: float
+    curve_squeal: bool
+    aerodynamic: bool
+    receiver_distance_m: float
+    receiver_height_m: float
+    source_height_m: float
+    pass_by_sources: str
+    ground_reflection: float
+    ground_flow_resistivity_kpa_s_m2: float
+    ground_depth_m: float
+    rail_radius_m: float
+    sleeper_area_m2: float
+    wheel_rim_width_m: float
+    contact_filter: str
+    band_points: int
+    transfer_points: int
+    wheel: str
 
-def _radiators(self) -> wrn.Radiators:
-    return wrn.Radiators(self.rail_radius_m, self.sleeper_area_m2, self.wheel_rim_width_m)
+    @property
+    def receiver(self) -> Receiver:
+        return Receiver(self.receiver_distance_m, self.receiver_height_m, self.source_height_m, self.ground_depth_m,
+                        self.ground_reflection, 1.0e3 * self.ground_flow_resistivity_kpa_s_m2)
 
-
-NoiseConfig = values_type(
-    "NoiseConfig", NOISE_SPECS, "The site's noise parameters (names and units as in NOISE_SPECS), with the "
-    "receiver and the mechanics model's radiators they describe.", __name__, receiver=property(_receiver),
-    radiators=property(_radiators))
+    @property
+    def radiators(self) -> wrn.Radiators:
+        """The mechanics model's rail, sleeper and wheel radiators."""
+        return wrn.Radiators(self.rail_radius_m, self.sleeper_area_m2, self.wheel_rim_width_m)
 
 
 def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConfig:

@@ -5,10 +5,11 @@ wheel mode is each vehicle class's, VEHICLE_SPECS)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of, values_type
+from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 
 # SquealPrediction.RISK_* values.
 RISK_NONE, RISK_LOW, RISK_MEDIUM, RISK_HIGH = range(4)
@@ -29,8 +30,17 @@ SQUEAL_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
-SquealConfig = values_type(
-    "SquealConfig", SQUEAL_SPECS, "The site's squeal parameters (names and units as in SQUEAL_SPECS).", __name__)
+@dataclass(frozen=True)
+class SquealConfig:
+    """The site's squeal parameters (names and units as in SQUEAL_SPECS)."""
+
+    receiver_distance_m: float
+    spatial_average: float
+    reference_amplitude_mps: float
+    friction_modifier_effectiveness: float
+    background_level_dba: float
+    risk_medium_dba: float
+    risk_high_dba: float
 
 
 def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealConfig:
