@@ -20,7 +20,8 @@ import numpy as np
 
 from bench.timing import first_touch_s, peak_rss_mb
 from rail_monitor.batch.bag import run_to_bag
-from rail_monitor.batch.run import BatchResult, run_models
+from rail_monitor.batch.result import BatchResult
+from rail_monitor.batch.run import run_models
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.simulator_params import simulator_config
 from rail_monitor.core.site import site_from_values

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rail_monitor.bagio.csv_io import read_csv, write_csv
+from rail_monitor.bagio.csv_io import read_csv, read_csv_rows, write_csv
 from rail_monitor.core.errors import InputError
 
 from conftest import EXAMPLE_CSV
@@ -70,8 +70,9 @@ def test_not_utf8_names_the_line(tmp_path: Path):
 def test_skip_bad_rows_counts_them(tmp_path: Path):
     p = tmp_path / "some_bad.csv"
     p.write_text(HEADER + ROW + ROW.replace("19.0", "x") + ROW.replace("T1", "T2"), encoding="utf-8")
-    t = read_csv(p, skip_bad_rows=True)
-    assert len(t) == 2 and t.skipped == 1 and list(t.train_id) == ["T1", "T2"]
+    t, skipped = read_csv_rows(p, skip_bad_rows=True)
+    assert len(t) == 2 and len(skipped) == 1 and skipped[0].startswith("line 3: ") and list(t.train_id) == ["T1", "T2"]
+    assert read_csv(p, skip_bad_rows=True).equals(t)
 
 
 def test_separators_and_control_characters_in_a_field_stay_in_their_row(tmp_path):

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from rail_monitor.bagio.passes_bag import write_passes_bag
-from rail_monitor.bagio.reader import bag_info, read_bag_passes, read_passes
+from rail_monitor.bagio.reader import bag_info, read_bag_passes, read_passes_reported
 from rail_monitor.cli import main
 from rail_monitor.core.errors import InputError
 
@@ -126,8 +126,8 @@ def test_salvage_skips_a_damaged_chunk_and_reads_every_intact_one(small, tmp_pat
     _flip(f, start + 9 + length - 50)  # inside the second chunk's compressed records
     with pytest.raises(InputError, match=r"1 of \d+ chunks damaged"):
         read_bag_passes(bag)
-    salvaged = read_passes(bag, salvage=True)
-    report = salvaged.salvage
+    salvaged, read = read_passes_reported(bag, salvage=True)
+    report = read.salvage
     line = report.line(bag)
     assert report.damaged_chunks == 1 and "from the complete chunks" in line and "skipped 1 damaged chunk" in line
     lost = len(whole) - len(salvaged)

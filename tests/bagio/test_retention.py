@@ -102,8 +102,8 @@ def test_a_power_cut_leaves_the_finished_files_listed_and_the_open_one_salvageab
         assert sum(1 for _ in reader.messages()) == meta["message_count"] > 0
     with pytest.raises(InputError, match=r"was being written when the recording stopped.*--salvage"):
         check_bag(cut)
-    salvaged = salvage_bag_passes(cut)
-    assert 0 < len(salvaged) <= 2000 and salvaged.salvage.cut_off == 1
+    salvaged, report = salvage_bag_passes(cut)
+    assert 0 < len(salvaged) <= 2000 and report.cut_off == 1
 
 
 @pytest.mark.parametrize(("kw", "says"), [

@@ -100,7 +100,8 @@ def test_any_chunking_of_a_history_gives_the_one_call_outputs_alerts_included(si
     inside a run of equal stamps) give the one call's outputs bit for bit (exact equality)."""
     import numpy as np
 
-    from rail_monitor.batch.run import BatchResult, run_models
+    from rail_monitor.batch.result import BatchResult
+    from rail_monitor.batch.run import run_models
 
     history = _hostile_history(sample_passes)
     whole = run_models(history, site_values)
@@ -151,7 +152,8 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
     random chunk boundaries give the one call's outputs bit for bit."""
     import numpy as np
 
-    from rail_monitor.batch.run import BatchResult, run_models
+    from rail_monitor.batch.result import BatchResult
+    from rail_monitor.batch.run import run_models
     from rail_monitor.core.passes import rejection_reasons, with_class_defaults
     from rail_monitor.core.site import site_from_values
     from rail_monitor.corrugation.config import corrugation_config

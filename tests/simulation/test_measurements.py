@@ -12,7 +12,8 @@ import pytest
 from rail_monitor.alerts.config import KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH, KIND_WHEEL_DEFECT, alert_config
 from rail_monitor.alerts.manager import wheel_defect_score
 from rail_monitor.bagio.reader import read_bag_passes
-from rail_monitor.batch.run import BatchResult, BatchRun, run_models
+from rail_monitor.batch.result import BatchResult
+from rail_monitor.batch.run import BatchRun, run_models
 from rail_monitor.simulation.measurements import simulate_measurements
 from rail_monitor.site_file import load_parameter_file
 

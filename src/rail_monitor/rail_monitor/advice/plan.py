@@ -186,16 +186,26 @@ def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor
     per_band = g.shape[1] // len(est.bands)
     show = allowed & ((current > 1e-6) | (rec > 1e-6))
     ci_rows = np.nonzero(show)[0]
+    class_noise_current, class_noise_rec = (lp * current).sum(axis=2), (lp * rec).sum(axis=2)
+    class_squeal_current, class_squeal_rec = (sq * current).sum(axis=1), (sq * rec).sum(axis=1)
     return SpeedAdvice(
-        float(pass_w @ mean), float(low.min()), float(high.max()), 0.5 * (edges[:-1] + edges[1:]),
-        pass_w @ current, pass_w @ rec, cur_peak, rec_peak,
-        1.0 - rec_peak / cur_peak if cur_peak > 0 else 0.0, cur_peak / rec_peak if rec_peak > 0 else float("inf"),
-        float(est.bands[int(np.argmax(now)) // per_band]),
-        classes, mean, pass_w, (sq * current).sum(axis=1), (sq * rec).sum(axis=1),
-        list(consequences.noise.models), (lp * current).sum(axis=2).T.ravel(), (lp * rec).sum(axis=2).T.ravel(),
-        (lp * current).sum(axis=2) @ pass_w, (lp * rec).sum(axis=2) @ pass_w, cfg.advice_noise_rise_dba,
-        float(pass_w @ (sq * current).sum(axis=1)), float(pass_w @ (sq * rec).sum(axis=1)),
-        [classes[c] for c in ci_rows], low[show], high[show], current[show], rec[show])
+        mean_speed_mps=float(pass_w @ mean), min_speed_mps=float(low.min()), max_speed_mps=float(high.max()),
+        speed_bin_centres_mps=0.5 * (edges[:-1] + edges[1:]),
+        current_probability=pass_w @ current, recommended_probability=pass_w @ rec,
+        current_peak_growth=cur_peak, recommended_peak_growth=rec_peak,
+        peak_growth_reduction=1.0 - rec_peak / cur_peak if cur_peak > 0 else 0.0,
+        grinding_interval_factor=cur_peak / rec_peak if rec_peak > 0 else float("inf"),
+        current_peak_wavelength_m=float(est.bands[int(np.argmax(now)) // per_band]),
+        vehicle_class=classes, class_mean_speed_mps=mean, class_pass_share=pass_w,
+        class_squeal_share_current=class_squeal_current, class_squeal_share_recommended=class_squeal_rec,
+        noise_model=list(consequences.noise.models),
+        class_noise_current_dba=class_noise_current.T.ravel(), class_noise_recommended_dba=class_noise_rec.T.ravel(),
+        noise_current_dba=class_noise_current @ pass_w, noise_recommended_dba=class_noise_rec @ pass_w,
+        noise_rise_limit_dba=cfg.advice_noise_rise_dba,
+        squeal_share_current=float(pass_w @ class_squeal_current),
+        squeal_share_recommended=float(pass_w @ class_squeal_rec),
+        band_vehicle_class=[classes[c] for c in ci_rows], band_low_mps=low[show], band_high_mps=high[show],
+        band_current_share=current[show], band_recommended_share=rec[show])
 
 
 def advise_or_none(est: CorrugationEstimator, consequences: Consequences,

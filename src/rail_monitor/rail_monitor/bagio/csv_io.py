@@ -133,7 +133,12 @@ def csv_cells(line: str, header: list[str]) -> list[str]:
 
 def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
     """Read a detector CSV. A malformed row is an error naming its line, unless skip_bad_rows
-    (then it is left out and counted in the returned table's ``skipped`` attribute)."""
+    (then it is left out; read_csv_rows says which)."""
+    return read_csv_rows(path, skip_bad_rows)[0]
+
+
+def read_csv_rows(path: str | Path, skip_bad_rows: bool = False) -> tuple[PassTable, list[str]]:
+    """read_csv, with each row left out under skip_bad_rows as "line N: reason"."""
     path = Path(path)
     header_line, header, lines = csv_lines(path, "time_utc,train_id,...")
     parsers: dict[int, tuple[str, Callable[[str], object]]] = {}
@@ -157,7 +162,7 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
     if "vehicle_count" not in seen and "axle_count" not in seen:
         raise InputError(f"{path}: missing column: vehicle_count or axle_count")
 
-    rows, skipped, why = [], 0, []
+    rows, why = [], []
     for n, line in lines:
         try:
             cells = csv_cells(line, header)
@@ -171,12 +176,8 @@ def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
         except ValueError as exc:
             if not skip_bad_rows:
                 raise InputError(f"{path}: line {n}: {exc}") from None
-            skipped += 1
             why.append(f"line {n}: {exc}")
-    table = PassTable.from_rows(rows)
-    table.skipped = skipped  # type: ignore[attr-defined]
-    table.skipped_rows = why  # type: ignore[attr-defined]  (each "line N: reason")
-    return table
+    return PassTable.from_rows(rows), why
 
 
 CSV_HEADER_COMMENT = """\

@@ -223,16 +223,33 @@ def read_history_inputs(source: str | Path, measured: str | Path | None = None, 
 def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,
                 salvage: bool = False) -> PassTable:
     """Train passes from a CSV export or a bag, whichever path names (skip_bad_rows: CSV only,
-    see read_csv; the table's ``skipped`` attribute counts what was left out; salvage: MCAP only,
-    see salvage_bag_passes)."""
+    see read_csv; salvage: MCAP only, see salvage_bag_passes; read_passes_reported says what was
+    left out or salvaged)."""
+    return read_passes_reported(path, topic, skip_bad_rows, salvage)[0]
+
+
+@dataclass(frozen=True)
+class ReadReport:
+    """What reading a history left out or recovered: the CSV rows skipped ("line N: reason"), the
+    salvage of a damaged bag (None when not salvaged)."""
+
+    skipped_rows: tuple[str, ...] = ()
+    salvage: SalvageReport | None = None
+
+
+def read_passes_reported(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,
+                         salvage: bool = False) -> tuple[PassTable, ReadReport]:
+    """read_passes, with its ReadReport."""
     path = Path(path)
     if salvage:
-        return salvage_bag_passes(path, topic)
+        table, report = salvage_bag_passes(path, topic)
+        return table, ReadReport(salvage=report)
     if is_csv(path):
-        from rail_monitor.bagio.csv_io import read_csv
+        from rail_monitor.bagio.csv_io import read_csv_rows
 
-        return read_csv(path, skip_bad_rows=skip_bad_rows)
-    return read_bag_passes(path, topic)
+        table, skipped = read_csv_rows(path, skip_bad_rows=skip_bad_rows)
+        return table, ReadReport(skipped_rows=tuple(skipped))
+    return read_bag_passes(path, topic), ReadReport()
 
 
 def salvage_mcap(path: str | Path) -> list[ScannedMessage]:
@@ -256,13 +273,13 @@ class SalvageReport:
                 f"{self.files} MCAP file(s) in {path}{skipped}")
 
 
-def salvage_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
+def salvage_bag_passes(path: str | Path, topic: str | None = None) -> tuple[PassTable, SalvageReport]:
     """Every TrainPass in the intact chunks of a bag's MCAP files (a folder or one .mcap file), even
     files cut off mid-write with no summary or metadata.yaml (a killed recorder, a full disk) or with
     damaged chunks between intact ones (skipped and counted; see bagio.integrity.scan_mcap).
 
-    The table's ``salvage`` attribute (SalvageReport) says what was recovered. Passes are in
-    log-time order (stable across split files). topic: as in read_bag_passes.
+    The passes, in log-time order (stable across split files), and a SalvageReport of what was
+    recovered. topic: as in read_bag_passes.
     """
     path = Path(path)
     if not path.exists():
@@ -288,9 +305,7 @@ def salvage_bag_passes(path: str | Path, topic: str | None = None) -> PassTable:
     except Exception as exc:
         raise InputError(f"{path}: cannot salvage: {_one_line(exc)}") from None
     rows.sort(key=lambda r: r[0])
-    table = PassTable.from_rows([r for _, r in rows])
-    table.salvage = SalvageReport(len(files), total, len(rows), damaged, cut_off)  # type: ignore[attr-defined]
-    return table
+    return PassTable.from_rows([r for _, r in rows]), SalvageReport(len(files), total, len(rows), damaged, cut_off)
 
 
 def _split_index(path: Path) -> tuple[int, str]:

@@ -16,7 +16,8 @@ from rail_monitor.advice.plan import SpeedAdvice
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
-from rail_monitor.batch.run import BatchResult, BatchRun
+from rail_monitor.batch.result import BatchResult
+from rail_monitor.batch.run import BatchRun
 from rail_monitor.codec.cdr import serialize
 from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.core.errors import PassOrderError
@@ -196,12 +197,12 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
 def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
            site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool,
            events: list[MaintenanceEvent], measured: list[Measurement]) -> Recorded:
-    from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.bagio.reader import read_passes_reported
 
-    passes = read_passes(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
-    notes = [printable(passes.salvage.line(source)), "surveys, grinding and the bag's measured noise are not "
-             "salvaged"] if salvage else []
-    skipped = getattr(passes, "skipped_rows", [])
+    passes, report = read_passes_reported(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
+    notes = [printable(report.salvage.line(source)), "surveys, grinding and the bag's measured noise are not "
+             "salvaged"] if report.salvage is not None else []
+    skipped = report.skipped_rows
     if skipped:
         notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "
                      + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))

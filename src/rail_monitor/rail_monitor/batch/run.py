@@ -16,7 +16,7 @@ import os
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -25,11 +25,12 @@ from rail_monitor.advice.consequences import Consequences
 from rail_monitor.advice.plan import SpeedAdvice, advise_or_none
 from rail_monitor.alerts.config import alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager
+from rail_monitor.batch.result import BatchResult
 from rail_monitor.core.errors import PassOrderError
 from rail_monitor.core.node_params import STAMP_SPECS, StampParams
 from rail_monitor.core.params import resolve, section, values_of
 from rail_monitor.core.passes import PassTable, publishable, reject_ahead, rejection_reasons, with_class_defaults
-from rail_monitor.core.site import Site, site_from_values
+from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import fits_time_msg, format_iso_ns
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
@@ -51,46 +52,6 @@ HISTORY_CHUNK = 16_384  # passes per advance_history call: bounds its (passes x 
 #                         and the noise of one chunk is predicted while the next is advanced
 NOISE_CHUNK = 8_192  # passes per noise prediction (every model): bounds its (passes x bands) arrays
 PAIR_BLOCK = 1_000  # passes whose predictions are given to the residual tracker at once (at most half it holds)
-
-
-@dataclass
-class BatchResult:
-    """Model outputs over a history, or over one chunk of it (BatchRun.feed). Arrays over
-    ``accepted`` rows unless named otherwise."""
-
-    site: Site
-    passes: PassTable                 # the passes in time order (as the replayer sends them)
-    reasons: np.ndarray               # per pass: '' accepted, else why rejected
-    accepted: PassTable               # accepted passes, class defaults filled
-    squeal: dict[str, np.ndarray]
-    trajectory: Trajectory            # state after each counted pass (index: row of ``accepted``)
-    noise: dict[str, NoisePrediction]  # per source model
-    alerts: list[Alert]               # events, in order (a chunk's: those no later chunk can precede)
-    standing: list[Alert]             # after these passes
-    advice: SpeedAdvice | None        # on the final state (None for a chunk before the last)
-    estimator: CorrugationEstimator   # the state after these passes
-    receiver: Any
-    left_out: dict[str, int]          # passes the replayer would not send, by reason
-    events: list[MaintenanceEvent] = field(default_factory=list)  # surveys and grinding taken, applied or not
-    measurements: list[Measurement] = field(default_factory=list)  # measured pass-bys taken, paired or not
-    residuals: list[Residual] = field(default_factory=list)        # measured minus predicted, in stamp order
-    observations: list[Observation] = field(default_factory=list)  # indirect roughness windows closed
-
-    @classmethod
-    def merged(cls, parts: Sequence[BatchResult], held: list[Alert], advice: SpeedAdvice | None) -> BatchResult:
-        """BatchRun's chunk results, in order, with what its finish() returned, as the one result of
-        the whole history (equal to run_models on it)."""
-        last = parts[-1]
-        starts = np.cumsum([0, *(len(p.accepted) for p in parts[:-1])]).tolist()
-        left_out = sum((Counter(p.left_out) for p in parts), Counter())
-        return cls(last.site, PassTable.concat([p.passes for p in parts]), np.concatenate([p.reasons for p in parts]),
-                   PassTable.concat([p.accepted for p in parts]),
-                   {k: np.concatenate([p.squeal[k] for p in parts]) for k in last.squeal},
-                   Trajectory.concat(list(zip(starts, [p.trajectory for p in parts], strict=True))),
-                   {m: NoisePrediction.concat([p.noise[m] for p in parts]) for m in last.noise},
-                   [a for p in parts for a in p.alerts] + held, last.standing, advice, last.estimator, last.receiver,
-                   dict(left_out), [e for p in parts for e in p.events], [m for p in parts for m in p.measurements],
-                   [r for p in parts for r in p.residuals], [o for p in parts for o in p.observations])
 
 
 @dataclass
@@ -239,9 +200,11 @@ class BatchRun:
         events = sorted(self._held + events, key=_alert_key)
         later = int(table.stamp_ns[-1]) if len(table) else np.iinfo(np.int64).min
         self._held = [a for a in events if a.stamp_ns >= later]  # may tie with the next chunk's first pass
-        return BatchResult(self.site, table, reasons, accepted, squeal, traj, noise,
-                           [a for a in events if a.stamp_ns < later], self.standing(), None, self.estimator,
-                           self.model.receiver, dict(left_out), [], measured, residuals)
+        return BatchResult(site=self.site, passes=table, reasons=reasons, accepted=accepted, squeal=squeal,
+                           trajectory=traj, noise=noise, alerts=[a for a in events if a.stamp_ns < later],
+                           standing=self.standing(), advice=None, estimator=self.estimator,
+                           receiver=self.model.receiver, left_out=dict(left_out), measurements=measured,
+                           residuals=residuals)
 
     def _measured(self, table: PassTable, accepted: PassTable, noise: dict[str, NoisePrediction],
                   squeal_risk: np.ndarray) -> tuple[list[Measurement], list[Residual]]:

@@ -19,7 +19,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.bagio.reader import bag_info, is_csv, read_passes
+    from rail_monitor.bagio.reader import bag_info, is_csv, read_passes, read_passes_reported
     from rail_monitor.bagio.site_record import describe, read_site_record
     from rail_monitor.codec.typestore import TRAIN_PASS
     from rail_monitor.core.text import printable
@@ -27,8 +27,8 @@ def run(ns: argparse.Namespace) -> int:
 
     path = Path(ns.bag)
     if ns.salvage:
-        table = read_passes(path, ns.topic, salvage=True)
-        print(printable(table.salvage.line(path)))
+        table, report = read_passes_reported(path, ns.topic, salvage=True)
+        print(printable(report.salvage.line(path)))
     else:
         if not is_csv(path):
             info = bag_info(path)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import sys
 
-from rail_monitor.bagio.reader import read_history_inputs, read_passes
+from rail_monitor.bagio.reader import read_history_inputs, read_passes_reported
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import REPLAYER_SPECS, ReplayerParams
 from rail_monitor.core.params import values_of
@@ -42,11 +42,11 @@ class PassReplayer(PassSourceNode):
             self.advertise_measurements()
 
     def _load(self) -> PassTable:
-        table = read_passes(self.src.source, self.src.source_topic or None, self.src.skip_bad_rows,
-                            salvage=self.src.salvage)
-        if self.src.salvage:
-            self.get_logger().info(table.salvage.line(self.src.source))
-        self.skipped = getattr(table, "skipped", 0)
+        table, report = read_passes_reported(self.src.source, self.src.source_topic or None, self.src.skip_bad_rows,
+                                             salvage=self.src.salvage)
+        if report.salvage is not None:
+            self.get_logger().info(report.salvage.line(self.src.source))
+        self.skipped = len(report.skipped_rows)
         if self.skipped:
             self.get_logger().warning(f"{self.src.source}: {self.skipped} malformed row(s) left out")
         return table

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.alerts.config import alert_config
-from rail_monitor.batch.run import BatchResult
+from rail_monitor.batch.result import BatchResult
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.measured.config import residual_config
