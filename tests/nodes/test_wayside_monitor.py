@@ -32,6 +32,7 @@ from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent
 from rail_monitor.engine.checkpoint import load, resume
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.measured.records import Measurement
 from rail_monitor.messages.fields import time_ns
 from rail_monitor.nodes.alert_manager import AlertManagerNode
@@ -483,5 +484,5 @@ def test_late_subscriber_sees_the_standing_alerts(ros_context, site_values):
 
 
 def test_build_report_from_batch_result_without_ros(runs, tmp_path):
-    files = build_report(runs["batch"], _values(), tmp_path)
+    files = build_report(runs["batch"], SiteConfig.from_values(_values()), tmp_path)
     assert all(f.stat().st_size > 0 for f in files)

@@ -14,6 +14,7 @@ import pytest
 from rail_monitor.bagio.reader import read_passes
 from rail_monitor.batch.bag import write_bag
 from rail_monitor.batch.run import run_models
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.report import plots as report_plots
 from rail_monitor.report import tables as report_tables
 from rail_monitor.report.run_data import load_run
@@ -36,7 +37,7 @@ def report(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("page")
     bag = write_bag(run_models(read_passes(EXAMPLE_CSV), values), tmp / "bag", "curve_250")
     run = load_run(bag)
-    files = build_report(run, values, tmp / "report", "curve_250.yaml")
+    files = build_report(run, SiteConfig.from_values(values), tmp / "report", "curve_250.yaml")
     return run, values, files, tmp / "report"
 
 
@@ -83,8 +84,8 @@ def test_pdf_summary_and_squealing_trains(report):
     pdf = (folder / "report.pdf").read_bytes()
     assert pdf.startswith(b"%PDF") and pdf.count(b"/Type /Page\n") + pdf.count(b"/Type /Page ") >= 6
     summary = json.loads((folder / "summary.json").read_text(), parse_constant=lambda c: pytest.fail(c))
-    t = pass_table(run, values).as_dict()
-    lim = report_tables.limits(values)
+    t = pass_table(run, SiteConfig.from_values(values)).as_dict()
+    lim = report_tables.limits(SiteConfig.from_values(values))
     squealing = report_tables.squealing(t, lim["squeal_min_risk"])
     assert summary["squealing_passes"] == int(squealing.sum()) and summary["software_version"]
     assert summary["grinding"]["days"] == pytest.approx(float(run.states["days_to_threshold"][-1]), rel=1e-12)
@@ -125,8 +126,8 @@ def _ticks(fig) -> list[str]:
 
 def test_figures_follow_the_report_conventions(report):
     run, values, _, _ = report
-    t = pass_table(run, values).as_dict()
-    lim = report_tables.limits(values)
+    t = pass_table(run, SiteConfig.from_values(values)).as_dict()
+    lim = report_tables.limits(SiteConfig.from_values(values))
     fig = report_plots.corrugation(run.states, "Australia/Brisbane")
     assert "µm" in fig.axes[0].get_ylabel() and "Australia/Brisbane" in fig.axes[0].get_xlabel()
     assert any("threshold" in label for label in _labels(fig))

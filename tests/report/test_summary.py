@@ -8,6 +8,7 @@ from rail_monitor.bagio.reader import read_passes
 from rail_monitor.batch.bag import write_bag
 from rail_monitor.batch.run import run_models
 from rail_monitor.cli import main
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.report.run_data import load_run
 from rail_monitor.report.summary import build_report, summary_lines
 
@@ -28,7 +29,7 @@ def bag(tmp_path_factory):
 def test_the_summary_states_what_the_bag_holds(bag):
     path, values, result = bag
     run = load_run(path)
-    lines = summary_lines(run, values)
+    lines = summary_lines(run, SiteConfig.from_values(values))
     assert lines[0].startswith(f"site curve_250: {len(result.passes)} passes from 2026-09-01T")
     assert lines[0].endswith("AEST local)")  # the site's zone, Australia/Brisbane
     assert lines[1] == f"processed {len(result.accepted)}, rejected 0"
@@ -38,7 +39,7 @@ def test_the_summary_states_what_the_bag_holds(bag):
 
 def test_the_report_folder_has_a_page_and_its_plots(bag, tmp_path):
     path, values, _ = bag
-    files = build_report(load_run(path), values, tmp_path)
+    files = build_report(load_run(path), SiteConfig.from_values(values), tmp_path)
     page = files[-1].read_text()
     assert files[-1].name == "index.html"
     pngs = [f for f in files if f.suffix == ".png"]

@@ -14,6 +14,7 @@ from rail_monitor.alerts.manager import wheel_defect_score
 from rail_monitor.bagio.reader import read_bag_passes
 from rail_monitor.batch.result import BatchResult
 from rail_monitor.batch.run import BatchRun, run_models
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.simulation.measurements import simulate_measurements
 from rail_monitor.site_file import load_parameter_file
 
@@ -74,7 +75,7 @@ def test_the_report_lists_the_defective_vehicles_and_plots_measured_against_pred
 
     _, sim, result = loop
     bag = write_bag(result, tmp_path / "bag", "curve_250")
-    build_report(load_run(bag), load_parameter_file(SITE_FILE), tmp_path / "report")
+    build_report(load_run(bag), SiteConfig.from_values(load_parameter_file(SITE_FILE)), tmp_path / "report")
     page = (tmp_path / "report" / "index.html").read_text()
     assert (tmp_path / "report" / "measured.png").stat().st_size > 10_000
     section = page.split("wheel-defect suspects (repeat offenders)")[1].split("<h2>")[0]

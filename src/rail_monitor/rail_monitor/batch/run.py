@@ -23,29 +23,22 @@ import numpy as np
 
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.advice.plan import SpeedAdvice, advise_or_none
-from rail_monitor.alerts.config import alert_config
 from rail_monitor.alerts.manager import Alert, AlertManager
 from rail_monitor.batch.result import BatchResult
 from rail_monitor.core.errors import PassOrderError
-from rail_monitor.core.node_params import STAMP_SPECS, StampParams
-from rail_monitor.core.params import resolve, section, values_of
 from rail_monitor.core.passes import PassTable, publishable, reject_ahead, rejection_reasons, with_class_defaults
-from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import fits_time_msg, format_iso_ns
-from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.records import StateSnapshot, Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
 from rail_monitor.engine.corrugation_site import CorrugationSite
-from rail_monitor.measured.config import residual_config
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.measured.observer import IndirectObserver, Observation
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual, ResidualTracker, predictions_of
-from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation, NoisePrediction, NoiseRows
 from rail_monitor.noise.state_of_pass import state_index
-from rail_monitor.squeal.config import squeal_config
 from rail_monitor.squeal.predict import predict as predict_squeal
 
 HISTORY_CHUNK = 16_384  # passes per advance_history call: bounds its (passes x bands x components) arrays,
@@ -98,13 +91,13 @@ class BatchRun:
     def __init__(self, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,
                  threads: int = 0, events: Sequence[MaintenanceEvent] = (),
                  measurements: Sequence[Measurement] = ()) -> None:
-        self.values = values
-        self.site = site_from_values(values)
-        self.margins = values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.", strict=True))
-        self.estimator = estimator or CorrugationEstimator(self.site, corrugation_config(values))
+        self.cfg = SiteConfig.from_values(values)
+        self.site, self.margins = self.cfg.site, self.cfg.stamps
+        self.estimator = estimator or CorrugationEstimator(self.site, self.cfg.corrugation)
         self.estimator.engine = "numba"  # compiled kernels for many passes (their numpy twins in the nodes)
-        self.model = RollingNoiseModel(self.site, noise_config(values), engine="numba")
-        self.alerts = AlertManager(alert_config(values, self.estimator.cfg.lead_time_days))
+        self.model = RollingNoiseModel(self.site, self.cfg.noise, engine="numba")
+        # The alerts' lead time is the state's (a resumed estimator's own configuration).
+        self.alerts = AlertManager(replace(self.cfg.alerts, lead_time_days=self.estimator.cfg.lead_time_days))
         self.threads = threads or os.cpu_count() or 1
         self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
         self.newest_taken_ns = self.estimator.newest_ns  # the nodes' reference
@@ -116,7 +109,7 @@ class BatchRun:
         self.trailing_measurements: list[Measurement] = []
         self._measurements = sorted(measurements, key=lambda m: m.key)  # not yet taken, by pass
         receiver = self.model.receiver
-        rcfg = residual_config(values)
+        rcfg = self.cfg.residual
         self.tracker = ResidualTracker(rcfg, self.model.band_hz, (receiver.distance_m, receiver.height_m),
                                        self.model.models)
         observer = IndirectObserver(self.model, rcfg, self.estimator.bands) if rcfg.indirect_days > 0 else None
@@ -173,7 +166,7 @@ class BatchRun:
         self.newest_taken_ns = reject_ahead(table.stamp_ns, reasons, self.newest_taken_ns, self.margins)
         accepted = with_class_defaults(table.take(reasons == ""), self.site)
         with ThreadPoolExecutor(max_workers=self.threads) as pool:
-            squeal_job = pool.submit(predict_squeal, squeal_config(self.values), self.site, accepted)
+            squeal_job = pool.submit(predict_squeal, self.cfg.squeal, self.site, accepted)
             # The corrugation history in chunks on this thread, each chunk's noise on the pool while
             # the next is advanced (the estimator carries the kept passes, _Tail the states a later
             # pass may be predicted on: the chunks give one call's states and predictions).
@@ -248,8 +241,7 @@ class BatchRun:
         self.tracker.finish()
         held, self._held = self._held, []
         with ThreadPoolExecutor(max_workers=self.threads) as pool:
-            return held, advise_or_none(self.estimator, Consequences(self.site, self.model,
-                                                                     squeal_config(self.values)), pool)
+            return held, advise_or_none(self.estimator, Consequences(self.site, self.model, self.cfg.squeal), pool)
 
 
 def run_models(passes: PassTable, values: Mapping[str, Any], estimator: CorrugationEstimator | None = None,

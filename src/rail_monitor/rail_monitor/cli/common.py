@@ -195,13 +195,15 @@ def report_dir(bag: str, report: str | None) -> Path:
 
 def print_report(bag: str, site: str | None, report: str | None) -> None:
     """Print the run summary and write the report folder."""
+    from rail_monitor.engine.site_config import SiteConfig
     from rail_monitor.report.run_data import load_run
     from rail_monitor.report.summary import build_report, summary_lines
 
     values, site_text = bag_site_values(bag, site)
+    cfg = SiteConfig.from_values(values)
     run = load_run(bag)
-    print("\n".join(summary_lines(run, values)))
-    files = build_report(run, values, report_dir(bag, report), site_text)
+    print("\n".join(summary_lines(run, cfg)))
+    files = build_report(run, cfg, report_dir(bag, report), site_text)
     pngs = sum(f.suffix == ".png" for f in files)
     print(f"report: {files[-1]} ({pngs} figures; report.pdf, squealing_trains.csv, summary.json beside it)")
 

@@ -32,6 +32,7 @@ def run(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.output_folder import new_output_folder
     from rail_monitor.bagio.site_record import read_site_record
     from rail_monitor.core.text import printable
+    from rail_monitor.engine.site_config import SiteConfig
     from rail_monitor.report.export import export_run
 
     values, _ = bag_site_values(ns.bag, ns.site)
@@ -42,7 +43,7 @@ def run(ns: argparse.Namespace) -> int:
     fresh_output(out, ns.overwrite, [ns.bag])
     folder = new_output_folder(out)
     try:
-        done = export_run(ns.bag, values, ns.format, folder, about, ns.chunk)
+        done = export_run(ns.bag, SiteConfig.from_values(values), ns.format, folder, about, ns.chunk)
     except BaseException:
         shutil.rmtree(folder)  # created above: a failed export leaves nothing behind
         raise

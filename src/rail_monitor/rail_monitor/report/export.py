@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.report.run_data import RunData
 from rail_monitor.report.run_tables import Table, alert_table, pass_table
 
@@ -30,7 +31,7 @@ class Written:
     notes: list[str]
 
 
-def export_run(bag: str | Path, values: Mapping[str, Any], fmt: str, folder: Path,
+def export_run(bag: str | Path, cfg: SiteConfig, fmt: str, folder: Path,
                schema_metadata: Mapping[str, str], chunk: int = 5_000) -> Written:
     """The pass and alert tables of a recorded run written into folder (a new, empty one).
 
@@ -42,18 +43,18 @@ def export_run(bag: str | Path, values: Mapping[str, Any], fmt: str, folder: Pat
     notes: list[str] = []
     if fmt in ("csv", "parquet") and chunk > 0:
         try:
-            return _export_in_parts(bag, values, fmt, folder, schema_metadata, chunk)
+            return _export_in_parts(bag, cfg, fmt, folder, schema_metadata, chunk)
         except (NotStampOrdered, ColumnsChanged) as exc:
             for name in ("passes", "alerts"):  # the parts written so far: this export's own files
                 (folder / f"{name}.{fmt}").unlink(missing_ok=True)
             notes.append(f"{exc}; read whole instead")
     run = load_run(bag)
-    tables = [pass_table(run, values), alert_table(run, values)]
+    tables = [pass_table(run, cfg), alert_table(run, cfg)]
     files = write_tables(tables, fmt, folder, schema_metadata)
     return Written([(t.name, len(t.columns[0].values), len(t.columns)) for t in tables], files, notes)
 
 
-def _export_in_parts(bag: str | Path, values: Mapping[str, Any], fmt: str, folder: Path,
+def _export_in_parts(bag: str | Path, cfg: SiteConfig, fmt: str, folder: Path,
                      schema_metadata: Mapping[str, str], chunk: int) -> Written:
     from rail_monitor.report.run_data import iter_runs
 
@@ -61,12 +62,12 @@ def _export_in_parts(bag: str | Path, values: Mapping[str, Any], fmt: str, folde
     alerts: list[Any] = []
     last: RunData | None = None
     for part in iter_runs(bag, chunk):
-        passes.add(pass_table(part, values))
+        passes.add(pass_table(part, cfg))
         alerts += part.alerts
         last = part
     assert last is not None  # iter_runs gives at least one part or raises
     last.alerts = sorted(alerts, key=lambda a: (a.stamp_ns, a.kind, a.key, a.active))
-    table = alert_table(last, values)
+    table = alert_table(last, cfg)
     events = TableSink("alerts", fmt, folder, schema_metadata)
     events.add(table)
     files = [passes.close(), events.close()]

@@ -17,10 +17,10 @@ from typing import Any
 import numpy as np
 
 from rail_monitor import __version__
-from rail_monitor.alerts.config import KIND_NAMES, alert_config
-from rail_monitor.core.site import site_from_values
+from rail_monitor.alerts.config import KIND_NAMES
 from rail_monitor.core.text import jsonable, printable
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.report import plots as report_plots
 from rail_monitor.report import tables as report_tables
 from rail_monitor.report.run_data import RunData
@@ -123,7 +123,7 @@ def _headline_lines(h: Mapping[str, Any], lim: Mapping[str, Any]) -> list[str]:
     return lines
 
 
-def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_extra: Mapping[str, Any],
+def write_report(run: RunData, cfg: SiteConfig, out: Path, figures_extra: Mapping[str, Any],
                  site_text: str) -> list[Path]:
     """Write the report folder; returns the files written (index.html last).
 
@@ -132,17 +132,17 @@ def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_ext
     from matplotlib.backends.backend_pdf import PdfPages
 
     out.mkdir(parents=True, exist_ok=True)
-    site = site_from_values(values)
+    site = cfg.site
     zone = site.time_zone
-    t = pass_table(run, values).as_dict()
-    lim = report_tables.limits(values)
+    t = pass_table(run, cfg).as_dict()
+    lim = report_tables.limits(cfg)
     models = list(run.noise)
     tables = {"outlook": report_tables.grinding_outlook(run, t, zone),
               "noise": report_tables.noise_percentiles(t, lim, models),
               "classes": report_tables.by_class(t, lim, models),
               "friction": report_tables.friction_comparison(t, lim, zone),
               "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run),
-              "offenders": report_tables.repeat_offenders(t, values, zone)}
+              "offenders": report_tables.repeat_offenders(t, cfg, zone)}
     head = headline(run, t, lim, tables, zone)
     figures = [("timeline", "Passes and squealing passes per day, and the day's highest pass-by level against "
                 "the limit.", report_plots.timeline(report_tables.daily(t, lim, models, zone), models, lim, zone))]
@@ -159,7 +159,7 @@ def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_ext
     if run.residuals:
         figures.append(("measured", "Measured pass-by noise against the prediction, and the 500-2000 Hz residual "
                         "against the site's running baseline (the wheel-defect and drift alerts' reference).",
-                        report_plots.measured(t, list(run.residuals), alert_config(values, 60.0).residual_model,
+                        report_plots.measured(t, list(run.residuals), cfg.alerts.residual_model,
                                               zone)))
     figures.append(("speeds", "Speed distributions, shares of train passes: the history, the recent passes, "
                     "and the advised distribution (per class in the speed advice table).",
@@ -185,7 +185,7 @@ def write_report(run: RunData, values: Mapping[str, Any], out: Path, figures_ext
                                                            "classes": tables["classes"]}), indent=1,
                                                  allow_nan=False), encoding="utf-8")
     page = out / "index.html"
-    page.write_text(_html(run, values, head, tables, lim, figures, meta), encoding="utf-8")
+    page.write_text(_html(run, cfg.values, head, tables, lim, figures, meta), encoding="utf-8")
     return [*files, out / "report.pdf", out / "squealing_trains.csv", out / "summary.json", page]
 
 

@@ -8,7 +8,6 @@ at or before the pass time. Units are in the column names (as in the pass CSV).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -16,8 +15,8 @@ import numpy as np
 
 from rail_monitor.alerts.config import KIND_NAMES, RISK_NAMES
 from rail_monitor.core.passes import FRICTION_NAMES, KMH_PER_MPS, rejection_reasons
-from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import format_iso_ns, format_local_ns
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.models.squeal import REGIME_NAMES
 from rail_monitor.noise.predict import INCREASE_REFERENCE
 from rail_monitor.report.run_data import RunData
@@ -61,9 +60,9 @@ def _pick(values: np.ndarray, index: np.ndarray, fill: Any = np.nan) -> np.ndarr
     return out
 
 
-def pass_table(run: RunData, values: Mapping[str, Any]) -> Table:
+def pass_table(run: RunData, cfg: SiteConfig) -> Table:
     """One row per recorded pass: the pass, its validation, and every model output for it."""
-    site = site_from_values(values)
+    site = cfg.site
     p = run.passes
     zone = site.time_zone
     keys = list(zip(p.train_id.tolist(), p.stamp_ns.tolist(), strict=True))
@@ -158,9 +157,9 @@ def _state_columns(run: RunData, stamps: np.ndarray) -> list[Column]:
     return cols
 
 
-def alert_table(run: RunData, values: Mapping[str, Any]) -> Table:
+def alert_table(run: RunData, cfg: SiteConfig) -> Table:
     """One row per alert event (a raise or a clear), in pass-time order."""
-    zone = site_from_values(values).time_zone
+    zone = cfg.site.time_zone
     a = run.alerts
     col = lambda f: np.array([f(x) for x in a], object)  # noqa: E731
     return Table("alerts", [

@@ -10,7 +10,6 @@ spectra before and after growth) and the validation of the passes.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -20,15 +19,16 @@ from rail_monitor.alerts.config import KIND_NAMES
 from rail_monitor.alerts.manager import describe
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.passes import FRICTION_NAMES, PassTable, rejection_reasons, synthetic_passes
-from rail_monitor.core.site import site_from_values
+from rail_monitor.core.site import Site
 from rail_monitor.core.text import printable
 from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns, format_local_ns
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.report.run_data import RunData
 
 
-def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12) -> list[str]:
+def summary_lines(run: RunData, cfg: SiteConfig, max_alerts: int = 12) -> list[str]:
     """The console summary of a run."""
-    site = site_from_values(values)
+    site = cfg.site
     p = run.passes
     reasons = rejection_reasons(p, site)
     lines = [f"site {site.site_id}: {len(p)} passes from {format_iso_ns(int(p.stamp_ns.min()))} to "
@@ -59,7 +59,7 @@ def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12)
                   f"{cls.get(nz['train_id'][i], ''):8s}"
                   f" {nz['speed_mps'][i]:5.1f} m/s  {nz['lpaeq_tp_dba'][i]:5.1f} / {nz['lpafmax_dba'][i]:5.1f} dB(A)"
                   for i in top]
-    lines += _limit_lines(run, values)
+    lines += _limit_lines(run, cfg)
     risk = run.squeal.get("risk", np.zeros(0, int))
     if len(risk):
         counts = np.bincount(risk.astype(int), minlength=4)
@@ -68,13 +68,13 @@ def summary_lines(run: RunData, values: Mapping[str, Any], max_alerts: int = 12)
     return lines
 
 
-def _limit_lines(run: RunData, values: Mapping[str, Any], shown: int = 5) -> list[str]:
+def _limit_lines(run: RunData, cfg: SiteConfig, shown: int = 5) -> list[str]:
     """Noise percentiles against the limit, and the loudest squealing trains."""
     from rail_monitor.report import tables
     from rail_monitor.report.run_tables import pass_table
 
-    t = pass_table(run, values).as_dict()
-    lim = tables.limits(values)
+    t = pass_table(run, cfg).as_dict()
+    lim = tables.limits(cfg)
     lines = [f"noise against the limit ({n['model']}, {n['metric']}): P50 {n['P50 [dB(A)]']:.1f}, P95 "
              f"{n['P95 [dB(A)]']:.1f}, max {n['max [dB(A)]']:.1f} dB(A); limit {n['limit [dB(A)]']:g} dB(A), "
              f"{n['above limit [%]']:.1f} % of passes above"
@@ -108,7 +108,7 @@ def _grinding_lines(run: RunData) -> list[str]:
 
 
 # -- report folder ------------------------------------------------------------------------------
-def build_report(run: RunData, values: Mapping[str, Any], out_dir: str | Path, site_text: str = "") -> list[Path]:
+def build_report(run: RunData, cfg: SiteConfig, out_dir: str | Path, site_text: str = "") -> list[Path]:
     """Write the report folder (rail_monitor.report.page) into out_dir; returns the files
     written, index.html last. site_text names the site file used. A write that fails (a full disk,
     no permission) is one RailMonitorError naming the folder."""
@@ -117,19 +117,17 @@ def build_report(run: RunData, values: Mapping[str, Any], out_dir: str | Path, s
     out = Path(out_dir)
     extra: dict[str, Any] = {}
     if run.noise:
-        extra["before"], extra["after"] = _spectra(run, values)
+        extra["before"], extra["after"] = _spectra(run, cfg)
     if len(run.squeal.get("risk", ())):
-        extra["curves"] = _squeal_curves(run, values)
+        extra["curves"] = _squeal_curves(run, cfg)
     try:
-        return write_report(run, values, out, extra, site_text)
+        return write_report(run, cfg, out, extra, site_text)
     except OSError as exc:
         raise RailMonitorError(f"{out}: cannot write the report: {exc.strerror or exc}") from None
 
 
-def _reference_pass(run: RunData, values: Mapping[str, Any]) -> PassTable:
+def _reference_pass(run: RunData, site: Site) -> PassTable:
     """The most common class at its median recorded speed, in the consist of its first pass."""
-
-    site = site_from_values(values)
     names, counts = np.unique(run.passes.vehicle_class.astype(str), return_counts=True)
     cls = str(names[np.argmax(counts)])
     rows = run.passes.vehicle_class == cls
@@ -137,14 +135,13 @@ def _reference_pass(run: RunData, values: Mapping[str, Any]) -> PassTable:
                             int(run.passes.vehicle_count[np.flatnonzero(rows)[0]]))
 
 
-def _spectra(run: RunData, values: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
+def _spectra(run: RunData, cfg: SiteConfig) -> tuple[dict[str, Any], dict[str, Any]]:
     """A-weighted 1/3-octave spectra of the reference pass on the post-grinding and the final rail."""
-    from rail_monitor.noise.config import noise_config
     from rail_monitor.noise.predict import RollingNoiseModel
     from rail_monitor.noise.records import Corrugation
 
-    ref = _reference_pass(run, values)
-    model = RollingNoiseModel(site_from_values(values), noise_config(values))
+    ref = _reference_pass(run, cfg.site)
+    model = RollingNoiseModel(cfg.site, cfg.noise)
     before: dict[str, Any] = {"label": f"{ref.vehicle_class[0]} at {ref.speed_mps[0]:.1f} m/s"}
     after: dict[str, Any] = {}
     s = run.states
@@ -159,14 +156,12 @@ def _spectra(run: RunData, values: Mapping[str, Any]) -> tuple[dict[str, Any], d
     return before, after
 
 
-def _squeal_curves(run: RunData, values: Mapping[str, Any]) -> dict[str, Any]:
+def _squeal_curves(run: RunData, site_cfg: SiteConfig) -> dict[str, Any]:
     """Amplitude against crabbing velocity for the reference pass, per friction state."""
-    from rail_monitor.squeal.config import squeal_config
     from rail_monitor.whatif.squeal import site_case, sweep
 
-    ref = _reference_pass(run, values)
-    site = site_from_values(values)
-    cfg = squeal_config(values)
+    site, cfg = site_cfg.site, site_cfg.squeal
+    ref = _reference_pass(run, site)
     top = max(float(np.max(run.squeal["crabbing_velocity_mps"], initial=0.0)) * 1.1, 0.05)
     vc = np.linspace(0.0, top, 200)
     curves = {"label": f"{ref.vehicle_class[0]} at {ref.speed_mps[0]:.1f} m/s"}

@@ -13,10 +13,10 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.alerts.config import alert_config, counts_as_squeal
+from rail_monitor.alerts.config import counts_as_squeal
 from rail_monitor.core.passes import FRICTION_MODIFIER, FRICTION_NAMES
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
-from rail_monitor.corrugation.config import corrugation_config
+from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.report.run_data import RunData
 
 PERCENTILES = (50, 90, 95, 99)
@@ -25,9 +25,9 @@ FULL_FORECAST, BAND_ESTIMATE = "the model's forecast", "estimate from the band's
 TOP_SQUEALERS = 20
 
 
-def limits(values: Mapping[str, Any]) -> dict[str, Any]:
+def limits(site: SiteConfig) -> dict[str, Any]:
     """The site's alert limits the report compares with."""
-    cfg = alert_config(values, corrugation_config(values).lead_time_days)
+    cfg = site.alerts
     return {"metric": cfg.noise_metric, "limit_dba": cfg.noise_limit_dba, "squeal_min_risk": cfg.squeal_min_risk,
             "lead_time_days": cfg.lead_time_days}
 
@@ -207,11 +207,11 @@ def speed_advice(run: Any) -> list[dict]:
     return rows
 
 
-def repeat_offenders(t: Mapping[str, np.ndarray], values: Mapping[str, Any], zone: str) -> list[dict]:
+def repeat_offenders(t: Mapping[str, np.ndarray], site: SiteConfig, zone: str) -> list[dict]:
     """The vehicles (or trains) whose measured passes scored as a wheel-defect suspect
     (alerts.wheel_defect_*; rail_monitor.alerts.manager.wheel_defect_score), most often flagged
     first."""
-    cfg = alert_config(values, 60.0)
+    cfg = site.alerts
     model = cfg.residual_model
     if f"{model}_excess_mid_db" not in t:
         return []
