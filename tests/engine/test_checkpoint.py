@@ -148,7 +148,8 @@ def test_a_version_2_checkpoint_resumes_with_its_passes_in_partial_slip(site_, t
 def test_the_writer_writes_the_newest_state_off_the_callers_thread(site_, tables, tmp_path):
     """CheckpointWriter: each write on its own thread, the newest submitted state the one on disk
     after flush (one still waiting is replaced, and counted), a failure counted and reported
-    without stopping the thread, nothing written after close."""
+    without stopping the thread, nothing written after close; a snapshot is the state when it was
+    taken, whatever the state does after, and encodes to the bytes save() writes."""
     import threading
 
     est = _estimator(site_, tables)
@@ -159,7 +160,7 @@ def test_the_writer_writes_the_newest_state_off_the_callers_thread(site_, tables
                                          on_error=failures.append)
     for k in range(0, 60, 10):
         est.advance(passes.take(slice(k, k + 10)))
-        writer.submit(checkpoint.encode(est))
+        writer.submit(checkpoint.snapshot(est))
     assert writer.flush(30.0)
     assert writer.written + writer.coalesced == 6 and writer.written >= 1 and not failures
     assert threads and all(t is not threading.current_thread() for t in threads)
@@ -169,11 +170,18 @@ def test_the_writer_writes_the_newest_state_off_the_callers_thread(site_, tables
     np.testing.assert_array_equal(again.log_components, est.log_components)
     np.testing.assert_array_equal(again.kept.stamp_ns, est.kept.stamp_ns)
 
+    early = checkpoint.snapshot(est)
+    est.advance(_passes(site_, np.linspace(15, 21, 5), start_s=1e6))
+    checkpoint.write_atomically(checkpoint.encode(early), tmp_path / "early.npz")
+    checkpoint.save(again, tmp_path / "again.npz")
+    assert (tmp_path / "early.npz").read_bytes() == (tmp_path / "again.npz").read_bytes()
+    assert est.total_pass_count == 65
+
     (tmp_path / "blocked").write_text("a file where the folder should be")
     bad = checkpoint.CheckpointWriter(tmp_path / "blocked" / "corrugation.npz", on_error=failures.append)
-    bad.submit(checkpoint.encode(est))
+    bad.submit(checkpoint.snapshot(est))
     assert bad.flush(30.0) and bad.failed == 1 and bad.written == 0 and isinstance(failures[0], OSError)
-    bad.submit(checkpoint.encode(est))  # the thread goes on after a failure
+    bad.submit(checkpoint.snapshot(est))  # the thread goes on after a failure
     assert bad.close(30.0) and bad.failed == 2
     assert writer.close(30.0)
     with pytest.raises(RuntimeError, match="closed"):

@@ -56,24 +56,30 @@ def previous_checkpoint(path: str | Path) -> Path:
 
 
 def save(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None) -> None:
-    """Write the state atomically (encode, then write_atomically)."""
-    write_atomically(encode(est, observer), path)
+    """Write the state atomically (snapshot, encode, write_atomically)."""
+    write_atomically(encode(snapshot(est, observer)), path)
 
 
-def encode(est: CorrugationEstimator, observer: IndirectObserver | None = None) -> bytes:
-    """The checkpoint file's bytes of the state now (a copy: the state may move on while they are
-    written)."""
+def snapshot(est: CorrugationEstimator, observer: IndirectObserver | None = None) -> dict[str, np.ndarray]:
+    """The state's arrays now, copied and not yet converted (the cheap part: the state may move on
+    while another thread encodes them)."""
     meta = {"version": VERSION, "site_id": est.site.site_id, **{k: getattr(est, k) for k in _COUNTS},
             "newest_train_id": est.newest_train_id, "calibration_fits": est.calibration.fits}
+    arrays = dict(meta=np.array(json.dumps(meta)), bands=est.bands, log_components=est.log_components,
+                  k_b=est.k_b, survey_log_amplitude=est.survey_log_amplitude,
+                  grinding_amplitude=est.grinding_amplitude, growth_by_state=est.growth_by_state,
+                  calibration_cov=est.calibration.cov, level_var=est.level_var,
+                  calibration_mean=est.calibration.mean, season_growth=est.season.growth,
+                  season_passes=est.season.passes, season_first_day=np.array(est.season.first_day),
+                  **{f"recent_{n}": getattr(est.kept, n) for n in COLUMNS},
+                  **(observer.to_arrays() if observer is not None else {}))
+    return {name: np.array(a, copy=True) for name, a in arrays.items()}
+
+
+def encode(arrays: dict[str, np.ndarray]) -> bytes:
+    """A snapshot's checkpoint file (.npz) bytes: the kept train ids as text, every array as written."""
     buf = io.BytesIO()
-    np.savez(buf, meta=np.array(json.dumps(meta)), bands=est.bands, log_components=est.log_components,
-             k_b=est.k_b, survey_log_amplitude=est.survey_log_amplitude, grinding_amplitude=est.grinding_amplitude,
-             growth_by_state=est.growth_by_state, calibration_cov=est.calibration.cov, level_var=est.level_var,
-             calibration_mean=est.calibration.mean,
-             season_growth=est.season.growth, season_passes=est.season.passes,
-             season_first_day=np.array(est.season.first_day),
-             **{f"recent_{n}": est.kept.train_id.astype(str) if n == "train_id" else getattr(est.kept, n)
-                for n in COLUMNS}, **(observer.to_arrays() if observer is not None else {}))
+    np.savez(buf, **{name: a.astype(str) if a.dtype == object else a for name, a in arrays.items()})
     return buf.getvalue()
 
 
@@ -100,10 +106,11 @@ def write_atomically(data: bytes, path: str | Path) -> None:
 
 class CheckpointWriter:
     """Writes checkpoints on a thread of its own, so that the thread advancing the state (a node's
-    executor) only encodes them; the newest state submitted is written, an older one still waiting
-    is replaced by it (coalesced). One thread and one file: writes never overlap.
+    executor) only copies it (snapshot); the encoding and the atomic write happen here. The newest
+    snapshot submitted is written, an older one still waiting is replaced by it (coalesced). One
+    thread and one file: writes never overlap.
 
-    on_written(data) and on_error(exc) are called on the writer's thread after each write.
+    on_written(snapshot) and on_error(exc) are called on the writer's thread after each write.
     """
 
     def __init__(self, path: str | Path, on_written=None, on_error=None) -> None:
@@ -111,15 +118,15 @@ class CheckpointWriter:
         self.on_written = on_written or (lambda data: None)
         self.on_error = on_error or (lambda exc: None)
         self.written = self.failed = self.coalesced = 0
-        self._waiting: bytes | None = None
+        self._waiting: dict[str, np.ndarray] | None = None
         self._busy = False
         self._closed = False
         self._cond = threading.Condition()
         self._thread = threading.Thread(target=self._run, name="checkpoint writer", daemon=True)
         self._thread.start()
 
-    def submit(self, data: bytes) -> None:
-        """Queue a checkpoint's bytes (replacing any not yet begun)."""
+    def submit(self, data: dict[str, np.ndarray]) -> None:
+        """Queue a snapshot (replacing any not yet begun)."""
         with self._cond:
             if self._closed:
                 raise RuntimeError("checkpoint writer closed")
@@ -149,7 +156,7 @@ class CheckpointWriter:
                     return
                 data, self._waiting, self._busy = self._waiting, None, True
             try:
-                write_atomically(data, self.path)
+                write_atomically(encode(data), self.path)
             except OSError as exc:
                 self.failed += 1
                 self.on_error(exc)

@@ -237,10 +237,11 @@ class CorrugationEstimatorNode(PassConsumerNode):
         return res
 
     def save(self) -> None:
-        """Encode the state here; the writer's thread writes it (the passes behind do not wait)."""
+        """Copy the state here; the writer's thread encodes and writes it (the passes behind wait
+        only for the copy)."""
         if self.writer is None:
             return
-        self.writer.submit(checkpoint.encode(self.est, self.observer))
+        self.writer.submit(checkpoint.snapshot(self.est, self.observer))
         self._since_checkpoint = 0
 
     def _checkpoint_failed(self, exc: OSError) -> None:  # on the writer's thread
