@@ -10,8 +10,9 @@ import pytest
 
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_tables as ct
 
-T = cn.tables()
+T = ct.tables()
 
 
 def _col(name):
@@ -28,7 +29,7 @@ def test_tables_have_the_documented_shapes():
 def test_unrounded_wheel_roughness_rounds_to_printed_table_g1a():
     """The unrounded values behind G-1a agree with the printed table to its rounding (0.05 dB), on the
     printed grid (labels 120, 12, 3.2, 1.2 mm are the 125, 12.5, 3.15, 1.25 mm bands)."""
-    labels, printed = cn.printed_wheel_roughness()
+    labels, printed = ct.printed_wheel_roughness()
     label_to_band = {0.12: 0.125, 0.012: 0.0125, 0.0032: 0.00315, 0.0012: 0.00125}
     wl = np.array([label_to_band.get(round(x, 6), x) for x in labels])
     idx = [int(np.argmin(np.abs(np.log(T.wavelength_m / w)))) for w in wl]

@@ -15,9 +15,10 @@ import pytest
 
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_tables as ct
 from rail_monitor.models.levels import level, power
 
-T = cn.tables()
+T = ct.tables()
 CASES = json.loads((Path(__file__).parent / "data" / "noisemodelling_rail_emission_cases.json").read_text())["cases"]
 NOISEMODELLING_TOLERANCE_DB = 1e-4   # the tolerance of NoiseModelling's own tests (EPSILON_TEST1)
 
@@ -154,6 +155,6 @@ def test_a_shared_spectrums_power_is_read_once_and_cannot_be_changed_by_a_caller
     for _ in range(2):
         assert np.array_equal(cb.band_roughness_power(rail, wheel, a3, speed), fresh)
     shared = cb._power_at(np.asarray(wheel, float).tobytes(), speed.tobytes(), speed.shape, T.band_hz.tobytes(),
-                          cn.DEFAULT_EDITION)
+                          ct.DEFAULT_EDITION)
     with pytest.raises(ValueError, match="read-only"):
         shared += 1.0

@@ -10,8 +10,9 @@ from hypothesis import strategies as st
 
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_catalogue as cc
+from rail_monitor.models import cnossos_tables as ct
 
-T = cn.tables()
+T = ct.tables()
 
 
 def frequency_table(columns: dict[str, np.ndarray]) -> str:
@@ -86,7 +87,7 @@ def test_a_faulty_catalogue_is_refused_with_one_line(text, why):
 
 
 def test_a_2015_catalogue_is_on_the_2015_grid():
-    t15 = cn.tables("2015")
+    t15 = ct.tables("2015")
     text = wavelength_table("contact_filter_80kN_760mm", FILTER[3:], t15.wavelength_m * 1e3)
     assert (80e3, 0.76) in cc.with_catalogue(t15, text).contact_filters
     with pytest.raises(ValueError, match="edition 2015 grid's 32 values"):

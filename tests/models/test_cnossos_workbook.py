@@ -17,11 +17,12 @@ import pytest
 
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_tables as ct
 from rail_monitor.models.levels import level, power
 
 DATA = Path(__file__).parent / "data"
 EDITION = "2015"
-T = cn.tables(EDITION)
+T = ct.tables(EDITION)
 OCTAVES = ("63", "125", "250", "500", "1000", "2000", "4000", "8000")
 PRINTED_HALF_STEP_DB = 0.005
 TOLERANCE_DB = PRINTED_HALF_STEP_DB + 1e-3
@@ -118,7 +119,7 @@ def test_2021_traction_is_the_2015_database_as_printed():
     # Two transcriptions, one of the Official Journal (2021 file, 0.1 dB) and one of the reference module's
     # catalogue (2015 file, 0.01 dB), agree to the printed rounding, except the 2200 kW locomotive's
     # 6300 Hz pair that Delegated Directive (EU) 2021/1226 corrected from 31.4 / 30.7 dB to 81.4 / 80.7 dB.
-    t21 = cn.tables("2021")
+    t21 = ct.tables("2021")
     k6300 = int(np.flatnonzero(t21.band_hz == 6300.0)[0])
     for kind in t21.traction_types:
         for source in "AB":
@@ -131,7 +132,7 @@ def test_2021_traction_is_the_2015_database_as_printed():
 
 
 def test_2021_traction_one_spectrum_for_both_conditions():
-    for kind in cn.tables("2021").traction_types:
+    for kind in ct.tables("2021").traction_types:
         np.testing.assert_array_equal(cn.traction_sound_power(kind, "A", "idling"),
                                       cn.traction_sound_power(kind, "A", "constant"))
 
@@ -139,7 +140,7 @@ def test_2021_traction_one_spectrum_for_both_conditions():
 def test_unchanged_tables_agree_between_editions():
     # G-3a's ballasted columns and G-3b are printed alike in both editions; the wheel roughness behind G-1a
     # too (the 2021 file pads it to 2000 mm).
-    t15, t21 = cn.tables("2015"), cn.tables("2021")
+    t15, t21 = ct.tables("2015"), ct.tables("2021")
     for name in (n for n in t15.by_frequency if n.startswith(("track_", "vehicle_wheel_", "aerodynamic_"))):
         np.testing.assert_array_equal(t15.by_frequency[name], t21.by_frequency[name], err_msg=name)
     common = np.isin(t21.wavelength_m, t15.wavelength_m)
@@ -151,7 +152,7 @@ def test_unchanged_tables_agree_between_editions():
 def test_aerodynamic_speed_law():
     # Table G-6: L_W,0,1 at v0 = 300 km/h, alpha = 50 per decade of speed; nothing at or below 200 km/h.
     at_v0 = cn.aerodynamic_sound_power(300.0, "A")
-    np.testing.assert_array_equal(at_v0, cn.tables().by_frequency["aerodynamic_A_300kmh"])
+    np.testing.assert_array_equal(at_v0, ct.tables().by_frequency["aerodynamic_A_300kmh"])
     np.testing.assert_allclose(cn.aerodynamic_sound_power(150.0 * 4.0, "B") - cn.aerodynamic_sound_power(300.0, "B"),
                                50.0 * np.log10(2.0), rtol=0, atol=1e-12)
     assert np.all(np.isneginf(cn.aerodynamic_sound_power(200.0, "A")))
@@ -164,7 +165,7 @@ def test_idling_line_power_is_energy_per_metre():
 
 def test_edition_refusals():
     with pytest.raises(ValueError, match="edition"):
-        cn.tables("2018")
+        ct.tables("2018")
     with pytest.raises(ValueError, match="2021 edition"):
         cb.band_roughness(T.by_wavelength["rail_roughness_E_iso3095"], 0.0, 0.0, 20.0, rule="noisemodelling",
                           edition="2015")

@@ -10,6 +10,7 @@ from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.core.site import site_from_values
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_tables as ct
 from rail_monitor.models.corrugation import band_limits, wavelength_bands
 from rail_monitor.noise.config import MODELS, noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
@@ -53,7 +54,7 @@ def test_doubling_the_speed_adds_about_9_db(model, name, vehicle_class):
 
 def _grown(model, added_db: float) -> Corrugation:
     """Corrugation that, added in energy, lifts the rail roughness at 31.5-80 mm by added_db."""
-    wl = cn.tables().wavelength_m
+    wl = ct.tables().wavelength_m
     bands = wl[(wl >= 0.0315 - 1e-9) & (wl <= 0.080 + 1e-9)]
     base = np.interp(bands, wl, model.baseline_db)
     amp = 1e-6 * 10 ** ((base + added_db) / 20) * np.sqrt(1 - 10 ** (-added_db / 10))
@@ -230,7 +231,7 @@ def test_a_freshly_ground_state_is_the_baseline_and_only_growth_is_added(model):
         assert model.predict(passes, name, Corrugation(bands, post, post)).lpaeq_tp_dba[0] == pytest.approx(
             model.predict(passes, name).lpaeq_tp_dba[0], abs=1e-12)
     grown = Corrugation(bands, 2 * post, post)
-    wl = cn.tables().wavelength_m
+    wl = ct.tables().wavelength_m
     i = int(np.argmin(np.abs(wl - bands[8])))                       # a table wavelength on a state band
     want = 10 * np.log10(10 ** (model.baseline_db[i] / 10) + (3 * post[8] ** 2) / 1e-12)
     assert model.rail_roughness_db(grown)[i] == pytest.approx(want, abs=1e-9)

@@ -55,22 +55,23 @@ References
 
 from __future__ import annotations
 
-import csv
-import io
 from dataclasses import dataclass
-from functools import lru_cache
-from importlib import resources
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rail_monitor.models.iec61260 import band_index
+from rail_monitor.models.cnossos_tables import (
+    DEFAULT_EDITION,
+    Tables,
+    as_tables,
+    check_edition,
+    check_rule_edition,
+    noisemodelling_wheel_roughness,
+)
 from rail_monitor.models.levels import level, power
 
 FloatArray = NDArray[np.float64]
 
-EDITIONS = ("2015", "2021")
-DEFAULT_EDITION = "2021"
 RAIL_ROUGHNESS_CLASSES = ("E", "M")
 BRAKE_TYPES = ("cast_iron", "composite", "disc")   # Table G-1a columns
 SLEEPER_TYPES = ("monoblock", "biblock", "wooden", "direct_fastening")
@@ -86,95 +87,6 @@ TRACTION_TYPES = ("diesel_loco_800kw", "diesel_loco_2200kw", "diesel_loco_1180kw
 AERODYNAMIC_ONSET_KMH = 200.0           # aerodynamic noise is taken into account above this speed (2.3.2)
 
 
-def table_rows(text: str) -> list[list[str]]:
-    """The rows of a table file's text: CSV, lines starting with # are comments."""
-    return [[cell.strip() for cell in r] for r in csv.reader(io.StringIO(text)) if r and not r[0].startswith("#")]
-
-
-def _read(name: str) -> tuple[list[str], FloatArray]:
-    rows = table_rows(resources.files("rail_monitor").joinpath("data", name).read_text(encoding="utf-8"))
-    return rows[0], np.array(rows[1:], float)
-
-
-@dataclass(frozen=True)
-class Tables:
-    """Appendix G of one edition. Wavelength tables on an ascending wavelength grid [m];
-    frequency tables on the 24 nominal band centres (band numbers x of IEC 61260-1)."""
-
-    edition: str
-    wavelength_m: FloatArray
-    by_wavelength: dict[str, FloatArray]
-    band: NDArray[np.int64]
-    band_hz: FloatArray
-    by_frequency: dict[str, FloatArray]
-
-    @property
-    def contact_filters(self) -> dict[tuple[float, float], FloatArray]:
-        """A_3 [dB] by (wheel load [N], wheel diameter [m]) (Table G-2)."""
-        out = {}
-        for name, col in self.by_wavelength.items():
-            if name.startswith("contact_filter_"):
-                load, dia = name.removeprefix("contact_filter_").split("_")
-                out[(float(load.removesuffix("kN")) * 1e3, float(dia.removesuffix("mm")) / 1e3)] = col
-        return out
-
-    @property
-    def vehicle_transfers(self) -> dict[float, FloatArray]:
-        """L_H,VEH [dB] by wheel diameter [m] (Table G-3b)."""
-        return {float(n.removeprefix("vehicle_wheel_").removesuffix("mm")) / 1e3: c
-                for n, c in self.by_frequency.items() if n.startswith("vehicle_wheel_")}
-
-    @property
-    def traction_types(self) -> tuple[str, ...]:
-        """The vehicle types of Table G-5 in this edition."""
-        names = (n.removeprefix("traction_").rsplit("_", 2)[0] for n in self.by_frequency if n.startswith("traction_"))
-        return tuple(dict.fromkeys(names))
-
-    def column(self, name: str, what: str) -> FloatArray:
-        """A table column by name; a one-line error naming the edition where it has none."""
-        found = self.by_frequency.get(name, self.by_wavelength.get(name))
-        if found is None:
-            raise ValueError(f"CNOSSOS-EU edition {self.edition} has no {what}")
-        return found
-
-
-def _as_tables(edition: str | Tables) -> Tables:
-    """The tables themselves, or an edition's (a site's own catalogue: models.cnossos_catalogue)."""
-    return edition if isinstance(edition, Tables) else tables(edition)
-
-
-def check_edition(edition: str) -> str:
-    if edition not in EDITIONS:
-        raise ValueError(f"unknown CNOSSOS-EU edition {edition!r}; use one of {EDITIONS}")
-    return edition
-
-
-def check_rule_edition(rule: str, edition: str) -> str:
-    """The interpolation rule, refused where its implementation has no tables of the edition."""
-    if rule == "noisemodelling" and check_edition(edition) != "2021":
-        raise ValueError("the noisemodelling interpolation rule reads the 2021 edition's tables only")
-    return rule
-
-
-@lru_cache(maxsize=len(EDITIONS))
-def tables(edition: str = DEFAULT_EDITION) -> Tables:
-    """The Appendix G tables of an edition (read once)."""
-    check_edition(edition)
-    head, data = _read(f"cnossos_eu_{edition}_wavelength.csv")
-    order = np.argsort(data[:, 0])
-    by_wl = {h: data[order, j] for j, h in enumerate(head) if j}
-    fhead, fdata = _read(f"cnossos_eu_{edition}_frequency.csv")
-    return Tables(edition=edition, wavelength_m=data[order, 0] / 1e3, by_wavelength=by_wl,
-                  band=band_index(fdata[:, 0]), band_hz=fdata[:, 0],
-                  by_frequency={h: fdata[:, j] for j, h in enumerate(fhead) if j})
-
-
-def printed_wheel_roughness() -> tuple[FloatArray, dict[str, FloatArray]]:
-    """Table G-1a as printed (rounded): wavelength labels [m] and levels by column [dB re 1 um]."""
-    head, data = _read("cnossos_eu_2021_g1a_printed.csv")
-    return data[:, 0] / 1e3, {h: data[:, j] for j, h in enumerate(head) if j}
-
-
 # -- roughness and contact filter (wavelength domain) --------------------------------------------
 def rail_roughness(roughness_class: str, edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
     """Rail roughness [dB re 1 um] of class E (EN ISO 3095:2013) or M (average network), Table G-1b
@@ -182,7 +94,7 @@ def rail_roughness(roughness_class: str, edition: str | Tables = DEFAULT_EDITION
     names = {"E": "rail_roughness_E_iso3095", "M": "rail_roughness_M_average_network"}
     if roughness_class not in names:
         raise ValueError(f"rail roughness class must be one of {RAIL_ROUGHNESS_CLASSES}")
-    return _as_tables(edition).by_wavelength[names[roughness_class]]
+    return as_tables(edition).by_wavelength[names[roughness_class]]
 
 
 def wheel_roughness(brake_type: str, rule: str = "reference", edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
@@ -192,19 +104,10 @@ def wheel_roughness(brake_type: str, rule: str = "reference", edition: str | Tab
     data/noisemodelling_wheel_roughness.csv; they differ by at most 0.005 dB)."""
     if brake_type not in BRAKE_TYPES:
         raise ValueError(f"brake type must be one of {BRAKE_TYPES}")
-    t = _as_tables(edition)
+    t = as_tables(edition)
     if check_rule_edition(rule, t.edition) == "noisemodelling":
-        return _noisemodelling_wheel_roughness()[brake_type]
+        return noisemodelling_wheel_roughness()[brake_type]
     return t.by_wavelength[f"wheel_roughness_{brake_type}_unrounded"]
-
-
-@lru_cache(maxsize=1)
-def _noisemodelling_wheel_roughness() -> dict[str, FloatArray]:
-    head, data = _read("noisemodelling_wheel_roughness.csv")
-    order = np.argsort(data[:, 0])
-    if not np.array_equal(data[order, 0] / 1e3, tables().wavelength_m):
-        raise ValueError("noisemodelling_wheel_roughness.csv: its wavelengths are not the tables' grid")
-    return {h: data[order, j] for j, h in enumerate(head) if j}
 
 
 def contact_filter(wheel_load_n: float, wheel_diameter_m: float,
@@ -215,14 +118,14 @@ def contact_filter(wheel_load_n: float, wheel_diameter_m: float,
     the contact length, which grows with both). Edition 2015 here holds the 920 mm / 50 kN entry
     only. Returns the entry and its column.
     """
-    entries = _as_tables(edition).contact_filters
+    entries = as_tables(edition).contact_filters
     key = min(entries, key=lambda k: (abs(np.log(k[1] / wheel_diameter_m)), abs(np.log(k[0] / wheel_load_n))))
     return key, entries[key]
 
 
 def impact_roughness(joints_per_m: float, edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
     """L_R,IMPACT [dB re 1 um] for a joint density n_l [1/m] (eq. 2.3.11; table for 1 per 100 m)."""
-    return _as_tables(edition).by_wavelength["impact_single_joint_per_100m"] + 10.0 * np.log10(joints_per_m / 0.01)
+    return as_tables(edition).by_wavelength["impact_single_joint_per_100m"] + 10.0 * np.log10(joints_per_m / 0.01)
 
 
 def total_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike,
@@ -244,7 +147,7 @@ def pad_class(pad_stiffness_npm: float) -> str:
 def track_transfer(sleeper_type: str, pad_stiffness_npm: float,
                    edition: str | Tables = DEFAULT_EDITION) -> tuple[str, FloatArray]:
     """L_H,TR [dB per axle] (Table G-3a) for a sleeper type and pad stiffness: (column, values)."""
-    t = _as_tables(edition)
+    t = as_tables(edition)
     if sleeper_type == "wooden":
         name = "track_wooden_sleepers"
     elif sleeper_type == "direct_fastening":
@@ -258,7 +161,7 @@ def track_transfer(sleeper_type: str, pad_stiffness_npm: float,
 
 def vehicle_transfer(wheel_diameter_m: float, edition: str | Tables = DEFAULT_EDITION) -> tuple[float, FloatArray]:
     """L_H,VEH [dB per axle] (Table G-3b) of the nearest tabulated wheel diameter: (diameter [m], values)."""
-    entries = _as_tables(edition).vehicle_transfers
+    entries = as_tables(edition).vehicle_transfers
     key = min(entries, key=lambda dia: abs(np.log(dia / wheel_diameter_m)))
     return key, entries[key]
 
@@ -271,7 +174,7 @@ def bridge_transfer(bridge_type: str, edition: str | Tables = DEFAULT_EDITION) -
         return None
     if bridge_type not in columns:
         raise ValueError(f"bridge type must be one of {BRIDGE_TYPES}")
-    return _as_tables(edition).column(columns[bridge_type], "bridge transfer table (the 2015 text adds a constant)")
+    return as_tables(edition).column(columns[bridge_type], "bridge transfer table (the 2015 text adds a constant)")
 
 
 # -- sound power ---------------------------------------------------------------------------------
@@ -387,7 +290,7 @@ def traction_sound_power(traction_type: str, source: str, condition: str = "cons
                          edition: str | Tables = DEFAULT_EDITION) -> FloatArray:
     """L_W,0 per vehicle [dB re 1 pW] of traction noise (Table G-5), 24 bands, at source A or B,
     at constant speed or idling. The 2021 table gives one spectrum for both conditions."""
-    t = _as_tables(edition)
+    t = as_tables(edition)
     if traction_type not in t.traction_types:
         raise ValueError(f"traction type must be one of {t.traction_types} (edition {edition})")
     if condition not in RUNNING_CONDITIONS:
@@ -403,7 +306,7 @@ def aerodynamic_sound_power(speed_kmh: ArrayLike, source: str, edition: str | Ta
     """L_W,0 per vehicle [dB re 1 pW] of aerodynamic noise (Table G-6): L_W,0,1 + alpha lg(v / v0)
     above 200 km/h, -inf (no power) at or below it: shape speed.shape + (24,)."""
     v = np.asarray(speed_kmh, float)[..., None]
-    spectrum = _as_tables(edition).by_frequency[f"aerodynamic_{_check_source(source)}_300kmh"]
+    spectrum = as_tables(edition).by_frequency[f"aerodynamic_{_check_source(source)}_300kmh"]
     with np.errstate(divide="ignore"):
         return np.where(v > AERODYNAMIC_ONSET_KMH, spectrum + alpha * np.log10(v / v0_kmh), -np.inf)
 

@@ -40,7 +40,7 @@ import functools
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rail_monitor.models.cnossos import DEFAULT_EDITION, check_rule_edition, tables
+from rail_monitor.models.cnossos_tables import DEFAULT_EDITION, check_rule_edition, tables
 from rail_monitor.models.iec61260 import band_index, exact_centre
 from rail_monitor.models.levels import level, power
 

@@ -9,7 +9,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from rail_monitor.models.cnossos import SOURCE_HEIGHTS, Tables, table_rows
+from rail_monitor.models.cnossos import SOURCE_HEIGHTS
+from rail_monitor.models.cnossos_tables import Tables, table_rows
 
 # A user's catalogue (with_catalogue): what its columns may add, by the table's first column.
 CATALOGUE_COLUMNS = {

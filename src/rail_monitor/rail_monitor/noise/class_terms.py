@@ -12,6 +12,7 @@ import numpy as np
 from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.site import Site, VehicleClass
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_tables as ct
 from rail_monitor.models import wheel_modes as wm
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.track import Track
@@ -40,7 +41,7 @@ class ClassTerms:
     traction: dict[str, np.ndarray]      # CNOSSOS L_W,0 per vehicle by source [dB re 1 pW], 24 bands
 
 
-def class_terms(site: Site, cfg: NoiseConfig, tables: cn.Tables, track_db: np.ndarray, rolling_excess_db: float,
+def class_terms(site: Site, cfg: NoiseConfig, tables: ct.Tables, track_db: np.ndarray, rolling_excess_db: float,
                 bridge_db: np.ndarray | None) -> dict[str, ClassTerms]:
     """Every class's terms. rolling_excess_db: added to every CNOSSOS-EU rolling transfer (the
     curve-squeal term and the 2015 bridge constant); bridge_db: Table G-7's transfer or None."""

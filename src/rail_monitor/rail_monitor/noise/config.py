@@ -13,6 +13,7 @@ from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_tables as ct
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.cnossos_catalogue import with_catalogue
 from rail_monitor.models.passby import Receiver
@@ -29,16 +30,16 @@ _CLASS_E = cn.rail_roughness("E")
 NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("model", "cnossos", "Source model of noise/rolling: CNOSSOS-EU (Directive 2015/996 as amended by "
               "2021/1226), the mechanics model, or both (one message per model).", choices=(*MODELS, "both")),
-    ParamSpec("cnossos_edition", cn.DEFAULT_EDITION, "Edition of CNOSSOS-EU's Appendix G: 2021 (Directive 2015/996 "
+    ParamSpec("cnossos_edition", ct.DEFAULT_EDITION, "Edition of CNOSSOS-EU's Appendix G: 2021 (Directive 2015/996 "
               "as amended by 2021/1226, in force) or 2015 (the 2015 text at the precision of the European Commission's "
               "reference module: its scalar bridge constant, absolute vertical directivity, 920 mm contact filter).",
-              choices=cn.EDITIONS),
+              choices=ct.EDITIONS),
     ParamSpec("interpolation", "reference", "Wavelength-to-frequency rule: the European reference module's (each "
               "table mapped on its own, dB linear in wavelength, ends held) or NoiseModelling's (energy linear in lg f "
               "on its grid, joints before the contact filter).", choices=cb.INTERPOLATION_RULES),
     ParamSpec("rail_roughness", "E", "Baseline rail roughness: class E (EN ISO 3095:2013), class M (CNOSSOS "
               "average network) or the measured spectrum below.", choices=ROUGHNESS_SOURCES),
-    ParamSpec("rail_roughness_wavelength_m", cn.tables().wavelength_m.tolist(), "Wavelengths of the measured "
+    ParamSpec("rail_roughness_wavelength_m", ct.tables().wavelength_m.tolist(), "Wavelengths of the measured "
               "rail roughness, ascending [m] (default: the CNOSSOS grid).", 1e-4, 10.0),
     ParamSpec("rail_roughness_db", _CLASS_E.tolist(), "Measured rail roughness per 1/3-octave wavelength band "
               "[dB re 1 um] (default: class E).", -60.0, 80.0),
@@ -104,7 +105,7 @@ def selected_models(model: str) -> tuple[str, ...]:
 
 def band_centres_hz() -> np.ndarray:
     """The nominal 1/3-octave band centres every noise prediction is given on [Hz]."""
-    return cn.tables().band_hz
+    return ct.tables().band_hz
 
 
 @dataclass(frozen=True)
@@ -164,12 +165,12 @@ def noise_config(values: Mapping[str, Any], prefix: str = "noise.") -> NoiseConf
     return values_of(NoiseConfig, values)
 
 
-def site_tables(edition: str, catalogue: str) -> cn.Tables:
+def site_tables(edition: str, catalogue: str) -> ct.Tables:
     """The CNOSSOS-EU tables a site selects: its edition's, with its catalogue."""
-    return with_catalogue(cn.tables(edition), catalogue)
+    return with_catalogue(ct.tables(edition), catalogue)
 
 
-def check_traction(site: Site, cfg: NoiseConfig) -> cn.Tables:
+def check_traction(site: Site, cfg: NoiseConfig) -> ct.Tables:
     """ConfigError for a vehicle class whose traction type the site's tables lack; the tables."""
     tables = site_tables(cfg.cnossos_edition, cfg.cnossos_catalogue)
     for name, v in site.vehicles.items():
