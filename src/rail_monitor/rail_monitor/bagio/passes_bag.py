@@ -8,17 +8,18 @@ from pathlib import Path
 
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.codec.cdr import serialize
+from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.codec.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
-from rail_monitor.messages.fields import measured_pass_noise_fields, roughness_survey_fields, train_pass_fields
+from rail_monitor.messages.fields import measured_pass_noise_fields, roughness_survey_fields, train_pass_columns
 from rail_monitor.messages.topics import EVENT, STREAM
 
 
 def pass_cdr(table: PassTable, frame_id: str) -> list[bytes]:
-    """CDR bytes of a TrainPass per row."""
-    return [serialize(TRAIN_PASS, train_pass_fields(table.row(i), frame_id)) for i in range(len(table))]
+    """CDR bytes of a TrainPass per row, written together from the table's columns."""
+    return serialize_columns(TRAIN_PASS, train_pass_columns(table, frame_id), len(table))
 
 
 def write_passes_bag(table: PassTable, folder: str | Path, frame_id: str, topic: str = "/train_pass",
