@@ -98,3 +98,16 @@ def test_separators_and_control_characters_in_a_field_stay_in_their_row(tmp_path
     with pytest.raises(InputError, match=r"line 2: .*field larger than field limit"):
         read_csv(big)
     assert len(read_csv(big, skip_bad_rows=True)) == 0
+
+
+def test_a_malformed_row_names_the_way_to_read_the_rest(tmp_path: Path):
+    """Issue 52: the one-line refusal of a file with a malformed row says how to go on, and doing
+    so reads every other row."""
+    p = tmp_path / "one_bad.csv"
+    p.write_text(HEADER + ROW + ROW.replace("19.0", "fast") + ROW.replace("T1", "T2"), encoding="utf-8")
+    with pytest.raises(InputError) as caught:
+        read_csv(p)
+    message = str(caught.value)
+    assert "line 3: " in message and "--skip-bad-rows" in message and "skip_bad_rows:=true" in message
+    assert "\n" not in message
+    assert list(read_csv(p, skip_bad_rows=True).train_id) == ["T1", "T2"]

@@ -13,8 +13,6 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from rail_monitor.alerts.config import ALERT_SPECS
 from rail_monitor.core import node_params
 from rail_monitor.core.errors import ConfigError
@@ -29,6 +27,7 @@ from rail_monitor.core.site import (
     Site,
     site_from_values,
 )
+from rail_monitor.core.yaml_text import load_yaml
 from rail_monitor.corrugation.config import CORRUGATION_SPECS
 from rail_monitor.measured.config import RESIDUAL_SPECS
 from rail_monitor.noise.config import NOISE_SPECS
@@ -78,9 +77,10 @@ def check_names(values: Mapping[str, Any], where: str = "") -> None:
 
 def _read_document(path: Path, text: str | None = None) -> Mapping[str, Any]:
     try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8") if text is None else text)
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        text = path.read_text(encoding="utf-8") if text is None else text
+    except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: cannot read parameter file: {str(exc).splitlines()[0]}") from None
+    doc = load_yaml(text, f"{path}: cannot read parameter file", ConfigError)
     if not isinstance(doc, Mapping) or not doc:
         raise ConfigError(f"{path}: not a ROS 2 parameter file (expected '/**: ros__parameters: ...')")
     return doc

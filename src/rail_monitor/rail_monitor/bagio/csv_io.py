@@ -131,6 +131,10 @@ def csv_cells(line: str, header: list[str]) -> list[str]:
     return cells
 
 
+SKIP_HINT = ("; to read the rest, leave malformed rows out with rail-monitor batch --skip-bad-rows "
+             "(pass_replayer: skip_bad_rows:=true)")
+
+
 def read_csv(path: str | Path, skip_bad_rows: bool = False) -> PassTable:
     """Read a detector CSV. A malformed row is an error naming its line, unless skip_bad_rows
     (then it is left out; read_csv_rows says which)."""
@@ -175,7 +179,7 @@ def read_csv_rows(path: str | Path, skip_bad_rows: bool = False) -> tuple[PassTa
             rows.append(row)
         except ValueError as exc:
             if not skip_bad_rows:
-                raise InputError(f"{path}: line {n}: {exc}") from None
+                raise InputError(f"{path}: line {n}: {exc}{SKIP_HINT}") from None
             why.append(f"line {n}: {exc}")
     return PassTable.from_rows(rows), why
 

@@ -20,7 +20,6 @@ from io import BytesIO
 from pathlib import Path
 from typing import Any
 
-import yaml
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Footer, Message, Schema, Statistics
@@ -28,6 +27,7 @@ from mcap.stream_reader import breakup_chunk
 
 from rail_monitor.bagio.mcap_bag import OPEN_FILE_KEY
 from rail_monitor.core.errors import InputError
+from rail_monitor.core.yaml_text import load_yaml
 
 MAGIC = b"\x89MCAP0\r\n"
 _FRAME = struct.Struct("<BQ")  # opcode, content length
@@ -174,8 +174,10 @@ def bag_files(path: Path) -> tuple[list[Path], dict[str, Any] | None]:
     if not meta_path.exists():
         return [path / n for n in on_disk], None
     try:
-        meta = yaml.safe_load(meta_path.read_text(encoding="utf-8"))["rosbag2_bagfile_information"]
+        meta = load_yaml(meta_path.read_text(encoding="utf-8"), str(meta_path))["rosbag2_bagfile_information"]
         listed = [str(p) for p in meta.get("relative_file_paths") or []]
+    except InputError:
+        raise
     except Exception as exc:
         raise InputError(f"{meta_path}: not a rosbag2 metadata file: {type(exc).__name__}") from None
     if len(set(listed)) < len(listed):

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rail_monitor.bagio.csv_io import TIME_COLUMNS, csv_cells, csv_lines
+from rail_monitor.bagio.csv_io import SKIP_HINT, TIME_COLUMNS, csv_cells, csv_lines
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.measured.records import Measurement
@@ -86,7 +86,7 @@ def read_measured_csv(path: str | Path, skip_bad_rows: bool = False) -> list[Mea
                 ids, levels if levels is not None else np.zeros(0)))
         except (ValueError, RailMonitorError) as exc:
             if not skip_bad_rows:
-                raise InputError(f"{path}: line {n}: {exc}") from None
+                raise InputError(f"{path}: line {n}: {exc}{SKIP_HINT}") from None
             skipped.append(f"line {n}: {exc}")
     result = _Measurements(out)
     result.skipped_rows = skipped

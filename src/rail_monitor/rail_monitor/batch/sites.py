@@ -26,10 +26,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
-import yaml
-
 from rail_monitor.bagio.output_folder import beside
 from rail_monitor.core.errors import ConfigError, RailMonitorError
+from rail_monitor.core.yaml_text import load_yaml
 
 
 # One site of a manifest: its site file, its history, and the bag folder to write.
@@ -57,9 +56,10 @@ def read_manifest(path: str | Path) -> list[SiteJob]:
     """The jobs of a manifest (ConfigError with one line naming the entry at fault)."""
     path = Path(path)
     try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: cannot read the manifest: {str(exc).splitlines()[0]}") from None
+    doc = load_yaml(text, f"{path}: cannot read the manifest", ConfigError)
     entries = doc.get("sites") if isinstance(doc, dict) else None
     if not isinstance(entries, list) or not entries:
         raise ConfigError(f"{path}: expected 'sites:' with a list of entries (site:, history:, output:)")

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.errors import ConfigError, RailMonitorError
 from rail_monitor.core.params import ParamSpec
 from rail_monitor.core.text import jsonable
 
@@ -128,13 +128,13 @@ def ros_args(ns: argparse.Namespace, site: Path | None, extra: dict[str, object]
 def _split_parameter_rules(argv: list[str]) -> tuple[list[str], dict[str, object]]:
     """The ROS arguments without their -p/--param rules, and those rules' values (parsed as YAML,
     as rcl parses them)."""
-    import yaml
+    from rail_monitor.core.yaml_text import load_yaml
 
     rest, values, i = [], {}, 0
     while i < len(argv):
         if argv[i] in ("-p", "--param") and i + 1 < len(argv) and ":=" in argv[i + 1]:
             name, text = argv[i + 1].split(":=", 1)
-            values[name] = yaml.safe_load(text) if text else ""
+            values[name] = load_yaml(text, f"-p {name}", ConfigError) if text else ""
             i += 2
         else:
             rest.append(argv[i])

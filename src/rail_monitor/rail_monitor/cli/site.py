@@ -10,6 +10,7 @@ from typing import Any
 
 from rail_monitor.cli.common import add_site_option, site_file
 from rail_monitor.core.errors import ConfigError, RailMonitorError
+from rail_monitor.core.yaml_text import load_yaml
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -39,7 +40,13 @@ def run(ns: argparse.Namespace) -> int:
             literal["noise.cnossos_catalogue"] = Path(ns.cnossos_catalogue).read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise RailMonitorError(f"{ns.cnossos_catalogue}: cannot read the catalogue: {exc}") from None
-    text, changed = edited_site_text(site_file(ns.site).read_text(encoding="utf-8"), ns.changes, literal)
+    source = site_file(ns.site)
+    try:
+        original = source.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{source}: cannot read parameter file: {exc}") from None
+    load_yaml(original, f"{source}: cannot read parameter file", ConfigError)  # one line for any YAML fault
+    text, changed = edited_site_text(original, ns.changes, literal)
     tmp = out.with_name(f".{out.name}.tmp")
     try:
         tmp.write_text(text, encoding="utf-8")
@@ -63,7 +70,6 @@ def edited_site_text(text: str, changes: list[str], literal: dict[str, str] | No
     """The site file's text with each NAME=VALUE set where the file sets NAME (in whichever
     section), else under ``/**``; comments and layout kept (ruamel.yaml round trip). literal: names
     set to a text kept line for line (a YAML block scalar). Returns the text and a line per change."""
-    import yaml
     from ruamel.yaml import YAML
     from ruamel.yaml.scalarstring import LiteralScalarString
 
@@ -76,10 +82,7 @@ def edited_site_text(text: str, changes: list[str], literal: dict[str, str] | No
         name, sep, raw = change.partition("=")
         if not sep or not name.strip():
             raise RailMonitorError(f"--set {change!r}: expected NAME=VALUE")
-        try:
-            value = yaml.safe_load(raw)
-        except yaml.YAMLError as exc:
-            raise RailMonitorError(f"--set {change!r}: the value is not YAML: {str(exc).splitlines()[0]}") from None
+        value = load_yaml(raw, f"--set {change!r}: the value", RailMonitorError)
         old = _set(doc, name.strip(), value)
         lines.append(f"{name.strip()}: {old!r} -> {value!r}")
     for name, block in (literal or {}).items():

@@ -13,7 +13,8 @@ rail_msgs/IndirectRoughness). Publishes
 and ``speed_advisory`` (rail_msgs/SpeedAdvisory, every ``advisory_period_s``), both latched;
 serves ``evaluate_speed_distribution``. With
 ``checkpoint_path`` set, the state is written atomically every ``checkpoint_every_passes``
-passes, after every survey and at shutdown, and a restart resumes from it.
+passes, after every survey and at shutdown (the executor copies it; a writer thread encodes and
+writes it, rail_monitor.engine.checkpoint.CheckpointWriter), and a restart resumes from it.
 """
 
 from __future__ import annotations
