@@ -107,6 +107,13 @@ def _meta(bag: Path, edit) -> None:
      "on /train_pa"),
     ("a lying topic count", lambda m: m["topics_with_message_count"][0].update(message_count=9999), "9999"),
     ("a lying total", lambda m: m.update(message_count=9999), "9999"),
+    # Issue 52: a type its files do not hold, and a start no stamp can hold (2**70 ns crashed `info`).
+    ("a lying topic type", lambda m: m["topics_with_message_count"][0]["topic_metadata"].update(
+        type="std_msgs/msg/String"), "says topic /train_pass is std_msgs/msg/String, its files hold rail_msgs"),
+    ("a start in the year 39381", lambda m: m["starting_time"].update(nanoseconds_since_epoch=2**70),
+     "not times a stamp can hold"),
+    ("a negative duration", lambda m: m["duration"].update(nanoseconds=-1), "not times a stamp can hold"),
+    ("no starting time", lambda m: m.pop("starting_time"), "starting_time"),
 ])
 def test_a_lying_metadata_file_is_refused(small, tmp_path, what, edit, match):
     bag, _ = _copy(small, tmp_path)
@@ -135,6 +142,35 @@ def test_salvage_skips_a_damaged_chunk_and_reads_every_intact_one(small, tmp_pat
     kept = set(zip(salvaged.stamp_ns.tolist(), salvaged.train_id.tolist(), strict=True))
     assert kept <= set(zip(whole.stamp_ns.tolist(), whole.train_id.tolist(), strict=True))
     assert int(salvaged.stamp_ns.max()) == int(whole.stamp_ns.max())  # the last chunk is intact
+
+
+def test_salvage_uses_the_summarys_channels_when_the_first_chunk_is_damaged(small, tmp_path):
+    """Issue 52: the first chunk holds the data's only schema and channel records; damaged, salvage
+    placed none of the later chunks' messages ("salvaged 0 messages"). The summary's copies place
+    them now: every pass of every intact chunk comes back."""
+    whole = read_bag_passes(small)
+    bag, f = _copy(small, tmp_path)
+    chunks = [(start, length) for opcode, start, length in _frames(f.read_bytes()) if opcode == CHUNK]
+    start, length = chunks[0]
+    _flip(f, start + 9 + length - 50)
+    salvaged, read = read_passes_reported(bag, salvage=True)
+    assert read.salvage.damaged_chunks == 1 and read.salvage.unplaced == 0
+    lost = len(whole) - len(salvaged)
+    assert 0 < lost < len(whole) / 2 and len(chunks) >= 4
+    assert salvaged.equals(whole.take(slice(lost, None)))  # all but the first chunk's passes, as written
+
+
+def test_the_campaigns_salvage_repro_on_the_sample(tmp_path):
+    """The campaign's repro: byte 74 of the sample flipped (inside its first chunk); the second
+    chunk's 691 passes come back."""
+    bag = tmp_path / "m"
+    shutil.copytree(SAMPLE, bag)
+    f = bag / "sample_0.mcap"
+    data = bytearray(f.read_bytes())
+    data[74] ^= 1
+    f.write_bytes(bytes(data))
+    salvaged, read = read_passes_reported(bag, salvage=True)
+    assert read.salvage.damaged_chunks == 1 and len(salvaged) >= 691, read.salvage.line(bag)
 
 
 def test_the_sample_and_a_recorded_bag_pass_the_checks():

@@ -27,6 +27,7 @@ from mcap.stream_reader import breakup_chunk
 
 from rail_monitor.bagio.mcap_bag import OPEN_FILE_KEY
 from rail_monitor.core.errors import InputError
+from rail_monitor.core.timeutil import TIME_MSG_END_NS
 from rail_monitor.core.yaml_text import load_yaml
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -53,6 +54,8 @@ class Scan:
     statistics: dict[str, int] | None = None                   # the Statistics record's count per topic
     summary_crc_ok: bool | None = None                         # None: no summary CRC to check
     summary_mismatch: int = 0                                  # summary schemas/channels unlike the data's
+    unplaced: int = 0                                          # messages on a channel no intact record defines
+    types: dict[str, str] = field(default_factory=dict)        # each topic's schema name
 
     def problems(self) -> list[str]:
         """Why the file disagrees with itself, one phrase each (empty: it does not)."""
@@ -65,6 +68,8 @@ class Scan:
             out.append("its summary fails its CRC")
         if self.summary_mismatch:
             out.append(f"{self.summary_mismatch} schema or channel record(s) of its summary differ from its data")
+        if self.unplaced:
+            out.append(f"{self.unplaced} message(s) on channels no intact record defines")
         if self.statistics is not None and dict(self.statistics) != {t: n for t, n in self.counts.items() if n}:
             for topic in sorted(set(self.statistics) | set(self.counts)):
                 want, got = self.statistics.get(topic, 0), self.counts.get(topic, 0)
@@ -100,30 +105,19 @@ def _per_topic(stats: Statistics, channel_ids: dict[str, set[int]]) -> dict[str,
 
 def scan_mcap(path: str | Path, keep: bool = False) -> tuple[Scan, list[ScannedMessage]]:
     """Read an MCAP file in file order: the counts of what its intact records hold and, with keep,
-    the messages themselves (log-time order is the caller's to impose)."""
+    the messages themselves (log-time order is the caller's to impose).
+
+    Schemas and channels are learned from every intact copy, the data's and the summary's, before
+    any message is placed: a damaged chunk that held the only data copy of a channel loses its own
+    messages, not the later chunks' (issue 52). A message on a channel no intact record defines is
+    counted in ``unplaced``."""
     path = Path(path)
     data = path.read_bytes()
     scan = Scan(path)
     if not data.startswith(MAGIC):
         raise InputError(f"{path}: not an MCAP file (no magic)")
-    schemas: dict[int, str] = {}
-    channels: dict[int, tuple[str, int]] = {}
-    kept: list[ScannedMessage] = []
-    channel_ids: dict[str, set[int]] = {}
-
-    def take(records: list[Any]) -> None:
-        for rec in records:
-            if isinstance(rec, Schema):
-                schemas[rec.id] = rec.name
-            elif isinstance(rec, Channel):
-                channels[rec.id] = (rec.topic, rec.schema_id)
-                channel_ids.setdefault(rec.topic, set()).add(rec.id)
-            elif isinstance(rec, Message) and rec.channel_id in channels:
-                topic, schema_id = channels[rec.channel_id]
-                scan.counts[topic] += 1
-                if keep:
-                    kept.append(ScannedMessage(topic, schemas.get(schema_id, ""), rec.log_time, bytes(rec.data)))
-
+    body: list[Any] = []       # the data section's intact records, in file order (chunks opened)
+    summary: list[Any] = []    # the summary's schema and channel records
     footer_at = stats_record = None
     in_summary = False
     for opcode, content, offset in _records(data, len(MAGIC), scan):
@@ -131,18 +125,14 @@ def scan_mcap(path: str | Path, keep: bool = False) -> tuple[Scan, list[ScannedM
         try:
             if opcode == Opcode.CHUNK:
                 scan.chunks += 1
-                take(breakup_chunk(Chunk.read(stream), validate_crc=True))
-            elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL) and in_summary:
-                rec = (Schema if opcode == Opcode.SCHEMA else Channel).read(stream)
-                known = schemas.get(rec.id) if opcode == Opcode.SCHEMA else channels.get(rec.id, (None,))[0]
-                if known is not None and known != (rec.name if opcode == Opcode.SCHEMA else rec.topic):
-                    scan.summary_mismatch += 1
+                body += breakup_chunk(Chunk.read(stream), validate_crc=True)
             elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL):
-                take([(Schema if opcode == Opcode.SCHEMA else Channel).read(stream)])
+                rec = (Schema if opcode == Opcode.SCHEMA else Channel).read(stream)
+                (summary if in_summary else body).append(rec)
             elif opcode == Opcode.DATA_END:
                 in_summary = True
             elif opcode == Opcode.MESSAGE:
-                take([Message.read(stream, len(content))])
+                body.append(Message.read(stream, len(content)))
             elif opcode == Opcode.STATISTICS:
                 stats_record = Statistics.read(stream)
             elif opcode == Opcode.FOOTER:
@@ -155,6 +145,32 @@ def scan_mcap(path: str | Path, keep: bool = False) -> tuple[Scan, list[ScannedM
         except Exception:  # a damaged record: mcap raises many types; the framing around it is intact
             if opcode == Opcode.CHUNK:
                 scan.damaged_chunks += 1
+    schemas: dict[int, str] = {r.id: r.name for r in body if isinstance(r, Schema)}
+    channels: dict[int, tuple[str, int]] = {r.id: (r.topic, r.schema_id) for r in body if isinstance(r, Channel)}
+    for rec in summary:  # the summary's copies: checked against the data's, and used where the data has none
+        known = schemas.get(rec.id) if isinstance(rec, Schema) else channels.get(rec.id, (None,))[0]
+        if known is None:
+            if isinstance(rec, Schema):
+                schemas[rec.id] = rec.name
+            else:
+                channels[rec.id] = (rec.topic, rec.schema_id)
+        elif known != (rec.name if isinstance(rec, Schema) else rec.topic):
+            scan.summary_mismatch += 1
+    channel_ids: dict[str, set[int]] = {}
+    for cid, (topic, _) in channels.items():
+        channel_ids.setdefault(topic, set()).add(cid)
+    kept: list[ScannedMessage] = []
+    for rec in body:
+        if not isinstance(rec, Message):
+            continue
+        if rec.channel_id not in channels:
+            scan.unplaced += 1
+            continue
+        topic, schema_id = channels[rec.channel_id]
+        scan.counts[topic] += 1
+        if keep:
+            kept.append(ScannedMessage(topic, schemas.get(schema_id, ""), rec.log_time, bytes(rec.data)))
+    scan.types = {topic: schemas.get(schema_id, "") for topic, schema_id in channels.values()}
     if footer_at is None:
         scan.cut_off = True
     if stats_record is not None:
@@ -192,6 +208,29 @@ def bag_files(path: Path) -> tuple[list[Path], dict[str, Any] | None]:
         raise InputError(f"{meta_path}: lists {len(listed)} file(s) ({', '.join(listed) or 'none'}) but the folder "
                          f"holds {len(on_disk)} ({', '.join(on_disk) or 'none'})")
     return [path / n for n in listed], meta
+
+
+def _check_times(path: Path, meta: dict[str, Any]) -> None:
+    """metadata.yaml's start and duration must be times a stamp can hold (InputError otherwise)."""
+    try:
+        start = int(meta["starting_time"]["nanoseconds_since_epoch"])
+        duration = int(meta["duration"]["nanoseconds"])
+    except (KeyError, TypeError, ValueError, OverflowError):
+        raise InputError(f"{path}: metadata.yaml has no readable starting_time and duration; --salvage reads "
+                         "the MCAP files alone") from None
+    if not (0 <= start < TIME_MSG_END_NS and duration >= 0 and start + duration < TIME_MSG_END_NS):
+        raise InputError(f"{path}: metadata.yaml's starting_time {start} ns and duration {duration} ns are not "
+                         "times a stamp can hold; --salvage reads the MCAP files alone")
+
+
+def _check_types(path: Path, meta: dict[str, Any], scans: list[Scan]) -> None:
+    """metadata.yaml's type of each topic must be the type its files' channels are written with."""
+    held = {topic: name for s in scans for topic, name in s.types.items()}
+    for entry in meta.get("topics_with_message_count") or []:
+        tm = entry["topic_metadata"]
+        if tm["name"] in held and str(tm.get("type")) != held[tm["name"]]:
+            raise InputError(f"{path}: metadata.yaml says topic {tm['name']} is {tm.get('type')}, its files hold "
+                             f"{held[tm['name']]}; --salvage reads the MCAP files alone")
 
 
 def metadata_counts(meta: dict[str, Any]) -> dict[str, int]:
@@ -245,7 +284,10 @@ def check_bag(path: str | Path) -> Claims:
         held.update(s.counts)
     stated = None
     if meta is not None:
+        _check_times(path, meta)
         stated = metadata_counts(meta)
+        if scans:
+            _check_types(path, meta, scans)
         total = int(meta.get("message_count", sum(stated.values())))
         if total != sum(stated.values()):
             raise InputError(f"{path}: metadata.yaml counts {total} messages in all but {sum(stated.values())} "

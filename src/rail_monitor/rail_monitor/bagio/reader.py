@@ -265,10 +265,12 @@ class SalvageReport:
     passes: int         # TrainPass messages among them (of the chosen topic)
     damaged_chunks: int = 0   # chunks skipped (failed CRC or decompression)
     cut_off: int = 0          # files whose framing ends before the footer
+    unplaced: int = 0         # messages on a channel no intact record defines (lost)
 
     def line(self, path: str | Path) -> str:
         skipped = (f"; skipped {self.damaged_chunks} damaged chunk(s)" if self.damaged_chunks else "") + (
-            f"; {self.cut_off} file(s) cut off before the footer" if self.cut_off else "")
+            f"; {self.cut_off} file(s) cut off before the footer" if self.cut_off else "") + (
+            f"; {self.unplaced} message(s) lost with the only record of their channel" if self.unplaced else "")
         return (f"salvaged {self.messages} messages ({self.passes} TrainPass) from the complete chunks of "
                 f"{self.files} MCAP file(s) in {path}{skipped}")
 
@@ -287,7 +289,7 @@ def salvage_bag_passes(path: str | Path, topic: str | None = None) -> tuple[Pass
     files = sorted(path.glob("*.mcap"), key=_split_index) if path.is_dir() else [path]
     if not files:
         raise InputError(f"{path}: no .mcap files to salvage")
-    rows, total, damaged, cut_off = [], 0, 0, 0
+    rows, total, damaged, cut_off, unplaced = [], 0, 0, 0, 0
     store = typestore()
     try:
         for f in files:
@@ -295,6 +297,7 @@ def salvage_bag_passes(path: str | Path, topic: str | None = None) -> tuple[Pass
             total += len(messages)
             damaged += scan.damaged_chunks
             cut_off += scan.cut_off
+            unplaced += scan.unplaced
             for m in messages:
                 if (m.topic == topic) if topic else (m.typename == TRAIN_PASS):
                     if m.typename != TRAIN_PASS:
@@ -305,7 +308,8 @@ def salvage_bag_passes(path: str | Path, topic: str | None = None) -> tuple[Pass
     except Exception as exc:
         raise InputError(f"{path}: cannot salvage: {_one_line(exc)}") from None
     rows.sort(key=lambda r: r[0])
-    return PassTable.from_rows([r for _, r in rows]), SalvageReport(len(files), total, len(rows), damaged, cut_off)
+    report = SalvageReport(len(files), total, len(rows), damaged, cut_off, unplaced)
+    return PassTable.from_rows([r for _, r in rows]), report
 
 
 def _split_index(path: Path) -> tuple[int, str]:
