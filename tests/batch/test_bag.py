@@ -100,7 +100,8 @@ def test_batch_applies_and_records_the_history_s_surveys_streamed_as_in_one_call
     bag = write_passes_bag(passes, tmp_path / "with_surveys", "curve_250", events=events)
     assert [(e.stamp_ns, e.kind) for e in read_bag_events(bag)] == [(e.stamp_ns, e.kind) for e in events]
     assert main(["batch", str(bag), "--output", str(tmp_path / "streamed"), "--no-report", "--chunk", "333"]) == 0
-    assert "3 roughness survey(s) and grinding event(s) applied in stamp order, 0 refused" in capsys.readouterr().out
+    said = capsys.readouterr().out
+    assert "3 roughness survey(s) and grinding event(s) read: 3 applied in stamp order, 0 refused" in said
     one = write_bag(run_models(read_bag_passes(bag), site_values, events=events), tmp_path / "one", "curve_250")
     a, b = _messages(one), _messages(tmp_path / "streamed")
     assert len(a["/curve_250/roughness_survey"]) == 3

@@ -123,16 +123,18 @@ def write_bag(result: BatchResult, folder: str | Path, namespace: str, compressi
 
 @dataclass
 class Recorded:
-    """What a batch run recorded: passes read, rejected, alert events, the final forecast [day]
+    """What a batch run recorded: passes recorded and read, rejected, alert events, the final forecast [day]
     (inf: none), passes left out by reason, and lines for the user (what was skipped or salvaged)."""
 
-    passes: int = 0
+    passes: int = 0                                               # passes recorded (sent to the models)
+    read: int = 0                                                 # passes read (recorded or left out)
     rejected: int = 0
     alert_events: int = 0
     days_to_threshold: float = math.inf
     left_out: dict[str, int] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     events: int = 0                                               # surveys and grinding events read
+    events_applied: int = 0                                       # of those, applied
     events_refused: dict[str, int] = field(default_factory=dict)  # of those, refused by reason
     measurements: int = 0                                         # measured pass-bys read
     measurements_refused: dict[str, int] = field(default_factory=dict)
@@ -150,7 +152,8 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
         for chunk in chunks:
             result = run.feed(chunk)
             bag.add(result)
-            out.passes += len(chunk)
+            out.read += len(chunk)
+            out.passes += len(result.passes)
             out.rejected += int((result.reasons != "").sum())
             out.alert_events += len(result.alerts)
             if len(result.trajectory):
@@ -162,6 +165,7 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
     out.alert_events += len(held)
     out.left_out = dict(run.left_out)
     out.events, out.events_refused = len(events), dict(run.events_refused)
+    out.events_applied = run.corrugation.applied["surveys"] + run.corrugation.applied["grindings"]
     out.measurements, out.measurements_refused = len(measurements), dict(run.tracker.refused)
     return out
 

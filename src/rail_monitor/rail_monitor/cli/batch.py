@@ -70,8 +70,8 @@ def run(ns: argparse.Namespace) -> int:
     for why, count in rec.left_out.items():
         print(f"batch: {count} pass(es) left out: {why}")
     if rec.events:
-        print(f"batch: {rec.events} roughness survey(s) and grinding event(s) applied in stamp order, "
-              f"{sum(rec.events_refused.values())} refused")
+        print(f"batch: {rec.events} roughness survey(s) and grinding event(s) read: {rec.events_applied} applied "
+              f"in stamp order, {rec.events - rec.events_applied} refused")
     for why, count in rec.events_refused.items():
         print(f"batch: {count} survey or grinding event(s) refused: {why}")
     if rec.measurements:
@@ -81,7 +81,7 @@ def run(ns: argparse.Namespace) -> int:
         print(f"batch: {count} measured pass-by(s) refused: {why}")
     t = time.monotonic() - t0
     print(f"batch: {rec.passes} passes through the models and recorded to {out} in {t:.2f} s "
-          f"({rec.passes / max(t, 1e-9):.0f} passes/s)")
+          f"({rec.passes / max(t, 1e-9):.0f} passes/s)" + (f"; {rec.read} read" if rec.read != rec.passes else ""))
     if not ns.no_report:
         print_report(str(out), ns.site, ns.report)
     return 0

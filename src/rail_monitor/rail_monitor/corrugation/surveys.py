@@ -42,6 +42,8 @@ class MaintenanceEvent:
 def apply_event(est: CorrugationEstimator, event: MaintenanceEvent) -> calibration.KbPosterior | None:
     """Apply a survey (apply_survey's result) or a grinding (None); ValueError, with the state
     untouched, for an event not newer than the last one applied or an unusable one."""
+    if event.stamp_ns < 0:
+        raise ValueError("stamp before 1970")
     if event.stamp_ns <= est.last_survey_ns:
         raise ValueError("not newer than the last survey or grinding applied")
     if event.kind == KIND_SURVEY:
