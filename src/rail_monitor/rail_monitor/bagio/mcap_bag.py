@@ -24,7 +24,7 @@ import yaml
 from mcap.writer import CompressionType, Writer
 
 from rail_monitor.bagio.direct_file import DirectFile
-from rail_monitor.bagio.output_folder import new_output_folder
+from rail_monitor.bagio.output_folder import Claim, new_output_folder
 from rail_monitor.bagio.retention import Retention
 from rail_monitor.codec.typestore import schema_text, type_hash
 from rail_monitor.core.errors import RailMonitorError
@@ -84,12 +84,13 @@ class McapBagWriter:
     def __init__(self, folder: str | Path, *, compression: str = "zstd", chunk_size: int = 1 << 20,
                  max_file_bytes: int = 0, max_file_duration_ns: int = 0, flush_period_ns: int = 0,
                  flush_wall_period_s: float = 0.0, max_total_bytes: int = 0, max_age_ns: int = 0,
-                 records: dict[str, dict[str, str]] | None = None, custom_data: dict[str, str] | None = None) -> None:
+                 records: dict[str, dict[str, str]] | None = None, custom_data: dict[str, str] | None = None,
+                 claim: Claim | None = None) -> None:
         if compression not in ("zstd", "none"):
             raise RailMonitorError(f"compression must be 'zstd' or 'none', not {compression!r}")
         self._retention = Retention.checked(max_total_bytes, max_age_ns, max_file_bytes, max_file_duration_ns,
                                             chunk_size)
-        self.folder = new_output_folder(Path(folder))
+        self.folder = new_output_folder(Path(folder), claim)
         self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
         self._chunk_size = chunk_size
         self._max_bytes, self._max_duration = max_file_bytes, max_file_duration_ns

@@ -4,7 +4,6 @@ log time = header stamp; chunk by chunk, so a long history is never held whole (
 from __future__ import annotations
 
 import math
-import shutil
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,6 +14,7 @@ import numpy as np
 from rail_monitor.advice.plan import SpeedAdvice
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.bagio.mcap_bag import McapBagWriter
+from rail_monitor.bagio.output_folder import Claim, claim_output_folder
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
 from rail_monitor.batch.result import BatchResult
 from rail_monitor.batch.run import BatchRun
@@ -36,11 +36,11 @@ class BatchBag:
     (bagio.site_record), as the recorder stores it."""
 
     def __init__(self, folder: str | Path, namespace: str, frame: str, compression: str = "zstd",
-                 site: dict[str, str] | None = None) -> None:
+                 site: dict[str, str] | None = None, claim: Claim | None = None) -> None:
         self.ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
         self.frame = frame
         stored = {"records": {SITE_RECORD: site}, "custom_data": custom_data(site)} if site else {}
-        self.bag = McapBagWriter(Path(folder), compression=compression, **stored)
+        self.bag = McapBagWriter(Path(folder), compression=compression, claim=claim, **stored)
         for name, (typename, qos) in GRAPH_TOPICS.items():
             self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
         self._standing: dict[tuple[int, str], Alert] = {}
@@ -142,13 +142,13 @@ class Recorded:
 
 def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: str | Path, namespace: str,
                site: dict[str, str] | None = None, events: Sequence[MaintenanceEvent] = (),
-               measurements: Sequence[Measurement] = ()) -> Recorded:
+               measurements: Sequence[Measurement] = (), claim: Claim | None = None) -> Recorded:
     """BatchRun over an iterable of PassTable chunks in time order (and the history's surveys and
     grinding events, and its measured pass-bys), each recorded as it is done (memory: one chunk's
-    outputs)."""
+    outputs). claim: the folder, claimed already (else claimed here)."""
     run = BatchRun(values, events=events, measurements=measurements)
     out = Recorded()
-    with BatchBag(folder, namespace, run.site.site_id, site=site) as bag:
+    with BatchBag(folder, namespace, run.site.site_id, site=site, claim=claim) as bag:
         for chunk in chunks:
             result = run.feed(chunk)
             bag.add(result)
@@ -180,25 +180,26 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
     CSV or a bag), else a bag history's own. A run that fails leaves no output behind."""
     from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_history_inputs
 
-    existed = folder.exists()
+    claim = claim_output_folder(folder)  # atomic: two runs never write one folder
     try:
         events, ms = read_history_inputs(source, measured, skip_bad_rows, salvage)
         if not (salvage or is_csv(Path(source))):
             try:
-                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms)
+                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms,
+                                  claim)
             except PassOrderError as exc:
                 note = f"{printable(str(source))}: {exc}; read whole to sort it"
-                _discard(folder, existed)
-                rec = _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, events, ms)
+                claim.empty()
+                rec = _whole(source, values, claim, namespace, site, topic, skip_bad_rows, salvage, events, ms)
                 rec.notes.insert(0, note)
                 return rec
-        return _whole(source, values, folder, namespace, site, topic, skip_bad_rows, salvage, events, ms)
+        return _whole(source, values, claim, namespace, site, topic, skip_bad_rows, salvage, events, ms)
     except BaseException:
-        _discard(folder, existed)
+        claim.release()  # what this run claimed and wrote, proven by its claim; nothing else
         raise
 
 
-def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
+def _whole(source: str | Path, values: Mapping[str, Any], claim: Claim, namespace: str,
            site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool,
            events: list[MaintenanceEvent], measured: list[Measurement]) -> Recorded:
     from rail_monitor.bagio.reader import read_passes_reported
@@ -210,17 +211,6 @@ def _whole(source: str | Path, values: Mapping[str, Any], folder: Path, namespac
     if skipped:
         notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "
                      + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
-    rec = run_to_bag([passes], values, folder, namespace, site, events, measured)
+    rec = run_to_bag([passes], values, claim.folder, namespace, site, events, measured, claim)
     rec.notes = notes
     return rec
-
-
-def _discard(folder: Path, existed: bool) -> None:
-    """Remove what this run wrote: the folder it made, or the files it put in an empty one."""
-    if not folder.exists():
-        return
-    if not existed:
-        shutil.rmtree(folder)
-        return
-    for f in folder.iterdir():
-        shutil.rmtree(f) if f.is_dir() else f.unlink()

@@ -26,10 +26,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    import shutil
 
     from rail_monitor import __version__
-    from rail_monitor.bagio.output_folder import new_output_folder
+    from rail_monitor.bagio.output_folder import claim_output_folder
     from rail_monitor.bagio.site_record import read_site_record
     from rail_monitor.core.text import printable
     from rail_monitor.engine.site_config import SiteConfig
@@ -41,11 +40,11 @@ def run(ns: argparse.Namespace) -> int:
              "site_id": str(values.get("site_id", "")), **{f"site.{k}": v for k, v in record.items()}}
     out = Path(ns.output) if ns.output else beside(ns.bag, "_export")
     fresh_output(out, ns.overwrite, [ns.bag])
-    folder = new_output_folder(out)
+    claim = claim_output_folder(out)
     try:
-        done = export_run(ns.bag, SiteConfig.from_values(values), ns.format, folder, about, ns.chunk)
+        done = export_run(ns.bag, SiteConfig.from_values(values), ns.format, claim.folder, about, ns.chunk)
     except BaseException:
-        shutil.rmtree(folder)  # created above: a failed export leaves nothing behind
+        claim.release()  # claimed above: a failed export leaves nothing behind, and nothing else goes
         raise
     for line in done.notes:
         print(f"export: {printable(line)}")
