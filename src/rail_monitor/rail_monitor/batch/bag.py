@@ -165,7 +165,7 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
     out.alert_events += len(held)
     out.left_out = dict(run.left_out)
     out.events, out.events_refused = len(events), dict(run.events_refused)
-    out.events_applied = run.corrugation.applied["surveys"] + run.corrugation.applied["grindings"]
+    out.events_applied = run.corrugation.maintenance_applied
     out.measurements, out.measurements_refused = len(measurements), dict(run.tracker.refused)
     return out
 

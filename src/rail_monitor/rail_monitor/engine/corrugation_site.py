@@ -104,14 +104,23 @@ class CorrugationSite:
             except ValueError as exc:
                 why = str(exc)
         if why:
-            self.refused[why] += 1
-            self.on_event(event, None, why)
+            self.refuse(event, why)
             return False
         if self.observer is not None:
             self.observer.note(event)
         self.applied[EVENT_COUNT.get(event.kind, "surveys")] += 1
         self.on_event(event, fit, "")
         return True
+
+    def refuse(self, event: MaintenanceEvent, why: str) -> None:
+        """Count a refused event by reason and report it (it changes nothing)."""
+        self.refused[why] += 1
+        self.on_event(event, None, why)
+
+    @property
+    def maintenance_applied(self) -> int:
+        """Surveys and grinding events applied (indirect observations aside)."""
+        return self.applied["surveys"] + self.applied["grindings"]
 
     def finish(self) -> list[MaintenanceEvent]:
         """Apply the events later than every pass (at the end of a history, or at shutdown); those

@@ -92,11 +92,9 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.corrugation = CorrugationSite(self.est, observer)
         self.corrugation.on_event = self._on_event
         self.corrugation.on_observation = self._on_observation
-        self.observer = observer
         self.checkpoint = self.params.checkpoint_path
         self.counts: Counter[str] = Counter()
         self.sent = Sent()
-        self.surveys_rejected = self.corrugation.refused  # on arrival or when applied, by reason
         self.checkpoint_skipped: list[str] = []
         if self.checkpoint:
             # An unreadable checkpoint falls back to the previous one; none readable is a ConfigError
@@ -122,6 +120,16 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
         wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
         self.listen()
+
+    @property
+    def observer(self) -> IndirectObserver | None:
+        """The indirect roughness windows (the corrugation step's)."""
+        return self.corrugation.observer
+
+    @property
+    def surveys_rejected(self) -> Counter[str]:
+        """Surveys, grinding and indirect observations refused, on arrival or when applied, by reason."""
+        return self.corrugation.refused
 
     def key_parameters(self) -> dict[str, Any]:
         return {"checkpoint": self.checkpoint or "none", "passes": self.est.total_pass_count,
@@ -198,8 +206,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if not why and event.stamp_ns <= max([self.est.last_survey_ns, *(e.stamp_ns for e in pending)]):
             why = "not newer than the last survey or grinding applied"
         if why:
-            self.corrugation.refused[why] += 1
-            self._log_refusal(why)
+            self.corrugation.refuse(event, why)
         elif event.stamp_ns >= self.est.newest_ns:
             pending.append(event)  # stamps rise (checked above)
         else:
@@ -210,15 +217,12 @@ class CorrugationEstimatorNode(PassConsumerNode):
     def _on_event(self, event: MaintenanceEvent, fit: KbPosterior | None, why: str) -> None:
         """A survey, grinding or indirect observation applied (checkpointed) or refused (logged)."""
         if why:
-            self._log_refusal(why)
+            self.get_logger().warning(f"roughness survey rejected: {why}")
             return
         if fit is not None and event.kind == surveys.KIND_SURVEY:
             self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
                                    f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
         self.save()
-
-    def _log_refusal(self, why: str) -> None:
-        self.get_logger().warning(f"roughness survey rejected: {why}")
 
     def _on_evaluate(self, req: EvaluateSpeedDistribution.Request,
                      res: EvaluateSpeedDistribution.Response) -> EvaluateSpeedDistribution.Response:
