@@ -27,6 +27,7 @@ from rail_monitor.core.site import (
     Site,
     site_from_values,
 )
+from rail_monitor.core.user_file import read_user_text
 from rail_monitor.core.yaml_text import load_yaml
 from rail_monitor.corrugation.config import CORRUGATION_SPECS
 from rail_monitor.measured.config import RESIDUAL_SPECS
@@ -76,10 +77,7 @@ def check_names(values: Mapping[str, Any], where: str = "") -> None:
 
 
 def _read_document(path: Path, text: str | None = None) -> Mapping[str, Any]:
-    try:
-        text = path.read_text(encoding="utf-8") if text is None else text
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read parameter file: {str(exc).splitlines()[0]}") from None
+    text = read_user_text(path, "a parameter file", error=ConfigError) if text is None else text
     doc = load_yaml(text, f"{path}: cannot read parameter file", ConfigError)
     if not isinstance(doc, Mapping) or not doc:
         raise ConfigError(f"{path}: not a ROS 2 parameter file (expected '/**: ros__parameters: ...')")

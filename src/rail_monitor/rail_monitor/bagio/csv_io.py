@@ -28,6 +28,7 @@ from pathlib import Path
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import FRICTION_BY_NAME, FRICTION_NAMES, KMH_PER_MPS, PassTable
 from rail_monitor.core.timeutil import NS_PER_S, checked_ns, format_iso_ns, parse_iso_ns
+from rail_monitor.core.user_file import MAX_TABLE_BYTES, read_user_text
 
 
 def time_utc(text: str) -> int:
@@ -90,24 +91,12 @@ def _quantity_of(column: str) -> str | None:
     return None
 
 
-def _read_text(path: Path) -> str:
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = raw[: exc.start].count(b"\n") + 1
-        raise InputError(f"{path}: line {line}: not UTF-8 text (byte {raw[exc.start]:#04x}); "
-                         "export the CSV as UTF-8") from None
-
 
 def csv_lines(path: Path, expected: str) -> tuple[int, list[str], list[tuple[int, str]]]:
     """A CSV file's header (its line number and stripped column names) and its data lines (line
     number, text), comments and blank lines left out; InputError without a header (expected: the
     columns to name in that error)."""
-    text = _read_text(path)
+    text = read_user_text(path, "a CSV", MAX_TABLE_BYTES)
     # Lines end at \n alone (str.splitlines would also split at U+2028 and other separators inside a field).
     lines = [(n, line.removesuffix("\r")) for n, line in enumerate(text.split("\n"), start=1)
              if line.strip() and not line.lstrip().startswith("#")]

@@ -11,6 +11,7 @@ one line naming the file and both numbers, unless the user asks to salvage it.
 
 from __future__ import annotations
 
+import mmap
 import struct
 import zlib
 from collections import Counter
@@ -28,6 +29,7 @@ from mcap.stream_reader import breakup_chunk
 from rail_monitor.bagio.mcap_bag import OPEN_FILE_KEY
 from rail_monitor.core.errors import InputError
 from rail_monitor.core.timeutil import TIME_MSG_END_NS
+from rail_monitor.core.user_file import read_user_text, regular_file
 from rail_monitor.core.yaml_text import load_yaml
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -84,7 +86,7 @@ def _records(data: bytes, start: int, scan: Scan) -> Iterator[tuple[int, bytes, 
     while pos + _FRAME.size <= len(data):
         opcode, length = _FRAME.unpack_from(data, pos)
         begin = pos + _FRAME.size
-        if begin + length > len(data):
+        if opcode == 0 or begin + length > len(data):  # opcode 0 is invalid: a zero-filled tail
             scan.cut_off = True
             return
         yield opcode, data[begin:begin + length], pos
@@ -112,9 +114,23 @@ def scan_mcap(path: str | Path, keep: bool = False) -> tuple[Scan, list[ScannedM
     messages, not the later chunks' (issue 52). A message on a channel no intact record defines is
     counted in ``unplaced``."""
     path = Path(path)
-    data = path.read_bytes()
+    size = regular_file(path, "an MCAP file").st_size
+    try:
+        with open(path, "rb") as fh:
+            # Mapped, not read: a file of gigabytes (or a sparse one) is paged in as it is scanned.
+            data = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) if size else b""
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: cannot read the MCAP file: {exc}") from None
+    try:
+        return _scan(path, data, keep)
+    finally:
+        if isinstance(data, mmap.mmap):
+            data.close()
+
+
+def _scan(path: Path, data: bytes | mmap.mmap, keep: bool) -> tuple[Scan, list[ScannedMessage]]:
     scan = Scan(path)
-    if not data.startswith(MAGIC):
+    if data[:len(MAGIC)] != MAGIC:
         raise InputError(f"{path}: not an MCAP file (no magic)")
     body: list[Any] = []       # the data section's intact records, in file order (chunks opened)
     summary: list[Any] = []    # the summary's schema and channel records
@@ -183,14 +199,16 @@ def bag_files(path: Path) -> tuple[list[Path], dict[str, Any] | None]:
     """The storage files of a bag (a folder with metadata.yaml, or one file) and its metadata.
 
     Refuses a metadata.yaml whose file list names a file twice or disagrees with the folder."""
-    if path.is_file():
+    if not path.is_dir():
+        regular_file(path, "a bag (a folder or an .mcap file)")
         return [path], None
     meta_path = path / "metadata.yaml"
     on_disk = sorted(p.name for p in path.iterdir() if p.suffix in (".mcap", ".db3"))
     if not meta_path.exists():
         return [path / n for n in on_disk], None
     try:
-        meta = load_yaml(meta_path.read_text(encoding="utf-8"), str(meta_path))["rosbag2_bagfile_information"]
+        text = read_user_text(meta_path, "a rosbag2 metadata file")
+        meta = load_yaml(text, str(meta_path))["rosbag2_bagfile_information"]
         listed = [str(p) for p in meta.get("relative_file_paths") or []]
     except InputError:
         raise

@@ -18,6 +18,7 @@ from rail_monitor.bagio.integrity import Claims, ScannedMessage, check_bag, scan
 from rail_monitor.codec.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS, typestore
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import PassTable
+from rail_monitor.core.user_file import regular_file
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
 from rail_monitor.measured.records import Measurement
 from rail_monitor.messages.fields import event_from_msg, measurement_from_msg, pass_row
@@ -44,7 +45,7 @@ def _checked(path: Path, reader: AnyReader) -> Claims:
 def _open_bag(path: Path) -> AnyReader:
     if not path.exists():
         raise InputError(f"{path}: no such file or folder")
-    if path.is_file() and path.stat().st_size == 0:
+    if not path.is_dir() and regular_file(path, "a bag (a folder or an .mcap file)").st_size == 0:
         raise InputError(f"{path}: empty file, not a bag")
     try:
         reader = AnyReader([path], default_typestore=typestore())

@@ -19,6 +19,7 @@ from mcap.reader import make_reader
 from rail_monitor import __version__
 from rail_monitor.bagio.integrity import bag_files
 from rail_monitor.core.errors import InputError
+from rail_monitor.core.user_file import read_user_text
 
 SITE_RECORD = "rail_monitor.site"
 FIELDS = ("site_file", "site_file_name", "site_file_sha256", "software_version")
@@ -27,10 +28,7 @@ FIELDS = ("site_file", "site_file_name", "site_file_sha256", "software_version")
 def site_record(path: str | Path) -> dict[str, str]:
     """The record of a site file (InputError if it cannot be read)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read the site file to store with the bag: {exc}") from None
+    text = read_user_text(path, "a site file")
     return {"site_file": text, "site_file_name": path.name,
             "site_file_sha256": hashlib.sha256(text.encode()).hexdigest(), "software_version": __version__}
 

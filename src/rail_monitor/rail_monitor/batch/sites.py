@@ -28,6 +28,7 @@ from typing import NamedTuple
 
 from rail_monitor.bagio.output_folder import beside
 from rail_monitor.core.errors import ConfigError, RailMonitorError
+from rail_monitor.core.user_file import read_user_text
 from rail_monitor.core.yaml_text import load_yaml
 
 
@@ -55,10 +56,7 @@ class SiteResult:
 def read_manifest(path: str | Path) -> list[SiteJob]:
     """The jobs of a manifest (ConfigError with one line naming the entry at fault)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read the manifest: {str(exc).splitlines()[0]}") from None
+    text = read_user_text(path, "a manifest", error=ConfigError)
     doc = load_yaml(text, f"{path}: cannot read the manifest", ConfigError)
     entries = doc.get("sites") if isinstance(doc, dict) else None
     if not isinstance(entries, list) or not entries:

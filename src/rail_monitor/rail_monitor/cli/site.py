@@ -10,6 +10,7 @@ from typing import Any
 
 from rail_monitor.cli.common import add_site_option, site_file
 from rail_monitor.core.errors import ConfigError, RailMonitorError
+from rail_monitor.core.user_file import read_user_text
 from rail_monitor.core.yaml_text import load_yaml
 
 
@@ -36,15 +37,9 @@ def run(ns: argparse.Namespace) -> int:
         raise RailMonitorError(f"{out} exists: give a new file name (a site file is never replaced)")
     literal = {}
     if ns.cnossos_catalogue:
-        try:
-            literal["noise.cnossos_catalogue"] = Path(ns.cnossos_catalogue).read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as exc:
-            raise RailMonitorError(f"{ns.cnossos_catalogue}: cannot read the catalogue: {exc}") from None
+        literal["noise.cnossos_catalogue"] = read_user_text(ns.cnossos_catalogue, "a CNOSSOS-EU catalogue")
     source = site_file(ns.site)
-    try:
-        original = source.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{source}: cannot read parameter file: {exc}") from None
+    original = read_user_text(source, "a parameter file", error=ConfigError)
     load_yaml(original, f"{source}: cannot read parameter file", ConfigError)  # one line for any YAML fault
     text, changed = edited_site_text(original, ns.changes, literal)
     tmp = out.with_name(f".{out.name}.tmp")

@@ -8,28 +8,49 @@ import yaml
 
 from rail_monitor.core.errors import InputError, RailMonitorError
 
+MAX_DEPTH = 100  # a site file nests 5 levels, a bag's metadata 6; deeper is not a document of ours
+MAX_NODES = 1_000_000  # values once aliases are expanded: a few aliases can stand for billions
+
+
+class _TooLarge(Exception):
+    pass
+
 
 def load_yaml(text: str, where: str, error: type[RailMonitorError] = InputError) -> Any:
-    """text parsed as YAML (safe types only). A syntax fault, or nesting deeper than the parser or
-    any later walk of the document can follow, is one ``error`` naming ``where``."""
+    """text parsed as YAML (safe types only). A syntax fault, a value the parser cannot build (an
+    integer of more than 4300 digits), nesting deeper than MAX_DEPTH, or aliases that expand to
+    more than MAX_NODES values (a "billion laughs" document) is one ``error`` naming ``where``."""
     try:
         doc = yaml.safe_load(text)
-        _depth(doc)
+        _check_shape(doc)
     except yaml.YAMLError as exc:
-        raise error(f"{where}: not valid YAML: {str(exc).splitlines()[0]}") from None
+        raise error(f"{where}: not valid YAML: {(str(exc).splitlines() or [''])[0]}") from None
     except RecursionError:
         raise error(f"{where}: nested too deeply to read (more than {MAX_DEPTH} levels)") from None
+    except _TooLarge:
+        raise error(f"{where}: its aliases expand to more than {MAX_NODES} values") from None
+    except Exception as exc:  # a scalar the constructor refuses (ValueError, OverflowError)
+        raise error(f"{where}: not valid YAML: {type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}") from None
     return doc
 
 
-MAX_DEPTH = 100  # a site file nests 5 levels, a bag's metadata 6; deeper is not a document of ours
-
-
-def _depth(doc: Any) -> None:
-    """RecursionError for a document nested more than MAX_DEPTH levels (before anything recurses)."""
-    level = [doc]
+def _check_shape(doc: Any) -> None:
+    """RecursionError past MAX_DEPTH levels, _TooLarge past MAX_NODES expanded values; level by level,
+    each distinct value once with how often aliases repeat it, so neither check itself recurses or
+    expands anything."""
+    level: dict[int, tuple[Any, int]] = {id(doc): (doc, 1)}
+    total = 1
     for _ in range(MAX_DEPTH + 1):
-        level = [v for x in level for v in (x.values() if isinstance(x, dict) else x if isinstance(x, list) else ())]
-        if not level:
+        below: dict[int, tuple[Any, int]] = {}
+        for value, times in level.values():
+            children = value.values() if isinstance(value, dict) else value if isinstance(value, list) else ()
+            for child in children:
+                seen = below.get(id(child))
+                below[id(child)] = (child, times + (seen[1] if seen else 0))
+                total += times
+            if total > MAX_NODES:
+                raise _TooLarge
+        if not below:
             return
+        level = below
     raise RecursionError

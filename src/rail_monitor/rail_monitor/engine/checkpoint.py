@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.user_file import regular_file
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.history import COLUMNS, KeptPasses
 from rail_monitor.corrugation.season import DailyGrowth
@@ -171,6 +172,9 @@ class CheckpointWriter:
 
 def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
     """The meta record and the arrays of a checkpoint file (CorruptCheckpoint if unreadable)."""
+    if not Path(path).exists():
+        raise ConfigError(f"{path}: no such checkpoint")
+    regular_file(path, "a checkpoint", CorruptCheckpoint)  # np.load would wait on a pipe for ever
     try:
         with np.load(path, allow_pickle=False) as z:
             data = {k: z[k] for k in z.files}  # zip member CRCs are checked as each is read
@@ -306,6 +310,9 @@ def resume(est: CorrugationEstimator, path: str | Path,
     """
     skipped: list[str] = []
     for candidate in (Path(path), previous_checkpoint(path)):
+        if candidate.is_symlink() and not candidate.exists():  # a disk not mounted: no fresh start
+            raise ConfigError(f"{candidate}: a symbolic link to nothing (or a loop); the checkpoint it "
+                              "stands for cannot be read, and a restart from zero would lose the history")
         if not candidate.exists():
             continue
         try:
