@@ -48,7 +48,7 @@ from rail_monitor.messages.output_columns import (
     state_refusals,
 )
 from rail_monitor.messages.topics import GRAPH_TOPICS
-from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
+from rail_monitor.nodes.base import declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
@@ -75,7 +75,6 @@ class AlertManagerNode(PassConsumerNode):
         self.alerts = AlertManager(alert_config(declare(self, ALERT_SPECS, prefix="alerts."), self._lead, prefix=""))
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.inputs: Counter[str] = Counter()
-        self.sent = Sent()
         self.pub = self.create_publisher(WaysideAlert, "alerts", ALERT_QOS)
         self.standing_pub = self.create_publisher(WaysideAlertArray, "alerts/standing", LATEST_QOS)
         noise = declare(self, PREDICTED_SPECS, prefix="noise.")

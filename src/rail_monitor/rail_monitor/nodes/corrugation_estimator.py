@@ -50,7 +50,7 @@ from rail_monitor.messages.fields import (
     speed_advisory_fields,
 )
 from rail_monitor.models.calibration import KbPosterior
-from rail_monitor.nodes.base import Sent, declare, subscribe_batched, take_queued, wall_timer
+from rail_monitor.nodes.base import declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_SUB_QOS
@@ -94,7 +94,6 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.corrugation.on_observation = self._on_observation
         self.checkpoint = self.params.checkpoint_path
         self.counts: Counter[str] = Counter()
-        self.sent = Sent()
         self.checkpoint_skipped: list[str] = []
         if self.checkpoint:
             # An unreadable checkpoint falls back to the previous one; none readable is a ConfigError

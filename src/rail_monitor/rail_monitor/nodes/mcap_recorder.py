@@ -69,6 +69,7 @@ class McapRecorder(TapNode):
                            "topics": len(self.tap.subs), "bag": str(self.writer.folder),
                            "not recorded (write failed)": self.dropped, "write error": self.writer.error,
                            **{f"refused: {why}": n for why, n in sorted(self.refused.items())},
+                           **{f"recorded {topic}": n for topic, n in sorted(self.counts.items())},
                            **self._health()},
             level=lambda: (DiagnosticStatus.ERROR, self.writer.error) if self.writer.error
             else (DiagnosticStatus.OK, "ok"))

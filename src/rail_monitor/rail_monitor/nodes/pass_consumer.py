@@ -33,6 +33,7 @@ from rail_monitor.nodes.base import (
     Diagnostics,
     RailNode,
     RateMeter,
+    Sent,
     announce,
     declare,
     declare_site,
@@ -60,6 +61,7 @@ class PassConsumerNode(RailNode):
         self.rejected: Counter[str] = Counter()
         self.model_errors: Counter[str] = Counter()  # accepted passes a model raised on (a bug: ERROR)
         self.last_pass_ns = 0
+        self.sent = Sent()  # messages published per topic (on /diagnostics: a soak checks the bag against it)
         self.margins = values_of(StampParams, declare(self, STAMP_SPECS, prefix="stamps."))
         self.stream_ns = 0  # newest pass taken: the reference of the stamp margin (a resumed state sets it)
         batch = declare(self, BATCH_SPECS)
@@ -158,6 +160,7 @@ class PassConsumerNode(RailNode):
         values.update({f"rejected: {reason}": n for reason, n in sorted(self.rejected.items())})
         values["model errors"] = sum(self.model_errors.values())
         values.update({f"model error: {why}": n for why, n in sorted(self.model_errors.items())})
+        values.update({f"sent {topic}": n for topic, n in sorted(self.sent.items())})
         return values
 
     def _level(self) -> tuple[int, str]:

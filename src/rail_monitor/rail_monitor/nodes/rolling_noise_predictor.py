@@ -32,7 +32,7 @@ from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import format_iso_ns
 from rail_monitor.messages.fields import PassHead, heads_columns, rolling_noise_cdr, time_columns_ns
 from rail_monitor.messages.output_columns import corrugation, corrugation_refusals
-from rail_monitor.nodes.base import Sent, declare, isolate_failures, runs, subscribe_batched, wall_timer
+from rail_monitor.nodes.base import declare, isolate_failures, runs, subscribe_batched, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.qos import STATE_SUB_QOS, STREAM_QOS
@@ -65,7 +65,6 @@ class RollingNoisePredictor(PassConsumerNode):
         self.states: deque[tuple[int, str, Corrugation]] = deque(maxlen=STATES_KEPT)  # in arrival order
         self._state_stamps: deque[int] = deque(maxlen=STATES_KEPT)  # their stamps, to bisect
         self.pending: deque[_Pending] = deque()
-        self.sent = Sent()
         self.counts: Counter[str] = Counter()
         self.states_rejected: Counter[str] = Counter()
         self.pub = self.create_publisher(RollingNoise, "noise/rolling", STREAM_QOS)

@@ -13,7 +13,7 @@ from typing import Any
 
 from rail_monitor.core.passes import PassTable
 from rail_monitor.messages.fields import PassHead, heads_columns, squeal_prediction_columns
-from rail_monitor.nodes.base import Sent, declare
+from rail_monitor.nodes.base import declare
 from rail_monitor.nodes.convert import to_cdr_many
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
@@ -30,7 +30,6 @@ class SquealRiskNode(PassConsumerNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("squeal_risk_model", **kwargs)
         self.cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
-        self.sent = Sent()
         self.pub = self.create_publisher(SquealPrediction, "noise/squeal", STREAM_QOS)
         self.listen()
 
