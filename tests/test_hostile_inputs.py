@@ -3,7 +3,7 @@ file maps any exception it can raise to one line naming the file and what is wro
 
 The readers: site and parameter files, a Dask manifest (YAML; a JSON document is YAML too), the
 detector and station CSVs, a bag (its index, its metadata.yaml, salvage, its stored site), a
-checkpoint, and the command line over them. Each hostile content is given under the name each reader
+checkpoint, a WAV recording, and the command line over them. Each hostile content is given under the name each reader
 expects (``.yaml``, ``.csv``, ``.mcap``, a bag folder's ``metadata.yaml``); the special files (a
 folder, a pipe, a sparse 8 GiB file, a link loop, a dangling link, nothing) under the same names.
 
@@ -34,6 +34,7 @@ from rail_monitor.bagio.csv_io import read_csv, read_csv_rows
 from rail_monitor.bagio.measured_csv import read_measured_csv
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.site_record import read_site_record
+from rail_monitor.bagio.wav import read_wav
 from rail_monitor.batch.sites import read_manifest
 from rail_monitor.cli import main
 from rail_monitor.core.errors import RailMonitorError
@@ -141,6 +142,7 @@ READERS: dict[str, tuple[tuple[str, ...], Callable[[Path], object]]] = {
     "bag salvage": ((".mcap", ""), reader.salvage_bag_passes),
     "bag's stored site": ((".mcap", ""), read_site_record),
     "checkpoint": ((".npz",), lambda p: checkpoint.resume(copy.deepcopy(_estimator()), p)),
+    "WAV": ((".wav",), read_wav),
 }
 MAY_RETURN = {"bag salvage", "bag's stored site"}  # salvage reads past metadata; a bag may hold no site
 
@@ -223,6 +225,7 @@ COMMANDS: dict[str, tuple[str, Callable[[Path, Path], list[str]]]] = {
                                               "--output", str(out)]),
     "batch --manifest": (".yaml", lambda p, out: ["batch", "--manifest", str(p)]),
     "site --site": (".yaml", lambda p, out: ["site", "--site", str(p), str(out)]),
+    "measure passby": (".wav", lambda p, out: ["measure", "passby", str(p), "--sensitivity", "1"]),
 }
 
 

@@ -1,5 +1,5 @@
 """rail-monitor: the command line (site, simulate, info, replay, record, monitor, demo, batch, report,
-export, predict).
+export, predict, measure).
 
 One module per verb: its arguments, a call into the package's functions (what-ifs, batch mode,
 the report, the nodes), and the printing. Node options are generated from the same ParamSpecs
@@ -20,6 +20,7 @@ from rail_monitor.cli import (
     export,
     graph,
     info,
+    measure,
     predict_corrugation,
     predict_noise,
     predict_roughness,
@@ -43,6 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
     models = s.add_subparsers(dest="model", required=True)
     for verb in (predict_squeal, predict_corrugation, predict_noise, predict_roughness):
         verb.add_parser(models)
+    measure.add_parser(sub)
     batch.add_parser(sub)
     report.add_parser(sub)
     export.add_parser(sub)

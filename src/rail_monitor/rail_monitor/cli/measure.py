@@ -1,0 +1,67 @@
+"""rail-monitor measure: what a station records, reduced as the standards say (a pass-by's audio)."""
+
+from __future__ import annotations
+
+import argparse
+
+from rail_monitor.cli.common import print_json
+from rail_monitor.core.errors import RailMonitorError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    m = sub.add_parser("measure", help="reduce a station's recording (a pass-by's audio)")
+    what = m.add_subparsers(dest="what", required=True)
+    p = what.add_parser("passby", help="ISO 3095 levels, 1/3-octave bands and tones of a recorded pass-by")
+    p.add_argument("wav", help="the pass-by's recording (WAV, one channel used, at least 25.6 kHz)")
+    p.add_argument("--calibration-file", help="a recording of a calibrator on the same channel (WAV)")
+    p.add_argument("--calibration-db", type=float, default=94.0,
+                   help="the calibrator's level [dB re 20 uPa]")
+    p.add_argument("--sensitivity", type=float,
+                   help="pascals per full-scale unit of the recording, instead of a calibration file")
+    p.add_argument("--channel", type=int, default=0, help="the channel of a multi-channel file (0 first)")
+    p.add_argument("--start-s", type=float, help="the train's front at the microphone [s from the start] "
+                   "(default: the record's start)")
+    p.add_argument("--end-s", type=float, help="the train's rear at the microphone [s] (default: the record's end)")
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.set_defaults(func=run_passby)
+
+
+def run_passby(ns: argparse.Namespace) -> int:
+    from rail_monitor.bagio.wav import read_wav
+    from rail_monitor.models.iso3095 import passby_levels, sensitivity_pa_per_unit
+
+    if (ns.calibration_file is None) == (ns.sensitivity is None):
+        raise RailMonitorError("give one of --calibration-file (with --calibration-db) or --sensitivity")
+    fs, samples = read_wav(ns.wav, ns.channel)
+    if ns.sensitivity is not None:
+        if not 0.0 < ns.sensitivity < float("inf"):
+            raise RailMonitorError(f"--sensitivity must be a positive number of pascals, not {ns.sensitivity:g}")
+        scale = ns.sensitivity
+    else:
+        _, cal = read_wav(ns.calibration_file, ns.channel)
+        try:
+            scale = sensitivity_pa_per_unit(cal, ns.calibration_db)
+        except ValueError as exc:
+            raise RailMonitorError(f"{ns.calibration_file}: {exc}") from None
+    try:
+        r = passby_levels(samples * scale, fs, ns.start_s, ns.end_s)
+    except ValueError as exc:
+        raise RailMonitorError(f"{ns.wav}: {exc}") from None
+    tones = [{"frequency_hz": t.frequency_hz, "level_db": t.level_db, "audibility_db": t.audibility_db}
+             for t in r.tones]
+    if ns.json:
+        print_json({"lpaeq_tp_db": r.lpaeq_tp_db, "lpafmax_db": r.lpafmax_db, "tel_db": r.tel_db, "sel_db": r.sel_db,
+                    "tp_s": r.tp_s, "record_s": r.record_s, "sensitivity_pa_per_unit": scale,
+                    "band_centres_hz": r.band_centres_hz.tolist(), "band_levels_db": r.band_levels_db.tolist(),
+                    "tones": tones})
+        return 0
+    print(f"# {ns.wav}: pass {r.tp_s:.2f} s of a {r.record_s:.2f} s record; dB re 20 uPa")
+    print(f"LpAeq,Tp {r.lpaeq_tp_db:6.1f} dB(A)   LpAFmax {r.lpafmax_db:6.1f} dB(A)   TEL {r.tel_db:6.1f} dB(A)   "
+          f"SEL {r.sel_db:6.1f} dB(A)")
+    print("band [Hz]  " + " ".join(f"{c:>6g}" for c in r.band_centres_hz))
+    print("Leq,Tp     " + " ".join(f"{v:6.1f}" for v in r.band_levels_db))
+    for t in tones:
+        print(f"tone {t['frequency_hz']:8.1f} Hz  {t['level_db']:6.1f} dB  audibility {t['audibility_db']:+5.1f} dB")
+    if not tones:
+        print("no audible tone")
+    return 0
