@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bench import audio as baudio
 from bench import batch as bb
 from bench import corrugation as bc
 from bench import graph as bg
@@ -159,6 +160,9 @@ def model_rows(site: str) -> list[Row]:
              f"{co['pass_batch'] * us:.1f} us in a batch")]
     rows += [(f"rolling noise, {name}, per pass with a corrugation state", f"{c['pass_single'] * us:.0f} us",
               f"{c['pass_batch'] * us:.1f} us in a batch") for name, c in no.items()]
+    au = baudio.costs(10.0)
+    rows.append(("pass-by audio, 10 s at 48 kHz (ISO 3095 levels, bands, tones)", f"{au['seconds'] * 1e3:.0f} ms",
+                 f"{au['real_time_x']:.0f}x real time on one core"))
     return rows
 
 

@@ -39,6 +39,8 @@ def test_the_json_holds_every_key_and_the_levels_of_the_library(tmp_path, capsys
     assert len(out["band_levels_db"]) == len(out["band_centres_hz"]) == 24
     assert out["tones"][0]["frequency_hz"] == pytest.approx(1000.0, abs=1.0)
     assert set(out["tones"][0]) == {"frequency_hz", "level_db", "audibility_db"}
+    assert out["squeal"]["detected"] and out["squeal"]["frequency_hz"] == pytest.approx(1000.0, abs=5.0)
+    assert out["squeal"]["duration_s"] == pytest.approx(2.0, abs=0.1) and not out["squeal"]["flanging"]
     fs, samples = wavfile.read(wav)
     lib = passby_levels(samples / 32768.0 * out["sensitivity_pa_per_unit"], fs, 1.0, 3.0)
     assert out["lpafmax_db"] == pytest.approx(lib.lpafmax_db, abs=1e-9)

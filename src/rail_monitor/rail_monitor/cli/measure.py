@@ -11,7 +11,7 @@ from rail_monitor.core.errors import RailMonitorError
 def add_parser(sub: argparse._SubParsersAction) -> None:
     m = sub.add_parser("measure", help="reduce a station's recording (a pass-by's audio)")
     what = m.add_subparsers(dest="what", required=True)
-    p = what.add_parser("passby", help="ISO 3095 levels, 1/3-octave bands and tones of a recorded pass-by")
+    p = what.add_parser("passby", help="ISO 3095 levels, 1/3-octave bands, tones and squeal of a recorded pass-by")
     p.add_argument("wav", help="the pass-by's recording (WAV, one channel used, at least 25.6 kHz)")
     p.add_argument("--calibration-file", help="a recording of a calibrator on the same channel (WAV)")
     p.add_argument("--calibration-db", type=float, default=94.0,
@@ -29,6 +29,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run_passby(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.wav import read_wav
     from rail_monitor.models.iso3095 import passby_levels, sensitivity_pa_per_unit
+    from rail_monitor.models.squeal_detection import detect_squeal
 
     if (ns.calibration_file is None) == (ns.sensitivity is None):
         raise RailMonitorError("give one of --calibration-file (with --calibration-db) or --sensitivity")
@@ -45,15 +46,18 @@ def run_passby(ns: argparse.Namespace) -> int:
             raise RailMonitorError(f"{ns.calibration_file}: {exc}") from None
     try:
         r = passby_levels(samples * scale, fs, ns.start_s, ns.end_s)
+        d = detect_squeal(samples * scale, fs, ns.start_s, ns.end_s)
     except ValueError as exc:
         raise RailMonitorError(f"{ns.wav}: {exc}") from None
     tones = [{"frequency_hz": t.frequency_hz, "level_db": t.level_db, "audibility_db": t.audibility_db}
              for t in r.tones]
+    squeal = {"detected": d.squeal, "frequency_hz": d.frequency_hz, "level_db": d.level_db,
+              "duration_s": d.duration_s, "share": d.share, "flanging": d.flanging, "flanging_s": d.flanging_s}
     if ns.json:
         print_json({"lpaeq_tp_db": r.lpaeq_tp_db, "lpafmax_db": r.lpafmax_db, "tel_db": r.tel_db, "sel_db": r.sel_db,
                     "tp_s": r.tp_s, "record_s": r.record_s, "sensitivity_pa_per_unit": scale,
                     "band_centres_hz": r.band_centres_hz.tolist(), "band_levels_db": r.band_levels_db.tolist(),
-                    "tones": tones})
+                    "tones": tones, "squeal": squeal})
         return 0
     print(f"# {ns.wav}: pass {r.tp_s:.2f} s of a {r.record_s:.2f} s record; dB re 20 uPa")
     print(f"LpAeq,Tp {r.lpaeq_tp_db:6.1f} dB(A)   LpAFmax {r.lpafmax_db:6.1f} dB(A)   TEL {r.tel_db:6.1f} dB(A)   "
@@ -64,4 +68,6 @@ def run_passby(ns: argparse.Namespace) -> int:
         print(f"tone {t['frequency_hz']:8.1f} Hz  {t['level_db']:6.1f} dB  audibility {t['audibility_db']:+5.1f} dB")
     if not tones:
         print("no audible tone")
+    print(f"squeal at {d.frequency_hz:.0f} Hz, {d.level_db:.1f} dB, for {d.duration_s:.1f} s ({100 * d.share:.0f} % of "
+          "the pass)" if d.squeal else "no squeal", f"; flanging for {d.flanging_s:.1f} s" if d.flanging else "")
     return 0
