@@ -49,12 +49,13 @@ def folder_bytes(folder: Path) -> int:
 def graph_command(site: str, out: Path, minutes: float, per_s: float, budget: int, split: int) -> list[str]:
     rate = per_s / (24 * TRAINS_PER_HOUR / DAY_S)          # simulated time per wall time
     days = 1.1 * minutes * 60.0 * rate / DAY_S              # history long enough for the run
-    p = {**_simulator(days, rate), "output": str(out), **_recorder(budget, split)}
+    p = {**_simulator(days, rate, TRAINS_PER_HOUR), "output": str(out), **_recorder(budget, split)}
     return _command("wayside_monitor", site, p)
 
 
-def _simulator(days: float, rate: float) -> dict[str, str]:
-    return {"simulator.days": f"{days:.6f}", "simulator.trains_per_hour": f"[{', '.join(['4.0'] * 24)}]",
+def _simulator(days: float, rate: float, trains_per_hour: float) -> dict[str, str]:
+    hourly = ", ".join([f"{trains_per_hour:.1f}"] * 24)
+    return {"simulator.days": f"{days:.6f}", "simulator.trains_per_hour": f"[{hourly}]",
             "rate": f"{rate:.1f}", "progress": "false", "use_sim_time": "true"}
 
 
@@ -69,7 +70,7 @@ def _command(exe: str, site: str, params: dict[str, str]) -> list[str]:
     return args
 
 
-def five_process_commands(site: str, out: Path, days: float, speedup: float, budget: int,
+def five_process_commands(site: str, out: Path, days: float, speedup: float, trains_per_hour: float, budget: int,
                           split: int) -> list[list[str]]:
     """The launch file's five processes and the simulator feeding them (last), on sim time."""
     from bench.live import MODEL_EXECUTABLES
@@ -77,7 +78,7 @@ def five_process_commands(site: str, out: Path, days: float, speedup: float, bud
     sim = {"use_sim_time": "true"}
     return [*(_command(exe, site, sim) for exe in MODEL_EXECUTABLES),
             _command("mcap_recorder", site, {**sim, "output": str(out), **_recorder(budget, split)}),
-            _command("pass_simulator", site, {**_simulator(days, speedup),
+            _command("pass_simulator", site, {**_simulator(days, speedup, trains_per_hour),
                                               "wait_for_subscribers": str(len(MODEL_EXECUTABLES) + 1)})]
 
 
@@ -171,6 +172,10 @@ def main() -> None:
     ap.add_argument("--passes-per-s", type=float, default=10.0, help="one: the pass rate")
     ap.add_argument("--days", type=float, default=30.0, help="five: simulated days of traffic")
     ap.add_argument("--speedup", type=float, default=100.0, help="five: simulated time per wall time")
+    ap.add_argument("--trains-per-hour", type=float, default=TRAINS_PER_HOUR, help="five: the flat traffic")
+    ap.add_argument("--warm-days", type=float, default=40.0,
+                    help="five: simulated days before the memory trend is taken (the stores bounded by the "
+                         "history window and by count fill first)")
     ap.add_argument("--budget-mib", type=float, default=20.0)
     ap.add_argument("--split-mib", type=float, default=2.0)
     ap.add_argument("--sample-s", type=float, default=10.0)
@@ -185,8 +190,8 @@ def main() -> None:
         bag = Path(tmp) / "soak"
         log = Path(tmp) / "graph.log"
         listener = DiagnosticsListener() if five else None
-        commands = five_process_commands(ns.site, bag, ns.days, ns.speedup, budget, split) if five else \
-            [graph_command(ns.site, bag, ns.minutes, ns.passes_per_s, budget, split)]
+        commands = (five_process_commands(ns.site, bag, ns.days, ns.speedup, ns.trains_per_hour, budget, split)
+                    if five else [graph_command(ns.site, bag, ns.minutes, ns.passes_per_s, budget, split)])
         with log.open("w") as err:
             procs = [subprocess.Popen(c, stdout=subprocess.DEVNULL, stderr=err, env=env) for c in commands]
         t0 = time.monotonic()
@@ -211,16 +216,19 @@ def main() -> None:
         final = folder_bytes(bag)
         errors = [line for line in log.read_text().splitlines() if "Traceback" in line or line.startswith("error")]
     t, rss, size = (np.array(c) for c in zip(*samples, strict=True))
-    warm = t >= min(5.0, t[-1] / 3)  # after start-up and the first splits
+    warm = t >= (ns.warm_days * DAY_S / ns.speedup / 60.0 if five else min(5.0, t[-1] / 3))  # after the stores fill
     slope = np.polyfit(t[warm], rss[warm], 1)[0] if warm.sum() > 2 else float("nan")
     late = t >= 2 * t[-1] / 3
     late_slope = np.polyfit(t[late], rss[late], 1)[0] if late.sum() > 2 else float("nan")
-    what = (f"{ns.days:g} simulated days at {ns.speedup:g}x, five processes and the simulator" if five
+    per_day = ns.speedup / DAY_S * 60.0  # simulated days per wall minute
+    what = (f"{ns.days:g} simulated days at {ns.speedup:g}x ({24 * ns.trains_per_hour:g} trains a day), five "
+            f"processes and the simulator; memory trend after {ns.warm_days:g} simulated days" if five
             else f"{ns.passes_per_s:g} passes per second, wayside_monitor")
     rows = [("run", f"{wall_min:.1f} min", f"{what}; exit codes {rcs}; {len(errors)} error lines"),
             ("RSS of the graph after warm-up / at the end", f"{rss[warm][0]:.0f} / {rss[-1]:.0f} MB",
              f"trend {60 * slope:+.1f} MB/hour over {t[warm][-1] - t[warm][0]:.1f} min, {60 * late_slope:+.1f} "
-             f"MB/hour over the last third; peak {rss.max():.0f} MB"),
+             f"MB/hour over the last third; peak {rss.max():.0f} MB"
+             + (f"; per simulated day {slope / per_day:+.3f} MB" if five else "")),
             ("bag on disk, largest sample / budget", f"{size.max() / 2**20:.2f} / {ns.budget_mib:g} MiB",
              f"final {final / 2**20:.2f} MiB; {len(samples)} samples, every {ns.sample_s:g} s"),
             ("kept files", f"{files}", f"{messages:,} messages read by rosbags through metadata.yaml; "
