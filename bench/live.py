@@ -29,7 +29,6 @@ import signal
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -37,6 +36,7 @@ from typing import Any
 import numpy as np
 
 import bench  # noqa: F401  (private DDS domain, one maths thread)
+from bench.spun_node import SpunNode
 from bench.timing import rss_mb
 
 MODEL_EXECUTABLES = ("corrugation_estimator", "rolling_noise_predictor", "squeal_risk_model", "alert_manager")
@@ -51,20 +51,14 @@ def cpu_s(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / TICKS
 
 
-class Probe:
+class Probe(SpunNode):
     """A node publishing TrainPass and timing the outputs of each pass (wall clock, monotonic)."""
 
     def __init__(self, passes: Any) -> None:
-        import rclpy
-        from rclpy.executors import SingleThreadedExecutor
-
         from rail_monitor.messages.fields import train_pass_fields
         from rail_monitor.nodes.convert import TOPICS, to_msg
 
-        self.rclpy = rclpy
-        self.ctx = rclpy.Context()
-        rclpy.init(context=self.ctx, domain_id=int(os.environ["ROS_DOMAIN_ID"]))
-        self.node = rclpy.create_node("bench_probe", context=self.ctx)
+        super().__init__("bench_probe")
         cls, qos = TOPICS["train_pass"]
         self.pub = self.node.create_publisher(cls, "train_pass", qos)
         self._to_msg, self._fields, self._cls = to_msg, train_pass_fields, cls
@@ -72,20 +66,12 @@ class Probe:
         self.sent: dict[str, float] = {}
         self.outputs: dict[str, list[float]] = {}
         self.first_output = 0.0
-        self.lock = threading.Lock()
         for name in ("noise/rolling", "noise/squeal", "corrugation/state"):
             c, q = TOPICS[name]
             self.node.create_subscription(c, name, lambda m, n=name: self._on_output(n, m), q)
         # Subscribed to train_pass too, so a replayer waiting for its subscribers waits for the probe.
         self.node.create_subscription(cls, "train_pass", lambda m: None, qos)
-        self.executor = SingleThreadedExecutor(context=self.ctx)
-        self.executor.add_node(self.node)
-        self.thread = threading.Thread(target=self._spin, daemon=True)
-        self.thread.start()
-
-    def _spin(self) -> None:
-        while self.ctx.ok():
-            self.executor.spin_once(timeout_sec=0.05)
+        self.start()
 
     def _on_output(self, topic: str, msg: Any) -> None:
         now = time.monotonic()
@@ -114,11 +100,6 @@ class Probe:
             return np.array([1e3 * (self.outputs[t][models - 1] - self.sent[t])
                              if len(self.outputs.get(t, [])) >= models else np.nan for t in ids])
 
-    def close(self) -> None:
-        self.executor.shutdown()
-        self.node.destroy_node()
-        self.rclpy.shutdown(context=self.ctx)
-        self.thread.join(timeout=5)
 
 
 def _spawn(exe: str | list[str], site: str, *params: str) -> subprocess.Popen:

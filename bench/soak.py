@@ -27,7 +27,6 @@ import os
 import signal
 import subprocess
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -35,6 +34,7 @@ import numpy as np
 from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
+from bench.spun_node import SpunNode
 from bench.timing import header, rss_mb
 
 DAY_S = 86_400.0
@@ -82,30 +82,18 @@ def five_process_commands(site: str, out: Path, days: float, speedup: float, tra
                                               "wait_for_subscribers": str(len(MODEL_EXECUTABLES) + 1)})]
 
 
-class DiagnosticsListener:
+class DiagnosticsListener(SpunNode):
     """The latest /diagnostics values of every node of the graph (a thread of this process)."""
 
     def __init__(self) -> None:
-        import rclpy
         from diagnostic_msgs.msg import DiagnosticArray
-        from rclpy.executors import SingleThreadedExecutor
 
         from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
 
-        self.ctx = rclpy.Context()
-        rclpy.init(context=self.ctx, domain_id=int(os.environ["ROS_DOMAIN_ID"]))
-        self.node = rclpy.create_node("bench_soak", context=self.ctx)
+        super().__init__("bench_soak")
         self.latest: dict[str, dict[str, str]] = {}
-        self.lock = threading.Lock()
         self.node.create_subscription(DiagnosticArray, "/diagnostics", self._on, DIAGNOSTICS_QOS)
-        self.executor = SingleThreadedExecutor(context=self.ctx)
-        self.executor.add_node(self.node)
-        self.thread = threading.Thread(target=self._spin, daemon=True)
-        self.thread.start()
-
-    def _spin(self) -> None:
-        while self.ctx.ok():
-            self.executor.spin_once(timeout_sec=0.05)
+        self.start()
 
     def _on(self, msg) -> None:
         with self.lock:
@@ -127,14 +115,6 @@ class DiagnosticsListener:
                 if name.endswith("pass_simulator"):
                     published = int(values.get("published", 0))
         return sent, recorded, published
-
-    def close(self) -> None:
-        self.executor.shutdown(timeout_sec=1.0)
-        self.node.destroy_node()
-        import rclpy
-
-        rclpy.shutdown(context=self.ctx)
-        self.thread.join(timeout=5)
 
 
 def check_kept(folder: Path) -> tuple[int, int]:
