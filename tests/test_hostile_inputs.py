@@ -3,7 +3,7 @@ file maps any exception it can raise to one line naming the file and what is wro
 
 The readers: site and parameter files, a Dask manifest (YAML; a JSON document is YAML too), the
 detector and station CSVs, a bag (its index, its metadata.yaml, salvage, its stored site), a
-checkpoint, a WAV recording, and the command line over them. Each hostile content is given under the name each reader
+checkpoint, a WAV recording, a trolley's trace, and the command line over them. Each hostile content is given under the name each reader
 expects (``.yaml``, ``.csv``, ``.mcap``, a bag folder's ``metadata.yaml``); the special files (a
 folder, a pipe, a sparse 8 GiB file, a link loop, a dangling link, nothing) under the same names.
 
@@ -34,6 +34,7 @@ from rail_monitor.bagio.csv_io import read_csv, read_csv_rows
 from rail_monitor.bagio.measured_csv import read_measured_csv
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.site_record import read_site_record
+from rail_monitor.bagio.trace_csv import read_trace
 from rail_monitor.bagio.wav import read_wav
 from rail_monitor.batch.sites import read_manifest
 from rail_monitor.cli import main
@@ -143,6 +144,7 @@ READERS: dict[str, tuple[tuple[str, ...], Callable[[Path], object]]] = {
     "bag's stored site": ((".mcap", ""), read_site_record),
     "checkpoint": ((".npz",), lambda p: checkpoint.resume(copy.deepcopy(_estimator()), p)),
     "WAV": ((".wav",), read_wav),
+    "trolley trace": ((".csv",), read_trace),
 }
 MAY_RETURN = {"bag salvage", "bag's stored site"}  # salvage reads past metadata; a bag may hold no site
 
@@ -226,6 +228,7 @@ COMMANDS: dict[str, tuple[str, Callable[[Path, Path], list[str]]]] = {
     "batch --manifest": (".yaml", lambda p, out: ["batch", "--manifest", str(p)]),
     "site --site": (".yaml", lambda p, out: ["site", "--site", str(p), str(out)]),
     "measure passby": (".wav", lambda p, out: ["measure", "passby", str(p), "--sensitivity", "1"]),
+    "measure roughness": (".csv", lambda p, out: ["measure", "roughness", str(p)]),
 }
 
 

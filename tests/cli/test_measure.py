@@ -58,3 +58,22 @@ def test_the_table_and_the_refusals(tmp_path, capsys):
     assert len(err) == 1 and "not inside the record" in err[0] and str(wav) in err[0]
     assert main(["measure", "passby", str(tmp_path / "none.wav"), "--sensitivity", "1"]) == 2
     assert "no such file" in capsys.readouterr().err
+
+
+def test_measure_roughness_reads_a_trolley_csv(tmp_path, capsys):
+    """A trace CSV in micrometres: the band of its 10 um sinusoid at 50.1 mm reads 16.99 dB re 1 um
+    to 0.1 dB; an unevenly spaced trace is one line naming the file."""
+    x = np.arange(0.0, 10.0, 0.001)
+    z_um = 10.0 * np.sin(2 * np.pi * x / 10 ** -1.3)
+    path = tmp_path / "trace.csv"
+    path.write_text("# trolley run 1\ndistance_m,displacement_um\n"
+                    + "".join(f"{a:.4f},{b:.5f}\n" for a, b in zip(x, z_um, strict=True)))
+    assert main(["measure", "roughness", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    k = int(np.argmin(np.abs(np.log(np.array(out["wavelength_m"]) / 10 ** -1.3))))
+    assert out["level_db"][k] == pytest.approx(20 * np.log10(10 / np.sqrt(2)), abs=0.1)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("distance_m,displacement_um\n" + "".join(f"{a * a:.6f},0\n" for a in range(20)))
+    assert main(["measure", "roughness", str(bad)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not evenly spaced" in err[0] and str(bad) in err[0]

@@ -24,6 +24,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--end-s", type=float, help="the train's rear at the microphone [s] (default: the record's end)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=run_passby)
+    r = what.add_parser("roughness", help="rail roughness per 1/3-octave wavelength band from a trolley's trace")
+    r.add_argument("trace", help="CSV: distance_m and displacement_um (or displacement_m), evenly spaced")
+    r.add_argument("--wheel-radius-m", type=float, default=0.46, help="radius of the wheel of the curvature "
+                   "processing [m]")
+    r.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    r.set_defaults(func=run_roughness)
 
 
 def run_passby(ns: argparse.Namespace) -> int:
@@ -70,4 +76,28 @@ def run_passby(ns: argparse.Namespace) -> int:
         print("no audible tone")
     print(f"squeal at {d.frequency_hz:.0f} Hz, {d.level_db:.1f} dB, for {d.duration_s:.1f} s ({100 * d.share:.0f} % of "
           "the pass)" if d.squeal else "no squeal", f"; flanging for {d.flanging_s:.1f} s" if d.flanging else "")
+    return 0
+
+
+def run_roughness(ns: argparse.Namespace) -> int:
+    from rail_monitor.bagio.trace_csv import read_trace
+    from rail_monitor.models.rail_roughness import roughness_spectrum
+
+    dx, z = read_trace(ns.trace)
+    if not 0.0 < ns.wheel_radius_m < 5.0:
+        raise RailMonitorError(f"--wheel-radius-m must be between 0 and 5 m, not {ns.wheel_radius_m:g}")
+    try:
+        s = roughness_spectrum(z, dx, ns.wheel_radius_m)
+    except ValueError as exc:
+        raise RailMonitorError(f"{ns.trace}: {exc}") from None
+    if ns.json:
+        print_json({"length_m": s.length_m, "spacing_m": dx, "spikes_removed": s.spikes,
+                    "wavelength_m": s.wavelength_m.tolist(), "rms_m": s.rms_m.tolist(),
+                    "level_db": s.level_db.tolist()})
+        return 0
+    print(f"# {ns.trace}: {s.length_m:.2f} m at {1e3 * dx:g} mm, {s.spikes} sample(s) replaced as spikes; "
+          "dB re 1 um")
+    print(f"{'lambda [mm]':>11} {'level':>7} {'r.m.s. [um]':>11}")
+    for lam, lv, rms in zip(s.wavelength_m, s.level_db, s.rms_m, strict=True):
+        print(f"{1e3 * lam:11.1f} {lv:7.1f} {1e6 * rms:11.3f}")
     return 0
