@@ -4,8 +4,9 @@ file maps any exception it can raise to one line naming the file and what is wro
 The readers: site and parameter files, a Dask manifest (YAML; a JSON document is YAML too), the
 detector and station CSVs, a bag (its index, its metadata.yaml, salvage, its stored site), a
 checkpoint, a WAV recording, a trolley's trace, and the command line over them. Each hostile
-content is given under the name each reader expects (``.yaml``, ``.csv``, ``.mcap``, a bag folder's ``metadata.yaml``); the special files (a
-folder, a pipe, a sparse 8 GiB file, a link loop, a dangling link, nothing) under the same names.
+content is given under the name each reader expects (``.yaml``, ``.csv``, ``.mcap``, ``.wav``, a bag
+folder's ``metadata.yaml``); the special files (a folder, a pipe, a sparse 8 GiB file, a link loop,
+a dangling link, nothing) under the same names.
 
 What holds for every pair: the reader raises RailMonitorError, or (salvage only, whose point is to
 read past a damaged index) returns; the error is one printable line naming the file; nothing hangs
