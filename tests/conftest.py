@@ -211,3 +211,28 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     lines = ["| area | tried | what holds | messages lost | test |", "|---|---|---|---|---|"]
     lines += [f"| {r['area']} | {r['tried']} | {r['held']} | {r['lost']} | `{r['test']}` |" for r in _TALLY]
     TALLY_FILE.write_text("\n".join(lines) + "\n")
+
+
+def band_noise_tolerance_db(bands, tp_s: float) -> np.ndarray:
+    """How far the pass-by processor may read a band of synthesised noise from what its filter passes
+    of the noise (band_readings_db) [dB]: 0.1 dB, plus two standard deviations of the power of Gaussian
+    noise of the band's width B over Tp (4.34 / sqrt(B Tp) dB)."""
+    from rail_monitor.models.iec61260 import band_edges
+
+    lo, hi = band_edges(bands)
+    return 0.1 + 2 * 4.34 / np.sqrt((hi - lo) * tp_s)
+
+
+def band_readings_db(level_db, bands) -> np.ndarray:
+    """What the processor's band filters pass of noise of flat density within each band at these
+    levels [dB]: sum over bands b' of P_b' times the mean of |H_b|^2 over b' (numerical integration;
+    the filters' effective bandwidth and their skirts over a stepped spectrum)."""
+    from rail_monitor.models.iec61260 import band_edges, band_power_response
+
+    lo, hi = band_edges(bands)
+    p = 10 ** (np.asarray(level_db, float) / 10)
+    coupling = np.empty((len(bands), len(bands)))
+    for j, (a, b) in enumerate(zip(lo, hi, strict=True)):
+        f = np.linspace(a, b, 2001)
+        coupling[:, j] = np.trapezoid(band_power_response(f, np.asarray(bands)), f, axis=-1) / (b - a)
+    return 10 * np.log10(coupling @ p)

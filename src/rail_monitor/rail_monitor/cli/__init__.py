@@ -21,6 +21,7 @@ from rail_monitor.cli import (
     graph,
     info,
     measure,
+    predict_audio,
     predict_corrugation,
     predict_noise,
     predict_roughness,
@@ -42,7 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     graph.add_parsers(sub)
     s = sub.add_parser("predict", help="run one model on physical inputs")
     models = s.add_subparsers(dest="model", required=True)
-    for verb in (predict_squeal, predict_corrugation, predict_noise, predict_roughness):
+    for verb in (predict_squeal, predict_corrugation, predict_noise, predict_roughness, predict_audio):
         verb.add_parser(models)
     measure.add_parser(sub)
     batch.add_parser(sub)

@@ -5,7 +5,8 @@ wheelset stays unstable. Flanging noise is broadband and high-pitched, with no s
 is cut into frames (0.2 s, half overlapping). In each frame the tonal components between 400 Hz
 and 10 kHz are found as models.tonality finds them (ISO/PAS 20065); a frame squeals when its
 strongest tone's audibility reaches ``min_audibility_db``. Consecutive squealing frames whose tones
-stay within one critical band of the first make a squeal, lasting (frames - 1) x hop (a tone partly
+stay within half a critical band of the frame before (a squeal glides with the Doppler shift as the
+wheel passes) make a squeal, lasting (frames - 1) x hop (a tone partly
 filling the frames at its ends is found in them too; half a frame more at an end of the pass, where
 the frames are cut); the pass squeals when its longest squeal lasts
 ``min_duration_s``. A frame with no such tone but with more power in the 4-10 kHz bands than in the
@@ -71,8 +72,8 @@ def detect_squeal(pressure_pa: ArrayLike, fs_hz: float, start_s: float | None = 
     best_at = run_at = 0
     run: list[tonality.Tone] = []
     for k, (tone, _) in enumerate(frames):
-        if tone is not None and run and abs(tone.frequency_hz - run[0].frequency_hz) <= \
-                tonality.critical_bandwidth_hz(run[0].frequency_hz) / 2:
+        if tone is not None and run and abs(tone.frequency_hz - run[-1].frequency_hz) <= \
+                tonality.critical_bandwidth_hz(run[-1].frequency_hz) / 2:
             run.append(tone)
         else:
             run, run_at = ([tone], k) if tone is not None else ([], k)
