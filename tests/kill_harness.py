@@ -43,20 +43,21 @@ from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
 
 TOP = Path(__file__).resolve().parents[1]
-PASSES = 400           # of the sample, per history
+PASSES = 120           # of the sample, per checkpointed history
+RECORDED = 240         # of the sample, per bag
 STEP = 10              # passes per take (the node takes what arrived; 10 is a busy moment)
-EVERY = 20             # passes between checkpoints (the node's default is 100; more writes, more chances)
+EVERY = 6              # passes between checkpoints (the node's default is 100; more writes, more chances)
 FLUSH_EVERY = 50       # messages between flushes (the node flushes every flush_period_s)
 LATE = 1.1             # a kill lands uniformly between the fork and LATE x an uninterrupted life
 
 
-def _sample() -> PassTable:
+def _sample(n: int) -> PassTable:
     from rail_monitor.site_file import load_site
 
     site = load_site(TOP / "src" / "rail_monitor" / "config" / "curve_250.yaml")
     table = read_passes(TOP / "bags" / "sample").sorted()
     table = with_class_defaults(table.take(rejection_reasons(table, site) == ""), site)
-    return table.take(slice(0, PASSES))
+    return table.take(slice(0, n))
 
 
 def _digest(arrays: dict[str, np.ndarray]) -> str:
@@ -111,7 +112,7 @@ def checkpoints(kills: int, seed: int, folder: Path) -> dict:
 
     config = SiteConfig.from_values(load_parameter_file(TOP / "src" / "rail_monitor" / "config" / "curve_250.yaml"))
     pristine = CorrugationEstimator(config.site, config.corrugation)
-    passes = _sample()
+    passes = _sample(PASSES)
     path = folder / "corrugation.npz"
 
     def work(fd: int) -> None:
@@ -187,14 +188,14 @@ def recordings(kills: int, seed: int, folder: Path) -> dict:
     from rail_monitor.bagio.mcap_bag import McapBagWriter
     from rail_monitor.codec.typestore import TRAIN_PASS
 
-    passes = _sample()
+    passes = _sample(RECORDED)
     cdr = pass_cdr(passes, "kill_harness")
     rng = random.Random(seed)
     faults: list[str] = []
     strict = salvaged_total = flushed_total = split_files = 0
 
     def work(fd: int, bag: Path) -> None:
-        writer = McapBagWriter(bag, chunk_size=16 << 10, max_file_bytes=64 << 10)
+        writer = McapBagWriter(bag, chunk_size=4 << 10, max_file_bytes=24 << 10)
         writer.add_topic("/train_pass", TRAIN_PASS)
         for i in range(0, len(cdr), FLUSH_EVERY):
             writer.write_many("/train_pass", cdr[i:i + FLUSH_EVERY], passes.stamp_ns[i:i + FLUSH_EVERY].tolist())

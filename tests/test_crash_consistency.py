@@ -39,7 +39,7 @@ def test_no_kill_leaves_a_checkpoint_that_fails_or_is_older_than_the_last_report
     assert r["histories"] >= 2  # histories resumed across kills ended in the uninterrupted state
     assert len(set(r["passes_at_kill"])) >= 10  # the kills landed all along the history
     tally("checkpoint SIGKILL", f"{KILLS} seeded SIGKILLs of a replay resuming from its checkpoint each time "
-          f"(400 sample passes per history, a checkpoint every 20): {r['histories']} whole histories, "
+          f"(120 sample passes per history, a checkpoint every 6): {r['histories']} whole histories, "
           f"{r['fallbacks']} kills between the two renames", "every checkpoint loads; never older than the last "
           "reported written; exactly a state submitted; each whole history ends in the uninterrupted state's bits",
           "0")
@@ -50,7 +50,8 @@ def test_no_kill_leaves_a_bag_that_loses_a_flushed_message(killed, tally):
     assert r["kills"] == KILLS and not r["faults"], "\n".join(r["faults"])
     assert r["read_strictly"] < KILLS // 2  # most kills landed before the bag was closed
     assert r["recovered"] >= r["flushed"] > 0
-    tally("recorder SIGKILL", f"{KILLS} seeded SIGKILLs of a bag writer (16 KiB chunks, 64 KiB split files, a "
-          f"flush every 50 messages): {r['files']} files", f"each bag read whole ({r['read_strictly']}) or refused "
-          f"in one line and salvaged; {r['recovered']} messages recovered of {r['flushed']} reported flushed, "
+    tally("recorder SIGKILL", f"{KILLS} seeded SIGKILLs of a bag writer (240 passes, 4 KiB chunks, 24 KiB split "
+          f"files, a flush every 50 messages): {r['files']} files",
+          f"each bag read whole ({r['read_strictly']}) or refused in one line and salvaged; {r['recovered']} "
+          f"messages recovered of {r['flushed']} reported flushed, "
           "each a prefix of what was written", "0 flushed")
