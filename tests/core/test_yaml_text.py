@@ -49,3 +49,13 @@ def test_the_issue_repro_is_one_line_through_the_command_line(tmp_path):
         assert r.returncode != 0 and "Traceback" not in r.stderr, r.stderr[-2000:]
         lines = [line for line in r.stderr.splitlines() if line.strip()]
         assert len(lines) == 1 and str(site) in lines[0] and "nested too deeply" in lines[0], r.stderr
+
+
+def test_brackets_in_quotes_and_comments_do_not_count_toward_the_depth():
+    """The pre-scan of flow nesting (before the parser) skips quoted text and comments: a document
+    with 150 '[' inside a double-quoted string (one escaped quote among them), a single-quoted string
+    and a comment loads."""
+    deep = "[" * 150
+    text = f'a: "x\\" {deep}"\nb: \'{deep}\'\n# {deep}\nc: [1, [2]]\n'
+    doc = load_yaml(text, "x")
+    assert doc["a"] == f'x" {deep}' and doc["b"] == deep and doc["c"] == [1, [2]]

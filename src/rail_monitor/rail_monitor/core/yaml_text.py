@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import Any
 
 import yaml
@@ -21,6 +22,8 @@ def load_yaml(text: str, where: str, error: type[RailMonitorError] = InputError)
     integer of more than 4300 digits), nesting deeper than MAX_DEPTH, or aliases that expand to
     more than MAX_NODES values (a "billion laughs" document) is one ``error`` naming ``where``."""
     try:
+        if _flow_depth(text) > MAX_DEPTH:  # before the parser, which takes seconds over 20,000 '['
+            raise RecursionError
         doc = yaml.safe_load(text)
         _check_shape(doc)
     except yaml.YAMLError as exc:
@@ -32,6 +35,40 @@ def load_yaml(text: str, where: str, error: type[RailMonitorError] = InputError)
     except Exception as exc:  # a scalar the constructor refuses (ValueError, OverflowError)
         raise error(f"{where}: not valid YAML: {type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}") from None
     return doc
+
+
+_FLOW = re.compile(r"""[\[\]{}'"#\n\\]""")
+
+
+def _flow_depth(text: str) -> int:
+    """The deepest nesting of flow collections ([ ], { }) in YAML text, outside quotes and comments
+    (the scan stops as soon as it passes MAX_DEPTH). A quote or bracket inside a plain scalar may
+    miscount it; load_yaml's check of the parsed document stays the rule."""
+    depth = deepest = 0
+    quote, comment, skip_at = "", False, -1
+    for m in _FLOW.finditer(text):
+        c, at = m.group(), m.start()
+        if at == skip_at:  # escaped by a backslash in a double-quoted string
+            continue
+        if comment:
+            comment = c != "\n"
+        elif quote:
+            if c == "\\" and quote == '"':
+                skip_at = at + 1
+            elif c == quote:
+                quote = ""
+        elif c in "'\"":
+            quote = c
+        elif c == "#" and (at == 0 or text[at - 1] in " \t\n"):
+            comment = True
+        elif c in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+            if deepest > MAX_DEPTH:
+                break
+        elif c in "]}":
+            depth = max(depth - 1, 0)
+    return deepest
 
 
 def _check_shape(doc: Any) -> None:
