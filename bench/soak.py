@@ -176,12 +176,14 @@ def main() -> None:
             procs = [subprocess.Popen(c, stdout=subprocess.DEVNULL, stderr=err, env=env) for c in commands]
         t0 = time.monotonic()
         samples: list[tuple[float, float, int]] = []  # (minutes, RSS MB of the graph, folder bytes)
+        each: list[list[float]] = []  # RSS MB of each process of the graph, at the same samples
         graph = procs[:-1] if five else procs  # the simulator ends by itself: not part of the graph's memory
         running = (lambda: procs[-1].poll() is None) if five else (lambda: procs[0].poll() is None)
         while time.monotonic() - t0 < (minutes * 60.0 if not five else 2 * minutes * 60.0 + 600) and running():
             time.sleep(ns.sample_s)
             if all(p.poll() is None for p in graph):
-                samples.append(((time.monotonic() - t0) / 60.0, sum(rss_mb(p.pid) for p in graph), folder_bytes(bag)))
+                each.append([rss_mb(p.pid) for p in graph])
+                samples.append(((time.monotonic() - t0) / 60.0, sum(each[-1]), folder_bytes(bag)))
         counts = _settled(listener, procs[-1], 120.0) if five else None
         for p in procs:
             if p.poll() is None:
@@ -201,6 +203,9 @@ def main() -> None:
     late = t >= 2 * t[-1] / 3
     late_slope = np.polyfit(t[late], rss[late], 1)[0] if late.sum() > 2 else float("nan")
     per_day = ns.speedup / DAY_S * 60.0  # simulated days per wall minute
+    names = [c[0] for c in commands[:len(graph)]]
+    by_process = ", ".join(f"{name} {np.polyfit(t[warm], col[warm], 1)[0] / per_day:+.3f}"
+                           for name, col in zip(names, np.array(each).T, strict=True)) if warm.sum() > 2 else ""
     what = (f"{ns.days:g} simulated days at {ns.speedup:g}x ({24 * ns.trains_per_hour:g} trains a day), five "
             f"processes and the simulator; memory trend after {ns.warm_days:g} simulated days" if five
             else f"{ns.passes_per_s:g} passes per second, wayside_monitor")
@@ -208,7 +213,7 @@ def main() -> None:
             ("RSS of the graph after warm-up / at the end", f"{rss[warm][0]:.0f} / {rss[-1]:.0f} MB",
              f"trend {60 * slope:+.1f} MB/hour over {t[warm][-1] - t[warm][0]:.1f} min, {60 * late_slope:+.1f} "
              f"MB/hour over the last third; peak {rss.max():.0f} MB"
-             + (f"; per simulated day {slope / per_day:+.3f} MB" if five else "")),
+             + (f"; per simulated day {slope / per_day:+.3f} MB ({by_process})" if five else "")),
             ("bag on disk, largest sample / budget", f"{size.max() / 2**20:.2f} / {ns.budget_mib:g} MiB",
              f"final {final / 2**20:.2f} MiB; {len(samples)} samples, every {ns.sample_s:g} s"),
             ("kept files", f"{files}", f"{messages:,} messages read by rosbags through metadata.yaml; "

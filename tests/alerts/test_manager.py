@@ -274,6 +274,26 @@ def test_wheel_defect_alerts_name_the_vehicle_count_repeats_and_clear_with_hyste
     assert set(m.standing) == {(KIND_WHEEL_DEFECT, "train T4"), (KIND_WHEEL_DEFECT, "vehicle V8")}
 
 
+
+def test_a_long_run_keeps_counts_not_every_event_or_every_train_flagged():
+    """A box running for years: events are handed over by take_events and forgotten, raises and
+    clears stay counted; the repeat-offender counts keep the most flagged keys, not one per train."""
+    from rail_monitor.alerts import manager
+
+    m = _manager(wheel_defect_raise_db=6.0, wheel_defect_clear_db=3.0, wheel_defect_vehicle_db=2.0)
+    n = 2 * manager.OFFENDERS_KEPT
+    # A named vehicle flagged every tenth pass and quiet five passes later (raised, then cleared),
+    # and a new train flagged on each of the others (0.8 n keys).
+    seq = [_residual(i, f"T{i}", 9.0, loudest="V1", loudest_db=5.0) if i % 10 == 0
+           else _residual(i, f"T{i}", 1.0, vehicles=("V1",)) if i % 10 == 5 else _residual(i, f"T{i}", 9.0)
+           for i in range(n)]
+    returned = m.on_residuals(seq)
+    taken = m.take_events()
+    assert taken == returned and m.events == [] and m.take_events() == []
+    assert m.raised == sum(e.active for e in taken) and m.cleared == sum(not e.active for e in taken) > 0
+    assert len(m.offences) <= manager.OFFENDERS_KEPT
+    assert m.offences["vehicle V1"] == (n + 9) // 10  # the repeat offender keeps its true count
+
 def test_the_drift_alert_raises_on_the_baseline_rise_and_clears_below_its_hysteresis():
     from rail_monitor.alerts.config import KIND_NOISE_DRIFT
 

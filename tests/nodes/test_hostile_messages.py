@@ -214,7 +214,7 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     assert est.surveys_rejected["stamp more than 366 d ahead of the stream (stamps.max_ahead_of_stream_s)"] == 2, \
         est.surveys_rejected
     assert any(why.startswith("ValueError") for why in process.CALLBACK_ERRORS), process.CALLBACK_ERRORS
-    assert not any("red" in a.key or a.key == "N" for a in alerts.alerts.events)
+    assert not any("red" in a.key or a.key == "N" for a in alerts.recent)
 
     # Every node goes on: valid passes after the storm get every output, recorded.
     after = _valid_passes(site, 4, T0 + 7200)

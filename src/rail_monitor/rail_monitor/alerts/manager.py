@@ -32,6 +32,10 @@ from rail_monitor.alerts.windows import Window, hysteresis_changes
 from rail_monitor.core.text import printable
 from rail_monitor.core.timeutil import format_iso_ns
 
+# Wheel-defect keys whose flags are counted: past this many, the most flagged half is kept (a key
+# per train id, new every pass, would otherwise grow without end on a box running for years).
+OFFENDERS_KEPT = 10_000
+
 
 @dataclass(frozen=True)
 class Alert:
@@ -56,7 +60,8 @@ class AlertManager:
     def __init__(self, cfg: AlertConfig) -> None:
         self.cfg = cfg
         self.standing: dict[tuple[int, str], Alert] = {}
-        self.events: list[Alert] = []
+        self.events: list[Alert] = []  # since the last take_events(): a long-running caller takes them
+        self.raised = self.cleared = 0  # every raise and clear so far
         self._noise: dict[str, Window] = {}
         self._squeal = Window(cfg.squeal_window_passes)
         self._rejected = Window(cfg.rejected_window_passes)
@@ -87,10 +92,18 @@ class AlertManager:
                       int(raised), int(due_ns))
         if active:
             self.standing[(kind, key)] = event
+            self.raised += 1
         else:
             del self.standing[(kind, key)]
+            self.cleared += 1
         self.events.append(event)
         return event
+
+    def take_events(self) -> list[Alert]:
+        """The raise and clear events since the last call, in the order made; the manager forgets
+        them (a node running for years must not keep every event)."""
+        out, self.events = self.events, []
+        return out
 
     def _windowed_change(self, active: bool, kind: int, key: str, stamp_ns: int, what: str, threshold_text: str,
                          unit: str, value: float, threshold: float) -> Alert | None:
@@ -251,6 +264,9 @@ class AlertManager:
             key = f"vehicle {r.loudest_vehicle_id}" if named else f"train {r.train_id}"
             if score >= cfg.wheel_defect_raise_db:
                 self.offences[key] += 1
+                if len(self.offences) > OFFENDERS_KEPT:  # a new train id per pass must not grow it for ever
+                    self.offences = Counter(dict(self.offences.most_common(OFFENDERS_KEPT // 2)))
+                    self.offences[key] = max(self.offences[key], 1)
                 events.append(self._set(
                     True, KIND_WHEEL_DEFECT, key, r.stamp_ns, SEVERITY_WARNING,
                     f"wheel defect suspect: {key} (train {r.train_id}) {score:+.1f} dB over the site's baseline "

@@ -189,7 +189,7 @@ class BatchRun:
         self.alerts.on_residuals(residuals)
         for name, out in noise.items():
             self.alerts.on_noise(accepted.stamp_ns, name, out.per_pass())
-        events, self.alerts.events = self.alerts.events, []
+        events = self.alerts.take_events()
         events = sorted(self._held + events, key=_alert_key)
         later = int(table.stamp_ns[-1]) if len(table) else np.iinfo(np.int64).min
         self._held = [a for a in events if a.stamp_ns >= later]  # may tie with the next chunk's first pass

@@ -15,7 +15,7 @@ standing alerts at once. Thresholds and hysteresis: ``alerts.*``
 from __future__ import annotations
 
 import sys
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Callable
 from typing import Any
 
@@ -63,6 +63,8 @@ from rail_msgs.msg import (
     WaysideAlertArray,
 )
 
+RECENT_KEPT = 100  # events the node keeps after publishing them, to inspect a running node
+
 
 class AlertManagerNode(PassConsumerNode):
     EXECUTABLE = "alert_manager"
@@ -72,6 +74,7 @@ class AlertManagerNode(PassConsumerNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("alert_manager", **kwargs)
         self._lead = declare(self, (LEAD_TIME,), prefix="corrugation.")["lead_time_days"]
+        self.recent: deque[Alert] = deque(maxlen=RECENT_KEPT)  # the latest events published
         self.alerts = AlertManager(alert_config(declare(self, ALERT_SPECS, prefix="alerts."), self._lead, prefix=""))
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.inputs: Counter[str] = Counter()
@@ -192,6 +195,8 @@ class AlertManagerNode(PassConsumerNode):
                 self._publish_standing(now)
 
     def _emit(self, events: list[Alert]) -> None:
+        self.alerts.take_events()  # published here: the manager keeps none over a run of years
+        self.recent.extend(events)
         for e in events:
             self.sent.publish(self.pub, wayside_alert_fields(e, self.site.site_id))
             self.get_logger().info(describe(e))
@@ -203,10 +208,9 @@ class AlertManagerNode(PassConsumerNode):
         self.sent.publish(self.standing_pub, wayside_alert_array_fields(alerts, stamp_ns, self.site.site_id))
 
     def diagnostic_values(self) -> dict[str, Any]:
-        events = self.alerts.events
         return {**super().diagnostic_values(), **{f"taken {k}": n for k, n in sorted(self.inputs.items())},
-                "standing": len(self.alerts.standing), "raised": sum(e.active for e in events),
-                "cleared": sum(not e.active for e in events), "residuals": self.sent[self.residual_pub.topic_name],
+                "standing": len(self.alerts.standing), "raised": self.alerts.raised,
+                "cleared": self.alerts.cleared, "residuals": self.sent[self.residual_pub.topic_name],
                 "measurements scored late": self.tracker.late,
                 **{f"noise/measured refused: {why}": n for why, n in sorted(self.tracker.refused.items())},
                 **{f"standing {KIND_NAMES[k]}": n for k, n in
