@@ -59,12 +59,14 @@ LATEST = Qos(1, transient_local=True)
 # so at depth 1 a burst over UDP lost states. Latched too: a late subscriber gets the recent states.
 STATE = Qos(1000, transient_local=True)
 STATE_SUB = Qos(10000, transient_local=True)
-# Rare events that must not be lost (roughness surveys, grinding events).
+# Rare inputs that must not be lost (roughness surveys, grinding events); their senders wait for
+# the subscribers' acknowledgement. Volatile: a survey is taken once, by the subscribers present.
 EVENT = Qos(100)
 # Alert raise/clear events: reliable and latched, deep enough that a late subscriber gets the
 # recent history; the standing set is on alerts/standing (LATEST).
 ALERT = Qos(1000, transient_local=True)
 DIAGNOSTICS = Qos(100)
+DIAGNOSTICS_TOPIC = "/diagnostics"  # every node reports here, each period
 CLOCK = Qos(10)
 
 GRAPH_TOPICS: dict[str, tuple[str, Qos]] = {
@@ -79,4 +81,5 @@ OPTIONAL_TOPICS: dict[str, tuple[str, Qos]] = {
     "roughness_survey": ("rail_msgs/msg/RoughnessSurvey", EVENT),
     "noise/measured": ("rail_msgs/msg/MeasuredPassNoise", STREAM),
     "noise/residual": ("rail_msgs/msg/NoiseResidual", STREAM),
-    "corrugation/indirect_roughness": ("rail_msgs/msg/IndirectRoughness", EVENT)}
+    # A model output like the others (latched): a recorder that matched a moment late lost one.
+    "corrugation/indirect_roughness": ("rail_msgs/msg/IndirectRoughness", STREAM)}

@@ -18,6 +18,7 @@ from rclpy.node import Node
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamGroups, ParamSpec
 from rail_monitor.core.site import CONTACT_SPECS, SITE_SPECS, TRACK_SPECS, VEHICLE_SPECS, Site, site_from_values
+from rail_monitor.messages.topics import DIAGNOSTICS_TOPIC
 from rail_monitor.nodes.convert import to_cdr
 from rail_monitor.nodes.process import CALLBACK_ERRORS, SESSION_DEFAULT_SITE
 from rail_monitor.nodes.qos import DIAGNOSTICS_QOS
@@ -188,7 +189,7 @@ class Diagnostics:
         self._node = node
         self._values = values
         self._level = level or (lambda: (DiagnosticStatus.OK, "ok"))
-        self._pub = node.create_publisher(DiagnosticArray, "/diagnostics", DIAGNOSTICS_QOS)
+        self._pub = node.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, DIAGNOSTICS_QOS)
         # Due at whole multiples of the period on the steady clock (CLOCK_MONOTONIC, which every
         # process shares), so that the nodes of a process, and the recorder taking the statuses of
         # every process, wake once a period instead of once per node: idle, wake-ups are the CPU.

@@ -53,7 +53,7 @@ from rail_monitor.models.calibration import KbPosterior
 from rail_monitor.nodes.base import declare, subscribe_batched, take_queued, wall_timer
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
-from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_SUB_QOS
+from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_QOS, STREAM_SUB_QOS
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
@@ -115,7 +115,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if self.observer is not None:
             self.measured_sub = subscribe_batched(self, MeasuredPassNoise, "noise/measured", self._on_measured,
                                                   STREAM_SUB_QOS, self.max_batch)
-            self.indirect_pub = self.create_publisher(IndirectRoughness, "corrugation/indirect_roughness", EVENT_QOS)
+            self.indirect_pub = self.create_publisher(IndirectRoughness, "corrugation/indirect_roughness", STREAM_QOS)
         self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
         wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
         self.listen()

@@ -21,7 +21,7 @@ from rclpy.qos import QoSProfile
 
 from rail_monitor.codec.typestore import schema_text
 from rail_monitor.core.node_params import FOXGLOVE_SPECS, FoxgloveParams
-from rail_monitor.messages.topics import GRAPH_TOPICS
+from rail_monitor.messages.topics import DIAGNOSTICS_TOPIC, GRAPH_TOPICS
 from rail_monitor.nodes.base import Diagnostics, RateMeter, announce, wall_timer
 from rail_monitor.nodes.process import run_node
 from rail_monitor.nodes.topic_tap import DIAGNOSTICS_TYPE, TapNode, TopicTap
@@ -48,7 +48,7 @@ class FoxgloveServer(TapNode):
         # The graph's own topics get their channels at once, before any client connects: a channel
         # advertised while a client is subscribing can be missed by it (seen with the SDK's server).
         wanted = {self.resolve_topic_name(t) for t in self.cfg.topics if t}
-        for name, (typename, _) in (*GRAPH_TOPICS.items(), ("/diagnostics", (DIAGNOSTICS_TYPE, None))):
+        for name, (typename, _) in (*GRAPH_TOPICS.items(), (DIAGNOSTICS_TOPIC, (DIAGNOSTICS_TYPE, None))):
             topic = self.resolve_topic_name(name)
             if not wanted or topic in wanted:
                 self._add_topic(topic, typename, [])

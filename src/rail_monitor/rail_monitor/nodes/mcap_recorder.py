@@ -29,6 +29,7 @@ from rail_monitor.codec.typestore import header_stamp_ns, starts_with_header
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.node_params import RECORDER_SPECS, RecorderParams
 from rail_monitor.core.timeutil import NS_PER_S
+from rail_monitor.messages.topics import DIAGNOSTICS_TOPIC
 from rail_monitor.nodes.base import Diagnostics, RateMeter, announce, wall_timer
 from rail_monitor.nodes.process import SESSION_PARAMS_FILES, run_node, spin_once_guarded
 from rail_monitor.nodes.qos import qos_to_dict
@@ -65,7 +66,8 @@ class McapRecorder(TapNode):
         self._failed = False  # a write error was reported
         self.refused: Counter[str] = Counter()  # messages that could not be written, by cause
         self.diagnostics = Diagnostics(
-            self, lambda: {"recorded": self.meter.count, "rate_per_s": f"{self.meter.rate():.1f}",
+            self, lambda: {"recorded": self.meter.count, "recorded outputs": self.outputs_recorded(),
+                           "rate_per_s": f"{self.meter.rate():.1f}",
                            "topics": len(self.tap.subs), "bag": str(self.writer.folder),
                            "not recorded (write failed)": self.dropped, "write error": self.writer.error,
                            **{f"refused: {why}": n for why, n in sorted(self.refused.items())},
@@ -77,6 +79,11 @@ class McapRecorder(TapNode):
         announce(self, bag=self.writer.folder, site=describe(record) if record else "none stored",
                  log_time=self.cfg.log_time, compression=self.cfg.compression,
                  max_bag_size=self.cfg.max_bag_size, max_total_bytes=self.cfg.max_total_bytes)
+
+    def outputs_recorded(self) -> int:
+        """Messages recorded but /diagnostics (which every node sends each period): a pass source
+        waits for this count to stand still before it ends a replay."""
+        return self.meter.count - self.counts.get(DIAGNOSTICS_TOPIC, 0)
 
     def _health(self) -> dict[str, object]:
         with self._lock:

@@ -24,6 +24,7 @@ from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
 from rail_monitor.messages.fields import measured_pass_noise_fields, roughness_survey_fields, train_pass_columns
+from rail_monitor.messages.topics import DIAGNOSTICS_TOPIC
 from rail_monitor.nodes.base import DIAGNOSTICS_PERIOD_S, Diagnostics, RailNode, RateMeter, announce, declare
 from rail_monitor.nodes.convert import time_msg, to_cdr, to_cdr_many
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STREAM_QOS
@@ -59,7 +60,7 @@ class PassSourceNode(RailNode):
         self.measurements_sent = 0
         self._bounds = (0, 0)  # stamps of the replay window [ns]
         self._status: dict[str, dict[str, str]] = {}  # latest /diagnostics values, by status name
-        self.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, DIAGNOSTICS_QOS)
+        self.create_subscription(DiagnosticArray, DIAGNOSTICS_TOPIC, self._on_diagnostics, DIAGNOSTICS_QOS)
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
                                    "left out": sum(self.left_out.values()), "surveys sent": self.events_sent,
                                    "measurements sent": self.measurements_sent,
@@ -173,8 +174,9 @@ class PassSourceNode(RailNode):
     def _wait_for_graph(self, published: int, ok: Callable[[], bool]) -> None:
         """End-of-replay handshake (other processes): wait until every train_pass consumer that
         reports on /diagnostics has taken every pass and has none pending, then until a recorder's
-        count has stood still for a diagnostics period, at most wait_timeout_s. A finite replay
-        that then exits (ros2 launch shuts down on it) leaves nothing in flight."""
+        count of outputs (/diagnostics aside) has stood still for a diagnostics period, at most
+        wait_timeout_s. A finite replay that then exits (ros2 launch shuts down on it) leaves
+        nothing in flight."""
         deadline = time.monotonic() + self.cfg.wait_timeout_s
         names = {f"{i.node_namespace.rstrip('/')}/{i.node_name}"
                  for i in self.get_subscriptions_info_by_topic(self.pub.topic_name)}
@@ -188,7 +190,7 @@ class PassSourceNode(RailNode):
             time.sleep(0.05)
         recorded = None
         while ok() and time.monotonic() < deadline:
-            now = tuple(self._status.get(n, {}).get("recorded") for n in sorted(names))
+            now = tuple(self._status.get(n, {}).get("recorded outputs") for n in sorted(names))
             if now == recorded:
                 return
             recorded = now
