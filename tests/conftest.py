@@ -236,3 +236,31 @@ def band_readings_db(level_db, bands) -> np.ndarray:
         f = np.linspace(a, b, 2001)
         coupling[:, j] = np.trapezoid(band_power_response(f, np.asarray(bands)), f, axis=-1) / (b - a)
     return 10 * np.log10(coupling @ p)
+
+
+def write_pass_audio(folder: Path, stamp_ns: int, train_id: str, lead_s: float = 1.0, fs_hz: float = 32_000.0,
+                     **pass_kw):
+    """A predicted pass of the shipped site (rail_monitor.whatif.audio.pass_audio with pass_kw) written
+    where a station's recorder leaves it: folder/<audio_name>, float WAV in pascals, lead_s before
+    the pass. Returns the PassAudio."""
+    from scipy.io import wavfile
+
+    from rail_monitor.site_file import load_parameter_file
+    from rail_monitor.station.pass_audio import audio_name
+    from rail_monitor.whatif.audio import pass_audio
+
+    a = pass_audio(load_parameter_file(SITE_FILE), fs_hz=fs_hz, margin_s=lead_s, **pass_kw)
+    folder.mkdir(parents=True, exist_ok=True)
+    wavfile.write(folder / audio_name(stamp_ns, train_id), int(fs_hz), a.pressure_pa.astype(np.float32))
+    return a
+
+
+def same_record(a, b) -> bool:
+    """Two dataclass records equal field by field, arrays element by element, NaN equal to NaN."""
+    import dataclasses
+
+    def equal(x, y) -> bool:
+        x, y = np.asarray(x), np.asarray(y)
+        return np.array_equal(x, y, equal_nan=x.dtype.kind == "f" and y.dtype.kind == "f")
+
+    return all(equal(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a))

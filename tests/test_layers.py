@@ -20,7 +20,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("core",),                                                    # what every layer shares
     ("corrugation", "noise", "squeal", "measured", "alerts", "advice"),  # the per-model packages
     ("engine",),                                                  # a site's state, live and batch alike
-    ("codec", "messages", "bagio", "site_file", "batch", "report", "simulation", "whatif"),  # I/O, applications
+    ("codec", "messages", "bagio", "site_file", "batch", "report", "simulation", "station", "whatif"),  # I/O, apps
     ("nodes", "cli"),                                             # ROS 2 glue and the command line
 )
 ROOT = "<root>"  # rail_monitor/__init__.py: the version, importable from every layer

@@ -50,6 +50,7 @@ setup(
             "alert_manager = rail_monitor.nodes.alert_manager:main",
             "foxglove_server = rail_monitor.nodes.foxglove_server:main",
             "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
+            "noise_station = rail_monitor.nodes.noise_station:main",
             "rail-monitor = rail_monitor.cli:main",
         ],
     },

@@ -33,12 +33,14 @@ from rail_monitor.corrugation.config import CORRUGATION_SPECS
 from rail_monitor.measured.config import RESIDUAL_SPECS
 from rail_monitor.noise.config import NOISE_SPECS
 from rail_monitor.squeal.config import SQUEAL_SPECS
+from rail_monitor.station.config import STATION_SPECS
 
 # Every section a site file may hold: (prefix, specs). Vehicle classes are added per name.
 SECTIONS: tuple[tuple[str, tuple[ParamSpec, ...]], ...] = (
     ("", SITE_SPECS), ("contact.", CONTACT_SPECS), ("track.", TRACK_SPECS),
     ("corrugation.", CORRUGATION_SPECS), ("squeal.", SQUEAL_SPECS), ("noise.", NOISE_SPECS),
     ("alerts.", ALERT_SPECS), ("residual.", RESIDUAL_SPECS), ("stamps.", node_params.STAMP_SPECS),
+    ("station.", STATION_SPECS),
     ("", SIMULATOR_SPECS),
     *(("", specs) for specs in (node_params.PUBLISH_SPECS, node_params.REPLAYER_SPECS, node_params.MODE_SPECS,
                                 node_params.RECORDER_SPECS, node_params.MONITOR_SPECS, node_params.BATCH_SPECS,
@@ -149,6 +151,7 @@ REFERENCE_SECTIONS: tuple[tuple[str, str, tuple[ParamSpec, ...]], ...] = (
     ("Corrugation", "corrugation.", CORRUGATION_SPECS), ("Squeal", "squeal.", SQUEAL_SPECS),
     ("Rolling noise", "noise.", NOISE_SPECS), ("Alerts", "alerts.", ALERT_SPECS),
     ("Measured noise: residuals", "residual.", RESIDUAL_SPECS),
+    ("Noise station (noise_station)", "station.", STATION_SPECS),
     ("Stamp plausibility", "stamps.", node_params.STAMP_SPECS), ("Simulator", "", SIMULATOR_SPECS),
     ("Pass sources (pass_replayer, pass_simulator)", "", node_params.PUBLISH_SPECS),
     ("pass_replayer", "", node_params.REPLAYER_SPECS), ("pass_simulator and pass_replayer: mode", "",

@@ -33,28 +33,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run_passby(ns: argparse.Namespace) -> int:
-    from rail_monitor.bagio.wav import read_wav
-    from rail_monitor.models.iso3095 import passby_levels, sensitivity_pa_per_unit
-    from rail_monitor.models.squeal_detection import detect_squeal
+    from rail_monitor.station.pass_audio import hear, sensitivity
 
     if (ns.calibration_file is None) == (ns.sensitivity is None):
         raise RailMonitorError("give one of --calibration-file (with --calibration-db) or --sensitivity")
-    fs, samples = read_wav(ns.wav, ns.channel)
-    if ns.sensitivity is not None:
-        if not 0.0 < ns.sensitivity < float("inf"):
-            raise RailMonitorError(f"--sensitivity must be a positive number of pascals, not {ns.sensitivity:g}")
-        scale = ns.sensitivity
-    else:
-        _, cal = read_wav(ns.calibration_file, ns.channel)
-        try:
-            scale = sensitivity_pa_per_unit(cal, ns.calibration_db)
-        except ValueError as exc:
-            raise RailMonitorError(f"{ns.calibration_file}: {exc}") from None
-    try:
-        r = passby_levels(samples * scale, fs, ns.start_s, ns.end_s)
-        d = detect_squeal(samples * scale, fs, ns.start_s, ns.end_s)
-    except ValueError as exc:
-        raise RailMonitorError(f"{ns.wav}: {exc}") from None
+    if ns.sensitivity is not None and not 0.0 < ns.sensitivity < float("inf"):
+        raise RailMonitorError(f"--sensitivity must be a positive number of pascals, not {ns.sensitivity:g}")
+    scale = sensitivity(ns.sensitivity or 0.0, ns.calibration_file, ns.calibration_db, ns.channel)
+    heard = hear(ns.wav, scale, ns.channel, ns.start_s, ns.end_s)
+    r, d = heard.levels, heard.squeal
     tones = [{"frequency_hz": t.frequency_hz, "level_db": t.level_db, "audibility_db": t.audibility_db}
              for t in r.tones]
     squeal = {"detected": d.squeal, "frequency_hz": d.frequency_hz, "level_db": d.level_db,

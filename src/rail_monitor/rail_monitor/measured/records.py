@@ -4,7 +4,8 @@ A measurement is refused, with a one-line reason, when a band level or single nu
 finite or outside 0-150 dB (no train at 7.5 m gives a level outside that), when its bands are not
 1/3-octave centres of the model's set, when its receiver is not the model's (within
 ``residual.receiver_tolerance_m``), when its instrument class is not 1 or 2, or when its vehicle
-segments do not pair ids with levels.
+segments do not pair ids with levels, or when a squeal measure (tone, level, duration; NaN: not
+measured) is out of range or given for a pass not flagged squealing.
 """
 
 from __future__ import annotations
@@ -17,6 +18,11 @@ import numpy as np
 LEVEL_RANGE_DB = (0.0, 150.0)
 INSTRUMENT_CLASSES = (1, 2)
 MAX_VEHICLES = 1000  # segments of one train: more is no train (and would cost memory to check)
+SQUEAL_BAND_HZ = (20.0, 20_000.0)  # a squeal's tone is audible sound (measured ones lie in 0.4-10 kHz)
+MAX_PASS_S = 3600.0  # no pass-by lasts an hour
+# The squeal measures a measurement may carry, each with its value when not measured.
+SQUEAL_MEASURES: dict[str, float | bool] = {"squeal_frequency_hz": float("nan"), "squeal_level_db": float("nan"),
+                                            "squeal_duration_s": float("nan"), "flanging_detected": False}
 
 
 @dataclass(frozen=True)
@@ -36,6 +42,10 @@ class Measurement:
     squeal_detected: bool = False
     vehicle_id: tuple[str, ...] = ()
     vehicle_lpaeq_dba: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    squeal_frequency_hz: float = float("nan")  # NaN: no squeal, or not measured
+    squeal_level_db: float = float("nan")      # [dB re 20 uPa]
+    squeal_duration_s: float = float("nan")    # 0: no squeal; NaN: not measured
+    flanging_detected: bool = False
 
     @property
     def key(self) -> tuple[int, str]:
@@ -89,4 +99,17 @@ def measurement_refusal(m: Measurement, model_band_hz: np.ndarray, receiver_m: t
     seg = np.asarray(m.vehicle_lpaeq_dba, float)
     if len(m.vehicle_id) != len(seg) or not np.all(np.isfinite(seg) & (seg >= lo) & (seg <= hi)):
         return "vehicle_id and vehicle_lpaeq_dba differ in length, or a vehicle level is not a level"
+    return squeal_refusal(m)
+
+
+def squeal_refusal(m: Measurement) -> str:
+    """Why a measurement's squeal measures are not measures ('' when they are, NaN: not measured)."""
+    f, level, duration = m.squeal_frequency_hz, m.squeal_level_db, m.squeal_duration_s
+    lo, hi = LEVEL_RANGE_DB
+    if not (np.isnan(f) or SQUEAL_BAND_HZ[0] <= f <= SQUEAL_BAND_HZ[1]) or not (np.isnan(level) or lo <= level <= hi) \
+            or not (np.isnan(duration) or 0.0 <= duration <= MAX_PASS_S):
+        return (f"a squeal measure is out of range (tone {SQUEAL_BAND_HZ[0]:g}-{SQUEAL_BAND_HZ[1]:g} Hz, level "
+                f"{lo:g}-{hi:g} dB, duration 0-{MAX_PASS_S:g} s)")
+    if not m.squeal_detected and (np.isfinite(f) or np.isfinite(level) or duration > 0.0):
+        return "squeal measured on a pass not flagged squealing"
     return ""

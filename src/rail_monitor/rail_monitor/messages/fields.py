@@ -26,7 +26,7 @@ from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot, Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent
-from rail_monitor.measured.records import Measurement
+from rail_monitor.measured.records import SQUEAL_MEASURES, Measurement
 from rail_monitor.measured.residuals import Residual
 from rail_monitor.noise.records import NoisePrediction
 
@@ -278,7 +278,8 @@ def measured_pass_noise_fields(m: Measurement, frame_id: str) -> Fields:
             "instrument_class": m.instrument_class, "band_centre_hz": np.asarray(m.band_centre_hz, float).tolist(),
             "leq_db": np.asarray(m.leq_db, float).tolist(), "lpaeq_tp_dba": m.lpaeq_tp_dba,
             "lpafmax_dba": m.lpafmax_dba, "tel_dba": m.tel_dba, "squeal_detected": m.squeal_detected,
-            "vehicle_id": list(m.vehicle_id), "vehicle_lpaeq_dba": np.asarray(m.vehicle_lpaeq_dba, float).tolist()}
+            "vehicle_id": list(m.vehicle_id), "vehicle_lpaeq_dba": np.asarray(m.vehicle_lpaeq_dba, float).tolist(),
+            **{name: getattr(m, name) for name in SQUEAL_MEASURES}}
 
 
 def noise_residual_fields(r: Residual, frame_id: str) -> Fields:
@@ -291,11 +292,13 @@ def noise_residual_fields(r: Residual, frame_id: str) -> Fields:
 # -- back to records ------------------------------------------------------------------------------
 def measurement_from_msg(msg: Any) -> Measurement:
     """A MeasuredPassNoise as a Measurement (its checks are measurement_refusal's)."""
+    # A bag recorded before the squeal measures (0.23 and earlier) has none: not measured.
+    squeal = {name: type(default)(getattr(msg, name, default)) for name, default in SQUEAL_MEASURES.items()}
     return Measurement(time_ns(msg.header.stamp), str(msg.train_id), float(msg.receiver_distance_m),
                        float(msg.receiver_height_m), int(msg.instrument_class), np.array(msg.band_centre_hz, float),
                        np.array(msg.leq_db, float), float(msg.lpaeq_tp_dba), float(msg.lpafmax_dba),
                        float(msg.tel_dba), bool(msg.squeal_detected), tuple(str(v) for v in msg.vehicle_id),
-                       np.array(msg.vehicle_lpaeq_dba, float))
+                       np.array(msg.vehicle_lpaeq_dba, float), **squeal)
 
 
 def residual_from_msg(msg: Any) -> Residual:
