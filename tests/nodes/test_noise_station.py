@@ -45,8 +45,8 @@ def test_each_pass_is_heard_from_its_audio_and_the_worth_hearing_kept(ros_contex
             (audio / audio_name(stamps[-1], train)).write_bytes(b"RIFF\x10\x00\x00\x00WAVEjunk")
     tp = a.pass_time_s  # every pass the same train at the same speed
     table = with_class_defaults(PassTable(
-        stamp_ns=stamps, train_id=[p[0] for p in PASSES], vehicle_class=["emu"] * 5, vehicle_count=[round(cls.mean_vehicles)] * 5,
-        axle_count=[0] * 5, speed_mps=[cls.speed_mean_mps] * 5,
+        stamp_ns=stamps, train_id=[p[0] for p in PASSES], vehicle_class=["emu"] * 5,
+        vehicle_count=[round(cls.mean_vehicles)] * 5, axle_count=[0] * 5, speed_mps=[cls.speed_mean_mps] * 5,
         angle_of_attack_rad=[1e-3 * p[2] for p in PASSES],
         wheel_load_n=[0.0] * 5, friction_state=[FRICTION_BY_NAME[p[1]] for p in PASSES],
         train_length_m=[tp * cls.speed_mean_mps] * 5), site)
