@@ -34,6 +34,7 @@ from bench import noise as bn
 from bench import recorder as br
 from bench import sites as bsites
 from bench import squeal as bs
+from bench import station as bstation
 from bench.timing import first_touch_s
 from rail_monitor.bagio.passes_bag import write_passes_bag
 from rail_monitor.bagio.reader import read_passes
@@ -214,6 +215,12 @@ def main() -> None:
         year_r, memory = year_rows(values, ns.site, year, tmp)
         sections.append(("a busy site's year", year_r))
         sections.append(("models, per pass", model_rows(ns.site)))
+        st = bstation.costs(ns.site, 5 if ns.quick else 20)
+        sections.append(("noise station", [(
+            f"noise_station hearing {st['passes']} passes of 10 s at 48 kHz",
+            f"{st['per_pass_s'] * 1e3:.0f} ms CPU a pass",
+            f"heard {st['heard']}; idle {100 * st['idle_share']:.2f} % of a core; 100 passes an hour "
+            f"{100 * st['duty_share']:.2f} % of a core")]))
         sections.append(("recorder", recorder_rows(values, source, tmp)))
         sections.append(("memory against passes", memory + streamed_rows(
             ns.site, [2_000, 6_000] if ns.quick else [100_000, 1_000_000])

@@ -21,7 +21,7 @@ def test_the_benchmark_harness_runs_and_batch_equals_the_live_graph(tmp_path):
     assert done.returncode == 0, done.stderr[-3000:]
     text = out.read_text()
     for section in ("graph against its rclpy ceiling", "live graph as a site runs it", "batch", "a busy site's year",
-                    "models, per pass", "recorder", "memory against passes"):
+                    "models, per pass", "noise station", "recorder", "memory against passes"):
         assert f"| **{section}** |" in text
     assert re.search(r"\| wayside_monitor start-up to first output \| [0-9.]+ s \|", text), text
     assert re.search(r"\| live graph, 20 passes/s arriving one at a time \| [0-9]+ % of a core \| latency pass to "
@@ -31,6 +31,8 @@ def test_the_benchmark_harness_runs_and_batch_equals_the_live_graph(tmp_path):
                      text), text
     assert re.search(r"\| no-op one-process graph, 20 passes/s arriving one at a time \| [0-9]+ % of a core \| over 40 "
                      r"passes", text), text
+    assert re.search(r"\| noise_station hearing 5 passes of 10 s at 48 kHz \| [0-9]+ ms CPU a pass \| heard 5; idle "
+                     r"[0-9.]+ % of a core; 100 passes an hour [0-9.]+ % of a core \|", text), text
     assert re.search(r"\| filling 256 MB new to this process \| [0-9.]+ s \| [0-9.]+ s again", text), text
     assert re.search(r"\| batch streamed to a bag, [0-9,]+ passes \| [0-9,]+ MB \|", text), text
     assert re.search(r"\| export to Parquet, [0-9,]+ passes, in parts of 5,000 passes \| [0-9,]+ MB \|", text), text

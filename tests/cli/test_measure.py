@@ -77,3 +77,47 @@ def test_measure_roughness_reads_a_trolley_csv(tmp_path, capsys):
     assert main(["measure", "roughness", str(bad)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "not evenly spaced" in err[0] and str(bad) in err[0]
+
+
+def test_a_trace_becomes_a_survey_that_batch_applies_as_if_it_were_in_the_history(tmp_path, capsys):
+    """measure roughness --survey-bag writes the trace's spectrum as one RoughnessSurvey at --stamp;
+    batch --surveys applies it (re-fitting K_b) exactly as it applies the same survey carried in the
+    history bag: every corrugation state the same bits. A CSV is not a surveys bag: one line."""
+    from rail_monitor.bagio.passes_bag import write_passes_bag
+    from rail_monitor.bagio.reader import read_bag_events, read_messages, read_passes
+    from rail_monitor.codec.typestore import CORRUGATION_STATE
+    from rail_monitor.core.timeutil import format_iso_ns
+    from rail_monitor.corrugation.surveys import KIND_SURVEY
+
+    from conftest import SAMPLE
+
+    rng = np.random.default_rng(15610)
+    x = np.arange(0.0, 12.0, 0.001)
+    z_um = 8.0 * np.sin(2 * np.pi * x / 0.05) + 3.0 * np.sin(2 * np.pi * x / 0.2) + rng.normal(0.0, 0.5, len(x))
+    trace = tmp_path / "trace.csv"
+    trace.write_text("distance_m,displacement_um\n"
+                     + "".join(f"{a:.4f},{b:.5f}\n" for a, b in zip(x, z_um, strict=True)))
+    passes = read_passes(SAMPLE).take(slice(0, 400))
+    stamp = int(passes.stamp_ns[200])
+    survey = tmp_path / "survey"
+    assert main(["measure", "roughness", str(trace), "--json", "--survey-bag", str(survey),
+                 "--stamp", format_iso_ns(stamp)]) == 0
+    spectrum = json.loads(capsys.readouterr().out)
+    (event,) = read_bag_events(survey)
+    assert event.kind == KIND_SURVEY and event.stamp_ns == stamp
+    rms = np.array(spectrum["rms_m"])
+    np.testing.assert_array_equal(event.amplitude_m, rms[rms > 0])
+    alone, within = tmp_path / "alone", tmp_path / "within"
+    write_passes_bag(passes, alone, "curve_250")
+    write_passes_bag(passes, within, "curve_250", events=[event])
+    for src, extra in ((alone, ["--surveys", str(survey)]), (within, [])):
+        assert main(["batch", str(src), "--no-report", "--output", str(tmp_path / f"{src.name}_out"), *extra]) == 0
+        assert "1 roughness survey(s) and grinding event(s) read: 1 applied" in capsys.readouterr().out
+    a, b = (read_messages(tmp_path / f"{n}_out", [CORRUGATION_STATE])[CORRUGATION_STATE] for n in ("alone", "within"))
+    assert len(a) == len(b) == 400
+    assert all(np.array_equal(s.amplitude_m, t.amplitude_m) and np.array_equal(s.k_b_by_friction, t.k_b_by_friction)
+               for s, t in zip(a, b, strict=True))
+    assert not np.array_equal(a[0].k_b_by_friction, a[-1].k_b_by_friction)  # the survey re-fitted K_b
+    assert main(["batch", str(alone), "--no-report", "--output", str(tmp_path / "x"), "--surveys", str(trace)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no rail_msgs/msg/RoughnessSurvey in it" in err[0]

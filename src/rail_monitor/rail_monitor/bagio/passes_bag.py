@@ -40,3 +40,14 @@ def write_passes_bag(table: PassTable, folder: str | Path, frame_id: str, topic:
             for item in items:
                 bag.write(f"{ns}/{name}", serialize(typename, to_fields(item, frame_id)), max(item.stamp_ns, 0))
     return Path(folder)
+
+
+def write_survey_bag(events: Sequence[MaintenanceEvent], folder: str | Path, frame_id: str,
+                     topic: str = "/roughness_survey") -> Path:
+    """Write surveys or grinding events alone, each a RoughnessSurvey on topic, log time = stamp
+    (rail-monitor batch --surveys and pass_replayer's surveys_source take them); returns the folder."""
+    with McapBagWriter(folder) as bag:
+        bag.add_topic(topic, ROUGHNESS_SURVEY, [EVENT.as_metadata()])
+        for e in events:
+            bag.write(topic, serialize(ROUGHNESS_SURVEY, roughness_survey_fields(e, frame_id)), max(e.stamp_ns, 0))
+    return Path(folder)

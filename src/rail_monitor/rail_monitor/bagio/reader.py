@@ -7,7 +7,7 @@ file and the cause; front ends print it without a traceback and exit non-zero.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Collection, Iterator
+from collections.abc import Collection, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -212,13 +212,21 @@ def read_bag_inputs(path: str | Path, events: bool = True, measurements: bool = 
 
 
 def read_history_inputs(source: str | Path, measured: str | Path | None = None, skip_bad_rows: bool = False,
-                        salvage: bool = False) -> tuple[list[MaintenanceEvent], list[Measurement]]:
+                        salvage: bool = False, surveys: Sequence[str | Path] = ()
+                        ) -> tuple[list[MaintenanceEvent], list[Measurement]]:
     """The surveys and grinding events and the measured pass-bys that go with a pass history: the
-    history bag's own (one read), the measurements from ``measured`` instead when given (a noise
-    station's CSV or a bag; skip_bad_rows as there). A salvage recovers passes only, so then none
-    of the history's own."""
+    history bag's own (one read) with those of the bags ``surveys`` (e.g. rail-monitor measure
+    roughness --survey-bag), in stamp order; the measurements from ``measured`` instead of the
+    history's when given (a noise station's CSV or a bag; skip_bad_rows as there). A salvage
+    recovers passes only, so then none of the history's own."""
     events, own = ([], []) if salvage else read_bag_inputs(source, measurements=not measured)
-    return events, read_measurements(measured, skip_bad_rows) if measured else own
+    for path in surveys:
+        found = [] if is_csv(Path(path)) else read_bag_events(path)
+        if not found:
+            raise InputError(f"{path}: no {ROUGHNESS_SURVEY} in it; surveys come as a bag of them (rail-monitor "
+                             "measure roughness --survey-bag writes one)")
+        events += found
+    return in_time_order(events), read_measurements(measured, skip_bad_rows) if measured else own
 
 
 def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,

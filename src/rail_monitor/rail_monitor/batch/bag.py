@@ -172,17 +172,18 @@ def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: s
 
 def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, namespace: str,
                    site: dict[str, str] | None = None, topic: str | None = None, chunk: int = 5_000,
-                   skip_bad_rows: bool = False, salvage: bool = False, measured: str | Path | None = None
-                   ) -> Recorded:
+                   skip_bad_rows: bool = False, salvage: bool = False, measured: str | Path | None = None,
+                   surveys: Sequence[str | Path] = ()) -> Recorded:
     """The batch run of a history file recorded to a new bag folder. A bag is read and recorded chunk
     by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
     time order is read whole and sorted. Its measured pass-bys are measured's (a noise station's
-    CSV or a bag), else a bag history's own. A run that fails leaves no output behind."""
+    CSV or a bag), else a bag history's own; its surveys and grinding events the history bag's own
+    with those of the bags ``surveys``. A run that fails leaves no output behind."""
     from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_history_inputs
 
     claim = claim_output_folder(folder)  # atomic: two runs never write one folder
     try:
-        events, ms = read_history_inputs(source, measured, skip_bad_rows, salvage)
+        events, ms = read_history_inputs(source, measured, skip_bad_rows, salvage, surveys)
         if not (salvage or is_csv(Path(source))):
             try:
                 return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms,

@@ -34,6 +34,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--salvage", action="store_true", help=SALVAGE_HELP)
     s.add_argument("--measured", help="measured pass-bys: a noise station's CSV (see the user guide) or a bag "
                    "(default: the source bag's own)")
+    s.add_argument("--surveys", nargs="+", default=[], metavar="BAG",
+                   help="bags of roughness surveys or grinding events to apply with the source's own (e.g. "
+                   "rail-monitor measure roughness --survey-bag)")
     s.add_argument("--chunk", type=int, default=5_000,
                    help="passes read, run and recorded at a time from a bag (memory: about 12 kB a pass; the "
                    "outputs do not depend on it) (default: 5000)")
@@ -64,7 +67,7 @@ def run(ns: argparse.Namespace) -> int:
     fresh_output(out, ns.overwrite, [ns.source])
     rec = record_history(ns.source, values, out, ns.namespace if ns.namespace is not None else
                          str(values.get("site_id", "")), stored_site(ns.site), ns.topic, ns.chunk, ns.skip_bad_rows,
-                         ns.salvage, ns.measured)
+                         ns.salvage, ns.measured, ns.surveys)
     for line in rec.notes:
         print(f"batch: {line}")
     for why, count in rec.left_out.items():

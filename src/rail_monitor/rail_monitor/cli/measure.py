@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
-from rail_monitor.cli.common import print_json
+from rail_monitor.cli.common import add_site_option, print_json
 from rail_monitor.core.errors import RailMonitorError
 
 
@@ -29,6 +30,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--wheel-radius-m", type=float, default=0.46, help="radius of the wheel of the curvature "
                    "processing [m]")
     r.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    r.add_argument("--survey-bag", help="also write the spectrum as a roughness survey (a bag folder of one "
+                   "rail_msgs/RoughnessSurvey) that batch --surveys and the graph take; needs --stamp")
+    r.add_argument("--stamp", help="when the trace was measured (ISO 8601 UTC, e.g. 2026-09-01T06:00:00Z)")
+    add_site_option(r)
     r.set_defaults(func=run_roughness)
 
 
@@ -70,6 +75,8 @@ def run_roughness(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.trace_csv import read_trace
     from rail_monitor.models.rail_roughness import roughness_spectrum
 
+    if bool(ns.survey_bag) != bool(ns.stamp):
+        raise RailMonitorError("--survey-bag and --stamp go together: a survey is of a time")
     dx, z = read_trace(ns.trace)
     if not 0.0 < ns.wheel_radius_m < 5.0:
         raise RailMonitorError(f"--wheel-radius-m must be between 0 and 5 m, not {ns.wheel_radius_m:g}")
@@ -77,6 +84,8 @@ def run_roughness(ns: argparse.Namespace) -> int:
         s = roughness_spectrum(z, dx, ns.wheel_radius_m)
     except ValueError as exc:
         raise RailMonitorError(f"{ns.trace}: {exc}") from None
+    if ns.survey_bag:
+        _survey_bag(ns, s)
     if ns.json:
         print_json({"length_m": s.length_m, "spacing_m": dx, "spikes_removed": s.spikes,
                     "wavelength_m": s.wavelength_m.tolist(), "rms_m": s.rms_m.tolist(),
@@ -88,3 +97,27 @@ def run_roughness(ns: argparse.Namespace) -> int:
     for lam, lv, rms in zip(s.wavelength_m, s.level_db, s.rms_m, strict=True):
         print(f"{1e3 * lam:11.1f} {lv:7.1f} {1e6 * rms:11.3f}")
     return 0
+
+
+def _survey_bag(ns: argparse.Namespace, s) -> None:
+    """The spectrum's resolved bands (r.m.s. above 0) as a survey at --stamp, in a new bag folder."""
+    import numpy as np
+
+    from rail_monitor.bagio.passes_bag import write_survey_bag
+    from rail_monitor.cli.common import fresh_output, site_values
+    from rail_monitor.core.timeutil import parse_iso_ns
+    from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
+
+    try:
+        stamp = parse_iso_ns(ns.stamp)
+    except RailMonitorError as exc:
+        raise RailMonitorError(f"--stamp: {exc}") from None
+    keep = np.isfinite(s.rms_m) & (s.rms_m > 0.0)
+    if not keep.any():
+        raise RailMonitorError(f"{ns.trace}: no band of the trace has roughness to survey")
+    fresh_output(Path(ns.survey_bag), False, [ns.trace])
+    site_id = str(site_values(ns.site).get("site_id", ""))
+    write_survey_bag([MaintenanceEvent(stamp, KIND_SURVEY, s.wavelength_m[keep], s.rms_m[keep])], ns.survey_bag,
+                     site_id, f"/{site_id}/roughness_survey" if site_id else "/roughness_survey")
+    if not ns.json:
+        print(f"# survey of {keep.sum()} band(s) at {ns.stamp} written to {ns.survey_bag}")

@@ -46,6 +46,8 @@ REPLAYER_SPECS: tuple[ParamSpec, ...] = (
               "(a killed recorder, a full disk) instead of failing."),
     ParamSpec("measured_source", "", "Measured pass-bys to replay: a noise station's CSV or a bag; empty: the "
               "source bag's own (none for a CSV source)."),
+    ParamSpec("surveys_source", [""], "Bags of roughness surveys (or grinding events) to replay with the source's "
+              "own, e.g. from rail-monitor measure roughness --survey-bag; empty: none."),
 )
 
 
@@ -183,6 +185,7 @@ class ReplayerParams:
     skip_bad_rows: bool
     salvage: bool
     measured_source: str
+    surveys_source: list[str]
 
 
 @dataclass(frozen=True)

@@ -35,7 +35,8 @@ class PassReplayer(PassSourceNode):
         self.skipped = 0
         self._table = self._load()  # read up front: a bad file fails before anything is published
         self._events, self._measured = read_history_inputs(self.src.source, self.src.measured_source or None,
-                                                           self.src.skip_bad_rows, self.src.salvage)
+                                                           self.src.skip_bad_rows, self.src.salvage,
+                                                           [p for p in self.src.surveys_source if p])
         if self._events:
             self.advertise_events()
         if self._measured:

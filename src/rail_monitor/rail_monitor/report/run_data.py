@@ -16,11 +16,12 @@ from rail_monitor.alerts.manager import Alert
 from rail_monitor.bagio.reader import iter_messages, read_messages
 from rail_monitor.core.errors import InputError, RailMonitorError
 from rail_monitor.core.passes import PassTable
+from rail_monitor.measured.records import SQUEAL_MEASURES
 from rail_monitor.messages.fields import alert_from_msg, pass_row, time_ns
 
 _TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory",
           "MeasuredPassNoise", "NoiseResidual")
-_MEASURED = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "squeal_detected", "instrument_class")
+_MEASURED = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "squeal_detected", "instrument_class", *SQUEAL_MEASURES)
 _RESIDUAL = ("residual_lpaeq_dba", "residual_lpafmax_dba", "residual_tel_dba", "residual_mid_db", "baseline_mid_db",
              "drift_db", "excess_mid_db", "loudest_vehicle_id", "loudest_vehicle_excess_db")
 _STATE = ("amplitude_m", "threshold_m", "post_grinding_m", "growth_per_axle_pass")
@@ -138,7 +139,8 @@ def _run_of(path: Path, got: dict[str, list[Any]]) -> RunData:
 
 def _columns(msgs: list[Any], names: tuple[str, ...]) -> dict[str, np.ndarray]:
     """Fields of messages as arrays, with their stamps [ns] and train ids."""
-    out = {k: np.array([getattr(m, k) for m in msgs]) for k in names}
+    # A bag recorded before the squeal measures (0.23 and earlier): not measured.
+    out = {k: np.array([getattr(m, k, SQUEAL_MEASURES.get(k)) for m in msgs]) for k in names}
     out["stamp_ns"] = np.array([time_ns(m.header.stamp) for m in msgs], np.int64)
     out["train_id"] = np.array([m.train_id for m in msgs], object)
     return out

@@ -124,7 +124,10 @@ def _measured_columns(run: RunData, keys: list[tuple[str, int]]) -> list[Column]
         i = _lookup(keys, list(zip(m["train_id"].tolist(), m["stamp_ns"].tolist(), strict=True)))
         cols += [Column(f"measured_{name}", unit, text, _pick(m[name], i, "")) for name, unit, text in (
             ("lpaeq_tp_dba", "dB(A)", "measured LpAeq,Tp"), ("lpafmax_dba", "dB(A)", "measured LpAFmax"),
-            ("tel_dba", "dB(A)", "measured TEL"), ("squeal_detected", "-", "the station's squeal flag"))]
+            ("tel_dba", "dB(A)", "measured TEL"), ("squeal_detected", "-", "the station's squeal flag"),
+            ("squeal_frequency_hz", "Hz", "the measured squeal's tone (NaN: none, or not measured)"),
+            ("squeal_level_db", "dB", "its tone level re 20 uPa"), ("squeal_duration_s", "s", "how long it lasted"),
+            ("flanging_detected", "-", "flanging heard (broadband 4-10 kHz, no tone)"))]
     for model, r in run.residuals.items():
         i = _lookup(keys, list(zip(r["train_id"].tolist(), r["stamp_ns"].tolist(), strict=True)))
         cols += [Column(f"{model}_{name}", unit, f"measured minus predicted ({model}): {text}", _pick(r[name], i, ""))
