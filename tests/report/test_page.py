@@ -59,24 +59,36 @@ def test_the_page_renders_in_chromium_with_every_image_loaded(report):
         browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=CHROMIUM_ARGS)
         try:
             page = browser.new_page()
-            page.on("requestfailed", lambda r: failed.append(r.url))
+            page.on("requestfailed", lambda r: failed.append((r.url, r.failure)))
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
             page.goto((folder / "index.html").as_uri(), wait_until="load")
             images = page.evaluate("Array.from(document.images).map(i => [i.getAttribute('src'), i.complete, "
                                    "i.naturalWidth, i.naturalHeight])")
             links = page.evaluate("Array.from(document.links).map(a => a.getAttribute('href'))")
             headings = page.evaluate("Array.from(document.querySelectorAll('h1,h2')).map(h => h.textContent)")
+            # Each player's file decodes in the browser, as long as the pass it holds.
+            audio = page.evaluate("""Promise.all(Array.from(document.querySelectorAll('audio')).map(a =>
+                new Promise(done => { a.onloadedmetadata = () => done([a.getAttribute('src'), a.duration]);
+                                      a.onerror = () => done([a.getAttribute('src'), -1]);
+                                      a.preload = 'auto'; a.load(); })))""")
         finally:
             browser.close()
     pngs = sorted(f.name for f in files if f.suffix == ".png")
     assert sorted(src for src, *_ in images) == pngs and len(pngs) == 5
     assert all(done and w > 0 and h > 0 for _, done, w, h in images), images
+    # A media element drops its first request for the ranges it wants (net::ERR_ABORTED): that its
+    # file then decodes is checked below.
+    failed = [(url, why) for url, why in failed if not (url.endswith(".wav") and why == "net::ERR_ABORTED")]
     assert not failed and not errors, (failed, errors)
     assert all((folder / href).is_file() for href in links), links
     for section in ("Headline", "Per vehicle class", "Noise against the limit", "Grinding outlook per band",
                     "Squealing trains (loudest first)", "Appendix for engineers", "Site parameters"):
         assert section in headings
     assert ("Speed advice per class" in headings) == (report[0].advisory is not None)
+    wavs = sorted(str(f.relative_to(folder)) for f in files if f.suffix == ".wav")
+    assert sorted(src for src, _ in audio) == wavs and len(wavs) == 3  # three passes, none recorded
+    assert all(d > 2 * 2.0 for _, d in audio), audio                    # the train between 2 s margins
+    assert "Listen: the loudest passes, predicted and recorded" in headings
 
 
 def test_pdf_summary_and_squealing_trains(report):
@@ -148,3 +160,42 @@ class _Spectrum:
 
     band_centre_hz = np.array([100.0, 1000.0])
     lp_db = np.array([[70.0, 80.0]])
+
+
+def test_the_loudest_passes_are_heard_predicted_and_recorded_on_one_scale(report, tmp_path):
+    """--listen 2 with a station's archive holding the loudest pass's recording: two predicted
+    files (the two loudest by predicted LpAFmax), the recording beside the loudest on the report's
+    scale (its samples x the station's sensitivity / 20 Pa), none beside the other; a predicted
+    file read back gives its pass-by level (its own line-source prediction within 0.15 dB)."""
+    from scipy.io import wavfile
+
+    from rail_monitor.core.friction import FRICTION_NAMES
+    from rail_monitor.models.iso3095 import passby_levels
+    from rail_monitor.report.listening import FULL_SCALE_PA, MARGIN_S, listening
+    from rail_monitor.whatif.audio import pass_audio
+
+    from conftest import write_pass_audio
+
+    run, values, _, _ = report
+    model = sorted(run.noise)[0]
+    order = np.argsort(-run.noise[model]["lpafmax_dba"], kind="stable")
+    keys = [(int(run.noise[model]["stamp_ns"][k]), str(run.noise[model]["train_id"][k])) for k in order[:2]]
+    archive = tmp_path / "archive"
+    write_pass_audio(archive, *keys[0], lead_s=1.0, seed=9)
+    cfg = SiteConfig.from_values({**values, "station.sensitivity_pa_per_unit": 0.5})
+    rows = listening(run, cfg, tmp_path / "out", 2, archive)
+    assert [r["train"] for r in rows] == [k[1] for k in keys]
+    assert rows[0]["measured"].endswith("_measured.wav") and rows[1]["measured"] == ""
+    fs, recorded = wavfile.read(next(archive.glob("*.wav")))
+    _, on_scale = wavfile.read(tmp_path / "out" / rows[0]["measured"])
+    np.testing.assert_allclose(on_scale, (recorded * 0.5 / FULL_SCALE_PA).astype(np.float32), rtol=1e-6)
+    # The predicted file is that pass's predicted audio (class, speed, consist, friction, angle of
+    # attack) in pascals / 20 Pa: read back on that scale, the levels of the signal itself.
+    fs, p = wavfile.read(tmp_path / "out" / rows[0]["predicted"])
+    i = int(np.flatnonzero((run.passes.train_id == keys[0][1]) & (run.passes.stamp_ns == keys[0][0]))[0])
+    want = pass_audio(values, str(run.passes.vehicle_class[i]), float(run.passes.speed_mps[i]),
+                      int(run.passes.vehicle_count[i]) or None, FRICTION_NAMES[int(run.passes.friction_state[i])],
+                      1e3 * float(run.passes.angle_of_attack_rad[i]), model, fs_hz=fs, margin_s=MARGIN_S, seed=0)
+    window = (MARGIN_S, MARGIN_S + want.pass_time_s)
+    heard = passby_levels(p.astype(float) * FULL_SCALE_PA, fs, *window)
+    assert heard.lpaeq_tp_db == pytest.approx(passby_levels(want.pressure_pa, fs, *window).lpaeq_tp_db, abs=1e-3)

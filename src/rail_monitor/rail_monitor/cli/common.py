@@ -193,7 +193,8 @@ def report_dir(bag: str, report: str | None) -> Path:
     return Path(report) if report else Path(f"{str(bag).rstrip('/')}_report")
 
 
-def print_report(bag: str, site: str | None, report: str | None) -> None:
+def print_report(bag: str, site: str | None, report: str | None, listen: int = 3,
+                 archive: str | None = None) -> None:
     """Print the run summary and write the report folder."""
     from rail_monitor.engine.site_config import SiteConfig
     from rail_monitor.report.run_data import load_run
@@ -203,7 +204,7 @@ def print_report(bag: str, site: str | None, report: str | None) -> None:
     cfg = SiteConfig.from_values(values)
     run = load_run(bag)
     print("\n".join(summary_lines(run, cfg)))
-    files = build_report(run, cfg, report_dir(bag, report), site_text)
+    files = build_report(run, cfg, report_dir(bag, report), site_text, listen, archive)
     pngs = sum(f.suffix == ".png" for f in files)
     print(f"report: {files[-1]} ({pngs} figures; report.pdf, squealing_trains.csv, summary.json beside it)")
 

@@ -185,8 +185,10 @@ def write_report(run: RunData, cfg: SiteConfig, out: Path, figures_extra: Mappin
                                                            "classes": tables["classes"]}), indent=1,
                                                  allow_nan=False), encoding="utf-8")
     page = out / "index.html"
-    page.write_text(_html(run, cfg.values, head, tables, lim, figures, meta), encoding="utf-8")
-    return [*files, out / "report.pdf", out / "squealing_trains.csv", out / "summary.json", page]
+    listen = figures_extra.get("listen", [])
+    page.write_text(_html(run, cfg.values, head, tables, lim, figures, meta, listen), encoding="utf-8")
+    audio = [out / r[k].split(" ")[0] for r in listen for k in ("predicted", "measured") if r[k]]
+    return [*files, *audio, out / "report.pdf", out / "squealing_trains.csv", out / "summary.json", page]
 
 
 def _write_csv(rows: list[dict], path: Path) -> None:
@@ -215,7 +217,29 @@ def _pdf_text_pages(head, tables, lim, meta, run) -> list:
     return pages
 
 
-def _html(run, values, head, tables, lim, figures, meta) -> str:
+def _listen_html(rows: list[dict]) -> str:
+    """The loudest passes, each with its predicted audio and its recording where kept."""
+    if not rows:
+        return ""
+
+    def player(src: str) -> str:
+        if not src:
+            return "not recorded"
+        path, _, note = src.partition(" ")
+        return f'<audio controls preload="none" src="{html.escape(path)}"></audio> {html.escape(note)}'
+
+    keys = [k for k in rows[0] if k not in ("predicted", "measured")]
+    head = "".join(f"<th>{html.escape(k)}</th>" for k in (*keys, "predicted", "measured"))
+    body = "".join("<tr>" + "".join(f"<td{' class=n' if num else ''}>{html.escape(text)}</td>"
+                                    for text, num in (_cell(k, r[k]) for k in keys))
+                   + f"<td>{player(r['predicted'])}</td><td>{player(r['measured'])}</td></tr>" for r in rows)
+    return (f"<h2>Listen: the loudest passes, predicted and recorded</h2><table><tr>{head}</tr>{body}</table>"
+            "<p class=\"meta\">The prediction made audible: each source's band noise moving past the microphone "
+            "with its spreading and Doppler shift, and the squeal's tone where the model finds the pass unstable. "
+            "Every file on one scale (full scale 120 dB re 20 µPa), so louder sounds louder.</p>")
+
+
+def _html(run, values, head, tables, lim, figures, meta, listen=()) -> str:
     e = html.escape
     lines = "".join(f"<li>{e(x)}</li>" for x in _headline_lines(head, lim))
     alerts = [{"pass time (local)": format_local_ns(a.stamp_ns, meta["time_zone"], seconds=True),
@@ -259,6 +283,7 @@ forecast, the others the fastest growth rate of the band.</p>
 {friction}
 <h2>Squealing trains (loudest first)</h2>{_html_table(tables['squealers'], 25)}
 {measured}
+{_listen_html(list(listen))}
 <h1>Appendix for engineers</h1>
 {fig('corrugation')}{fig('noise')}{fig('squeal')}{advice}{fig('speeds')}
 <h2>Alerts (raise and clear events)</h2>{_html_table(alerts)}

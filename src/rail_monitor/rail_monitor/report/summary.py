@@ -108,10 +108,14 @@ def _grinding_lines(run: RunData) -> list[str]:
 
 
 # -- report folder ------------------------------------------------------------------------------
-def build_report(run: RunData, cfg: SiteConfig, out_dir: str | Path, site_text: str = "") -> list[Path]:
+def build_report(run: RunData, cfg: SiteConfig, out_dir: str | Path, site_text: str = "", listen: int = 3,
+                 archive: str | Path | None = None) -> list[Path]:
     """Write the report folder (rail_monitor.report.page) into out_dir; returns the files
-    written, index.html last. site_text names the site file used. A write that fails (a full disk,
-    no permission) is one RailMonitorError naming the folder."""
+    written, index.html last. site_text names the site file used; listen: the loudest passes made
+    audible (rail_monitor.report.listening), beside their recordings in a station's archive
+    folder (default: the site's station.archive_folder, where it exists). A write that fails (a
+    full disk, no permission) is one RailMonitorError naming the folder."""
+    from rail_monitor.report.listening import listening
     from rail_monitor.report.page import write_report
 
     out = Path(out_dir)
@@ -120,7 +124,12 @@ def build_report(run: RunData, cfg: SiteConfig, out_dir: str | Path, site_text: 
         extra["before"], extra["after"] = _spectra(run, cfg)
     if len(run.squeal.get("risk", ())):
         extra["curves"] = _squeal_curves(run, cfg)
+    if archive is None and cfg.values.get("station.archive_folder"):
+        archive = cfg.values["station.archive_folder"]
     try:
+        out.mkdir(parents=True, exist_ok=True)
+        extra["listen"] = listening(run, cfg, out, listen, Path(archive) if archive and Path(archive).is_dir()
+                                    else None)
         return write_report(run, cfg, out, extra, site_text)
     except OSError as exc:
         raise RailMonitorError(f"{out}: cannot write the report: {exc.strerror or exc}") from None
