@@ -44,6 +44,7 @@ from rail_monitor.core.text import printable
 from rail_monitor.engine import checkpoint
 from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.site_file import check_parameter_file, load_parameter_file, load_site
+from rail_monitor.station.archive import read_index
 
 from conftest import EXAMPLE_CSV, SAMPLE, SITE_FILE
 
@@ -150,6 +151,7 @@ READERS: dict[str, tuple[tuple[str, ...], Callable[[Path], object]]] = {
     "checkpoint": ((".npz",), lambda p: checkpoint.resume(copy.deepcopy(_estimator()), p)),
     "WAV": ((".wav",), read_wav),
     "trolley trace": ((".csv",), read_trace),
+    "station's archive index": ((".json",), read_index),
 }
 MAY_RETURN = {"bag salvage", "bag's stored site"}  # salvage reads past metadata; a bag may hold no site
 
@@ -234,6 +236,8 @@ COMMANDS: dict[str, tuple[str, Callable[[Path, Path], list[str]]]] = {
     "site --site": (".yaml", lambda p, out: ["site", "--site", str(p), str(out)]),
     "measure passby": (".wav", lambda p, out: ["measure", "passby", str(p), "--sensitivity", "1"]),
     "measure roughness": (".csv", lambda p, out: ["measure", "roughness", str(p)]),
+    "batch --surveys": (".mcap", lambda p, out: ["batch", str(small_bag()), "--surveys", str(p), "--no-report",
+                                                 "--output", str(out)]),
 }
 
 

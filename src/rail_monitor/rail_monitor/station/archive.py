@@ -68,19 +68,9 @@ class AudioArchive:
 
     def _read_index(self) -> dict[tuple[int, str], Kept]:
         path = self.folder / INDEX
-        if not path.exists():
+        if not (path.exists() or path.is_symlink()):
             return {}
-        try:
-            rows = json.loads(read_user_text(path, "an audio archive's index"))
-            kept = [Kept(**row) for row in rows]
-            if any(not set(k.reasons) <= set(RANK) or not k.reasons or "/" in k.name for k in kept):
-                raise ValueError("an entry has an unknown reason or a name with a folder")
-        except InputError:
-            raise
-        except (ValueError, TypeError) as exc:
-            raise InputError(f"{path}: not this station's archive index ({exc}); move it away to start a new "
-                             "archive (the files it lists are then never removed)") from None
-        return {(k.stamp_ns, k.train_id): k for k in kept if (self.folder / k.name).is_file()}
+        return {(k.stamp_ns, k.train_id): k for k in read_index(path) if (self.folder / k.name).is_file()}
 
     @property
     def used_bytes(self) -> int:
@@ -180,3 +170,18 @@ class AudioArchive:
         tmp = self.folder / (INDEX + ".part")
         tmp.write_text(json.dumps(rows, indent=0), encoding="utf-8")
         os.replace(tmp, self.folder / INDEX)
+
+
+def read_index(path: str | Path) -> list[Kept]:
+    """The entries of an archive's index (InputError, one line naming it, for anything else)."""
+    try:
+        kept = [Kept(**row) for row in json.loads(read_user_text(path, "an audio archive's index"))]
+        if any(not k.reasons or not set(k.reasons) <= set(RANK) or "/" in k.name for k in kept):
+            raise ValueError("an entry has no reason, an unknown one, or a name with a folder")
+    except InputError:
+        raise
+    except (ValueError, TypeError, RecursionError) as exc:
+        why = "nested too deeply" if isinstance(exc, RecursionError) else str(exc)
+        raise InputError(f"{path}: not this station's archive index ({why}); move it away to start a new "
+                         "archive (the files it lists are then never removed)") from None
+    return kept
