@@ -62,6 +62,11 @@ class NoiseStation(PassConsumerNode):
             raise ConfigError("station.audio_folder is empty: name the folder the station's recorder leaves "
                               "each pass's WAV in")
         self.folder = Path(self.cfg.audio_folder)
+        if not self.folder.is_dir():
+            raise ConfigError(f"station.audio_folder {self.folder}: no such folder")
+        if self.cfg.sensitivity_pa_per_unit == 0.0 and not self.cfg.calibration_file:
+            raise ConfigError("station.sensitivity_pa_per_unit is 0 and station.calibration_file is empty: give the "
+                              "recordings' pascals per unit, or a calibrator's recording")
         self.scale = sensitivity(self.cfg.sensitivity_pa_per_unit, self.cfg.calibration_file,
                                  self.cfg.calibration_db, self.cfg.channel)
         self.archive = AudioArchive(self.cfg.archive_folder, int(self.cfg.archive_budget_mb * MIB),
