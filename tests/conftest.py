@@ -264,3 +264,10 @@ def same_record(a, b) -> bool:
         return np.array_equal(x, y, equal_nan=x.dtype.kind == "f" and y.dtype.kind == "f")
 
     return all(equal(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a))
+
+
+def node_parameters(values: dict, **extra) -> list:
+    """rclpy Parameters of a node for the site's flat values (the simulator's aside) and extra ones."""
+    from rclpy.parameter import Parameter
+
+    return [Parameter(k, value=v) for k, v in {**values, **extra}.items() if not k.startswith("simulator.")]

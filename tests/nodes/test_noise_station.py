@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 
 from rail_monitor.core.passes import FRICTION_BY_NAME, PassTable, with_class_defaults
 from rail_monitor.messages.fields import measurement_from_msg, train_pass_fields
@@ -22,7 +21,7 @@ from rail_monitor.station.config import station_config
 from rail_monitor.station.pass_audio import audio_name, hear_pass, measurement
 from rail_msgs.msg import MeasuredPassNoise, NoiseResidual, TrainPass
 
-from conftest import same_record, spinning, wait_until, write_pass_audio
+from conftest import node_parameters, same_record, spinning, wait_until, write_pass_audio
 
 T0 = 1_790_000_000 * 10**9
 # (train id, friction, angle of attack [mrad], audio): a dry pass, a wet squealing one, another
@@ -52,15 +51,15 @@ def test_each_pass_is_heard_from_its_audio_and_the_worth_hearing_kept(ros_contex
         train_length_m=[tp * cls.speed_mean_mps] * 5), site)
     station = {"station.audio_folder": str(audio), "station.lead_s": 1.0, "station.sensitivity_pa_per_unit": 1.0,
                "station.audio_wait_s": 3.0, "station.archive_folder": str(archive), "station.loudest_per_day": 1}
-    params = [Parameter(k, value=v) for k, v in {**site_values, **station}.items() if not k.startswith("simulator.")]
-    node = NoiseStation(context=ros_context, namespace="/curve_250", parameter_overrides=params)
+    node = NoiseStation(context=ros_context, namespace="/curve_250",
+                        parameter_overrides=node_parameters(site_values, **station))
     probe = Node("probe", context=ros_context, namespace="/curve_250")
+    passes = probe.create_publisher(TrainPass, "train_pass", STREAM_QOS)
+    residuals = probe.create_publisher(NoiseResidual, "noise/residual", STREAM_QOS)
     got: list[MeasuredPassNoise] = []
     diags: list[DiagnosticArray] = []
     probe.create_subscription(MeasuredPassNoise, "noise/measured", got.append, STREAM_SUB_QOS)
     probe.create_subscription(DiagnosticArray, "/diagnostics", diags.append, 10)
-    passes = probe.create_publisher(TrainPass, "train_pass", STREAM_QOS)
-    residuals = probe.create_publisher(NoiseResidual, "noise/residual", STREAM_QOS)
 
     def diag() -> dict[str, str]:
         for d in reversed(diags):

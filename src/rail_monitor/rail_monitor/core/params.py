@@ -135,6 +135,12 @@ def values_of(cls: type, values: Mapping[str, Any]) -> Any:
     return cls(**{attribute(k): v for k, v in values.items()})
 
 
+def section_values(cls: type, specs: Sequence[ParamSpec], values: Mapping[str, Any], prefix: str) -> Any:
+    """A section's checked values class from flat values (keys under prefix; a name the section's
+    specs do not know is a ConfigError)."""
+    return values_of(cls, resolve(specs, section(values, prefix), where=prefix, strict=True))
+
+
 def flatten(tree: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     """Flatten a nested YAML mapping into dotted names, as ROS 2 parameter files do."""
     flat: dict[str, Any] = {}

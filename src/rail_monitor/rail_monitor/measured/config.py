@@ -6,7 +6,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of
+from rail_monitor.core.params import ParamSpec, section_values
 
 RESIDUAL_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("prediction_sd_db", 2.0, "Standard uncertainty of a predicted 1/3-octave band level [dB] (the "
@@ -39,4 +39,4 @@ class ResidualConfig:
 
 def residual_config(values: Mapping[str, Any], prefix: str = "residual.") -> ResidualConfig:
     """Checked residual parameters from flat values (keys under prefix)."""
-    return values_of(ResidualConfig, resolve(RESIDUAL_SPECS, section(values, prefix), where=prefix, strict=True))
+    return section_values(ResidualConfig, RESIDUAL_SPECS, values, prefix)

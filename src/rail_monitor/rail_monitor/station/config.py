@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from rail_monitor.core.params import ParamSpec, resolve, section, values_of
+from rail_monitor.core.params import ParamSpec, section_values
 
 STATION_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("audio_folder", "", "Folder the station's recorder leaves each pass's audio in, one WAV per pass "
@@ -61,4 +61,4 @@ class StationConfig:
 
 def station_config(values: Mapping[str, Any], prefix: str = "station.") -> StationConfig:
     """Checked station parameters from flat values (keys under prefix)."""
-    return values_of(StationConfig, resolve(STATION_SPECS, section(values, prefix), where=prefix, strict=True))
+    return section_values(StationConfig, STATION_SPECS, values, prefix)
