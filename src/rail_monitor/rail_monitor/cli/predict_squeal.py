@@ -23,6 +23,12 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     q.add_argument("--rig", action="store_true", help="the UQ paper's two-disc rig (Figure 5) instead of a site")
     q.add_argument("--history", help="pass history (bag folder, .mcap, .db3 or .csv): a table per friction state "
                    "(creep curve, unstable share, onset, mean level, friction-modifier cut) instead of one case")
+    q.add_argument("--fit", action="store_true", help="with --history: each friction state's creep curve "
+                   "re-fitted from the history's measured squeal (P10/P50/P90), with the squeal share measured, "
+                   "by the configured curve and by the fitted one")
+    q.add_argument("--measured", help="with --fit: measured pass-bys (a station CSV or a bag; default: the "
+                   "history bag's own)")
+    q.add_argument("--occurrence-only", action="store_true", help="with --fit: leave the measured tone levels out")
     add_site_option(q)
     q.add_argument("--vehicle-class", help="vehicle class of the site (default: its first)")
     q.add_argument("--friction", default="dry", choices=tuple(FRICTION_BY_NAME), help="friction state")
@@ -100,6 +106,8 @@ def _friction_table(ns: argparse.Namespace) -> int:
 
     if ns.rig:
         raise RailMonitorError("--history is a site's: leave out --rig")
+    if ns.fit:
+        return _fit_table(ns)
     rows = friction_states(site_values(ns.site), read_passes(Path(ns.history)))
     if ns.json:
         print_json({"history": ns.history, "friction_states": rows})
@@ -112,4 +120,30 @@ def _friction_table(ns: argparse.Namespace) -> int:
               f"{100 * r['unstable_share']:8.1f}% {r['onset_mrad']:5.2f} mrad "
               + (f"{level:6.1f} dB(A)" if np.isfinite(level) else f"{'-':>11}")
               + (f" {cut:5.1f} dB" if np.isfinite(cut) else f" {'-':>8}"))
+    return 0
+
+
+def _fit_table(ns: argparse.Namespace) -> int:
+    from rail_monitor.bagio.reader import read_history_inputs, read_passes
+    from rail_monitor.core.errors import RailMonitorError
+    from rail_monitor.whatif.squeal_fit import fit_squeal
+
+    _, measured = read_history_inputs(ns.history, ns.measured)
+    if not measured:
+        raise RailMonitorError(f"{ns.history}: no measured pass-bys to fit on (give --measured, a station's CSV "
+                               "or bag)")
+    _, rows = fit_squeal(site_values(ns.site), read_passes(ns.history), measured, levels=not ns.occurrence_only)
+    if ns.json:
+        print_json({"history": ns.history, "levels": not ns.occurrence_only, "friction_states": rows})
+        return 0
+    print("# creep curves re-fitted from measured squeal" + (" occurrence" if ns.occurrence_only else
+                                                               " occurrence and tone levels")
+          + "; shares of the measured passes that squeal")
+    print(f"{'friction state':<18} {'k1 conf.':>8} {'k1 P10/P50/P90':>20} {'k2 conf.':>9} {'k2 P10/P50/P90':>26} "
+          f"{'passes':>7} {'measured':>9} {'conf.':>7} {'fitted':>7}")
+    for r in rows:
+        k1, k2 = r["k1_p10_p50_p90"], r["k2_p10_p50_p90"]
+        print(f"{r['friction_state']:<18} {r['k1']:8.3f} {k1[0]:6.3f}/{k1[1]:6.3f}/{k1[2]:6.3f} {r['k2']:9.4f} "
+              f"{k2[0]:8.4f}/{k2[1]:8.4f}/{k2[2]:8.4f} {r['passes']:7d} {100 * r['measured_share']:8.1f}% "
+              f"{100 * r['configured_share']:6.1f}% {100 * r['fitted_share']:6.1f}%")
     return 0

@@ -31,6 +31,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     t.add_argument("--measured", action="store_true", help="a noise station measuring every pass of the true rail "
                    "(4 vehicles with wheel flats among the fleets; their ids are printed)")
     t.add_argument("--measured-csv", help="also write the station's measurements as its CSV")
+    t.add_argument("--true-creep", action="append", default=[], metavar="STATE=K1,K2",
+                   help="the true rail's creep curve of a friction state (dry, wet, friction_modifier, contaminated), "
+                   "kept from the fitting: the station hears squeal by it (repeatable)")
     s.set_defaults(func=run)
 
 
@@ -52,6 +55,8 @@ def run(ns: argparse.Namespace) -> int:
         raise RailMonitorError("give --out BAG and/or --csv FILE")
     if ns.k_b_factor <= 0 or ns.surveys_every_days < 0:
         raise RailMonitorError("--k-b-factor must be positive and --surveys-every-days not negative")
+    if ns.true_creep and not (ns.measured or ns.measured_csv or ns.surveys_every_days > 0):
+        raise RailMonitorError("--true-creep is the true rail's: give --measured (or --surveys-every-days) too")
     events, measured = _measured_site(ns, values, site, table)
     if ns.out:
         fresh_output(Path(ns.out), ns.force)
@@ -68,12 +73,16 @@ def _measured_site(ns: argparse.Namespace, values: dict, site: Site, table: Pass
                    ) -> tuple[list[MaintenanceEvent], list[Measurement]]:
     """The true rail's surveys and the station's measurements the options ask for."""
     events, measured = [], []
+    creep = parse_true_creep(ns.true_creep)
     if ns.surveys_every_days > 0:
+        from rail_monitor.core.site import site_from_values
         from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
+        from rail_monitor.simulation.measurements import true_values
         from rail_monitor.simulation.surveys import simulate_surveys
 
-        series = simulate_surveys(site, values, table, ns.k_b_factor, ns.surveys_every_days, 1.0,
-                                  int(values["simulator.seed"]) + 100)
+        truth = true_values(values, creep)
+        series = simulate_surveys(site_from_values(truth) if creep else site, truth, table, ns.k_b_factor,
+                                  ns.surveys_every_days, 1.0, int(values["simulator.seed"]) + 100)
         events = [MaintenanceEvent(int(t), KIND_SURVEY, series.wavelength_m, series.amplitude_m[k])
                   for k, t in enumerate(series.stamp_ns.tolist())]
         print(f"true rail: K_b x {ns.k_b_factor:g} = {', '.join(f'{k:.3g}' for k in series.true_k_b)} "
@@ -81,7 +90,7 @@ def _measured_site(ns: argparse.Namespace, values: dict, site: Site, table: Pass
     if ns.measured or ns.measured_csv:
         from rail_monitor.simulation.measurements import station_on_true_rail
 
-        station = station_on_true_rail(table, values, ns.k_b_factor, int(values["simulator.seed"]))
+        station = station_on_true_rail(table, values, ns.k_b_factor, int(values["simulator.seed"]), creep)
         measured = station.measurements
         print(f"noise station: {len(measured)} measured pass-bys; vehicles with wheel flats: "
               f"{', '.join(sorted(station.defective))}")
@@ -91,3 +100,21 @@ def _measured_site(ns: argparse.Namespace, values: dict, site: Site, table: Pass
             write_measured_csv(measured, ns.measured_csv)
             print(f"wrote the station's measurements to {ns.measured_csv}")
     return events, measured
+
+
+def parse_true_creep(items: list[str]) -> dict[str, tuple[float, float]]:
+    """--true-creep STATE=K1,K2 options as {state: (k1, k2)} (RailMonitorError, one line, for a bad one)."""
+    from rail_monitor.core.friction import FRICTION_BY_NAME
+
+    out = {}
+    for item in items:
+        state, _, curve = item.partition("=")
+        try:
+            k1, k2 = (float(x) for x in curve.split(","))
+        except ValueError:
+            raise RailMonitorError(f"--true-creep {item!r}: give STATE=K1,K2, e.g. wet=0.18,-0.015") from None
+        if state not in FRICTION_BY_NAME or not 0.0 < k1 < 2.0 or not -1.0 < k2 < 1.0:
+            raise RailMonitorError(f"--true-creep {item!r}: the state is one of {', '.join(FRICTION_BY_NAME)}, "
+                                   "0 < K1 < 2 and -1 < K2 < 1")
+        out[state] = (k1, k2)
+    return out

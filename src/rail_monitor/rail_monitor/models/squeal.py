@@ -155,6 +155,24 @@ def creep_force(slip_velocity: ArrayLike, speed: ArrayLike, load: ArrayLike,
     return np.sign(xi) * mu * w
 
 
+HARMONIC_POINTS = 256  # midpoints over half a cycle: the kinks of the curve cost O(1/n^2), 2e-5, in the integral
+
+
+class BalanceResolution(NamedTuple):
+    """How finely the harmonic balance is solved: midpoints over half a cycle, points of the log
+    grid of A bracketing the balance (1e-3 to 1e3 times Vc + u_s), and halvings of the bracket."""
+
+    points: int = HARMONIC_POINTS
+    bracket: int = 49
+    halvings: int = 32
+
+
+FULL_BALANCE = BalanceResolution()
+# A calibration's many evaluations: an integral error O(1/64^2) = 2e-4 and a bracket of a factor
+# 1.78 halved 16 times (1e-5 of it): about 0.002 dB in a level, at an eighth of the cost.
+COARSE_BALANCE = BalanceResolution(64, 25, 16)
+
+
 class LimitCycle(NamedTuple):
     """Squeal state per case (arrays broadcast over the inputs).
 
@@ -200,6 +218,7 @@ def limit_cycle_amplitude(
     k1: ArrayLike,
     k2: ArrayLike,
     k3: ArrayLike,
+    resolution: BalanceResolution = FULL_BALANCE,
 ) -> LimitCycle:
     """Closed-form squeal velocity amplitude by energy balance (module docstring; UQ paper eq. 7 corrected).
 
@@ -209,7 +228,8 @@ def limit_cycle_amplitude(
         creep curve is odd); load : normal load W [N]; damping : modal damping c [N s/m];
     k1 : friction peak, slope of mu against xi' on the adhesion branch [-];
     k2 : slope of mu against xi' on the sliding branch [-] (< 0 falling);
-    k3 : lateral creep stiffness [N] (:func:`lateral_creep_stiffness`).
+    k3 : lateral creep stiffness [N] (:func:`lateral_creep_stiffness`);
+    resolution : of the harmonic balance where the closed form does not hold.
     """
     v0, vc, w, c, k1, k2, k3 = np.broadcast_arrays(
         *(np.asarray(x, float) for x in (speed, crabbing, load, damping, k1, k2, k3))
@@ -235,31 +255,32 @@ def limit_cycle_amplitude(
     whole = regime == REGIME_REVERSE_SLIP
     if whole.any():
         amplitude[whole] = harmonic_balance_amplitude(v0[whole], vc[whole], w[whole], c[whole], k1[whole],
-                                                      k2[whole], k3[whole])
+                                                      k2[whole], k3[whole], resolution)
     with np.errstate(invalid="ignore"):
         xi_max = (vc + np.where(unstable, amplitude, 0.0)) / u_s
         friction_positive = k1 + k2 * np.maximum(xi_max - 1.0, 0.0) > 0.0
     return LimitCycle(amplitude, closed, phi, regime.astype(np.int8), unstable, c_eff, u_s, friction_positive)
 
 
-HARMONIC_POINTS = 256  # midpoints over half a cycle: the kinks of the curve cost O(1/n^2), 2e-5, in the integral
 _BALANCE_CHUNK = 2048
 
 
 def _cycle_work(amplitude: FloatArray, speed: FloatArray, crabbing: FloatArray, load: FloatArray,
-                damping: FloatArray, k1: FloatArray, k2: FloatArray, k3: FloatArray) -> FloatArray:
+                damping: FloatArray, k1: FloatArray, k2: FloatArray, k3: FloatArray,
+                points: int = HARMONIC_POINTS) -> FloatArray:
     """Work per cycle on the mode over pi A^2 [N s/m] for y' = A cos(theta): the friction's
     (1 / (pi A)) integral of f(Vc + A cos theta) cos theta d theta, plus the damper's c."""
-    theta = (np.arange(HARMONIC_POINTS) + 0.5) * (np.pi / HARMONIC_POINTS)
+    theta = (np.arange(points) + 0.5) * (np.pi / points)
     cos = np.cos(theta)
     a = amplitude[:, None]
     f = creep_force(crabbing[:, None] + a * cos, speed[:, None], load[:, None], k1[:, None], k2[:, None],
                     k3[:, None])
-    return (2.0 / HARMONIC_POINTS) * (f * cos).sum(axis=1) / amplitude + damping
+    return (2.0 / points) * (f * cos).sum(axis=1) / amplitude + damping
 
 
 def harmonic_balance_amplitude(speed: ArrayLike, crabbing: ArrayLike, load: ArrayLike, damping: ArrayLike,
-                               k1: ArrayLike, k2: ArrayLike, k3: ArrayLike) -> FloatArray:
+                               k1: ArrayLike, k2: ArrayLike, k3: ArrayLike,
+                               resolution: BalanceResolution = FULL_BALANCE) -> FloatArray:
     """Limit-cycle velocity amplitude A w [m/s] by energy balance over the whole creep curve.
 
     With y' = A cos(theta), the friction force f = mu(xi') W of :func:`creep_force` (adhesion,
@@ -275,18 +296,19 @@ def harmonic_balance_amplitude(speed: ArrayLike, crabbing: ArrayLike, load: Arra
     v0, vc, w, c, k1, k2, k3 = (a.ravel() for a in arrays)
     vc = np.abs(vc)
     if v0.size > _BALANCE_CHUNK:  # bound the (cases, HARMONIC_POINTS) arrays' memory
-        parts = [harmonic_balance_amplitude(*(a[i:i + _BALANCE_CHUNK] for a in (v0, vc, w, c, k1, k2, k3)))
+        parts = [harmonic_balance_amplitude(*(a[i:i + _BALANCE_CHUNK] for a in (v0, vc, w, c, k1, k2, k3)),
+                                            resolution=resolution)
                  for i in range(0, v0.size, _BALANCE_CHUNK)]
         return np.concatenate(parts).reshape(shape)
     scale = vc + critical_slip_velocity(v0, w, k3)
-    grid = np.geomspace(1e-3, 1e3, 49)
-    args = (v0, vc, w, c, k1, k2, k3)
+    grid = np.geomspace(1e-3, 1e3, resolution.bracket)
+    args = (v0, vc, w, c, k1, k2, k3, resolution.points)
     work = np.stack([_cycle_work(g * scale, *args) for g in grid], axis=1)  # (M, grid)
     turns = (work[:, :-1] < 0.0) & (work[:, 1:] >= 0.0)
     found = turns.any(axis=1)
     j = np.argmax(turns, axis=1)
     lo, hi = grid[j] * scale, grid[np.minimum(j + 1, len(grid) - 1)] * scale
-    for _ in range(32):  # the bracket spans a factor 1.33: 32 halvings leave 1e-10 of it
+    for _ in range(resolution.halvings):  # 49 points: a bracket of a factor 1.33, 32 halvings leave 1e-10 of it
         mid = 0.5 * (lo + hi)
         feeds = _cycle_work(mid, *args) < 0.0
         lo, hi = np.where(feeds, mid, lo), np.where(feeds, hi, mid)

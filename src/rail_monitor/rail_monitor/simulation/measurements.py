@@ -42,11 +42,14 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
                           fleet_per_class: int = 40, defective: int = 4, defect_db: float = 12.0,
                           wheel_spread_db: float = 1.0, weather_sd_db: float = 0.5,
                           instrument_class: int = 1, squealing: np.ndarray | None = None,
-                          squeal_error: float = 0.02) -> MeasuredSeries:
+                          squeal_error: float = 0.02, squeal_hz: np.ndarray | None = None,
+                          squeal_db: np.ndarray | None = None, squeal_sd_db: float = 1.5) -> MeasuredSeries:
     """Measurements of passes (rows matching the predictions: lp_db (N, B) [dB] on band_hz [Hz],
     the single numbers (N,) [dB(A)]) at receiver_m (distance, height) [m]. squealing: whether
     each pass squeals (the squeal model's prediction, say); the station's flag is that, wrong on
-    a share squeal_error of passes (none squeal without it)."""
+    a share squeal_error of passes (none squeal without it). squeal_hz, squeal_db: each pass's
+    squeal tone [Hz] and its level at the microphone [dB re 20 uPa], measured (with an error of sd
+    squeal_sd_db) on the passes that squeal and are flagged; not measured (NaN) without them."""
     rng = np.random.Generator(np.random.PCG64(seed))
     classes = sorted(set(passes.vehicle_class.tolist()))
     fleets = {c: [f"{c.upper()}-V{k:03d}" for k in range(fleet_per_class)] for c in classes}
@@ -63,7 +66,13 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
                        strict=True))
     out, consists = [], []
     flags = np.zeros(len(passes), bool) if squealing is None else np.asarray(squealing, bool).copy()
+    truly = flags.copy()
     flags ^= rng.random(len(passes)) < (0.0 if squealing is None else squeal_error)
+    heard = flags & truly & (squeal_db is not None)
+    tone_rng = np.random.Generator(np.random.PCG64([seed, 55]))  # its own stream: the rest as without tones
+    tone_db = np.where(heard, (squeal_db if squeal_db is not None else 0.0)
+                       + tone_rng.normal(0.0, squeal_sd_db, len(passes)), np.nan)
+    tone_hz = np.where(heard, squeal_hz if squeal_hz is not None else np.nan, np.nan)
     for i in range(len(passes)):
         fleet = fleets[passes.vehicle_class[i]]
         n = int(min(max(passes.vehicle_count[i], 1), len(fleet)))
@@ -76,21 +85,38 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
         out.append(Measurement(int(passes.stamp_ns[i]), str(passes.train_id[i]), receiver_m[0], receiver_m[1],
                                instrument_class, band_hz.copy(), leq, float(lpaeq_tp_dba[i]) + shift,
                                float(lpafmax_dba[i]) + shift, float(tel_dba[i]) + shift, bool(flags[i]), vehicles,
-                               own))
+                               own, squeal_frequency_hz=float(tone_hz[i]), squeal_level_db=float(tone_db[i])))
         consists.append(vehicles)
     return MeasuredSeries(out, bad, consists)
 
 
-def station_on_true_rail(passes: PassTable, values: dict, k_b_factor: float, seed: int) -> MeasuredSeries:
+def true_values(values: dict, true_creep: dict[str, tuple[float, float]] | None = None) -> dict:
+    """The site's values with the true rail's creep curves (friction state name -> (k1, k2))."""
+    out = dict(values)
+    for state, (k1, k2) in (true_creep or {}).items():
+        out[f"contact.creep.{state}.k1"], out[f"contact.creep.{state}.k2"] = float(k1), float(k2)
+    return out
+
+
+def station_on_true_rail(passes: PassTable, values: dict, k_b_factor: float, seed: int,
+                         true_creep: dict[str, tuple[float, float]] | None = None) -> MeasuredSeries:
     """A station measuring every valid pass of a true rail whose K_b is the configured one times
-    k_b_factor (CNOSSOS-EU's prediction on that rail, with simulate_measurements' deviations; its
-    squeal flag the squeal model's risk medium or above)."""
+    k_b_factor and whose creep curves are true_creep's where given (state name -> (k1, k2)),
+    kept from the fitting (CNOSSOS-EU's prediction on that rail, with simulate_measurements'
+    deviations; its squeal flag the squeal model's risk medium or above there, with the tone's
+    frequency and level, spread from the squeal model's receiver to the microphone)."""
     from rail_monitor.batch.run import run_models
     from rail_monitor.core.site import site_from_values
     from rail_monitor.simulation.surveys import true_estimator
+    from rail_monitor.squeal.config import squeal_config
 
-    truth = run_models(passes, values, estimator=true_estimator(site_from_values(values), values, k_b_factor))
+    truth_values = true_values(values, true_creep)
+    truth = run_models(passes, truth_values,
+                       estimator=true_estimator(site_from_values(truth_values), truth_values, k_b_factor))
     p = truth.noise["cnossos"] if "cnossos" in truth.noise else next(iter(truth.noise.values()))
     receiver = truth.receiver
+    spread = 20.0 * np.log10(squeal_config(truth_values).receiver_distance_m / receiver.distance_m)
+    sq = truth.squeal
     return simulate_measurements(truth.accepted, p.lp_db, p.lpaeq_tp_dba, p.lpafmax_dba, p.tel_dba, p.band_centre_hz,
-                                 (receiver.distance_m, receiver.height_m), seed, squealing=truth.squeal["risk"] >= 2)
+                                 (receiver.distance_m, receiver.height_m), seed, squealing=sq["risk"] >= 2,
+                                 squeal_hz=sq["frequency_hz"], squeal_db=sq["level_db"] + spread)
