@@ -75,10 +75,11 @@ class FitConfig:
 
 @dataclass(frozen=True)
 class CurveQuantiles:
-    """A friction state's fitted creep curve: P10, P50, P90 of k1 and of k2 [-], and the passes seen."""
+    """A friction state's fitted creep curve: quantiles (P10, P50, P90) of k1 and of k2 [-], and
+    the passes seen and flagged squealing."""
 
-    k1: tuple[float, float, float]
-    k2: tuple[float, float, float]
+    k1: tuple[float, ...]
+    k2: tuple[float, ...]
     passes: int
     squealed: int
 
@@ -222,7 +223,7 @@ class SquealFit:
         return w / w.sum()
 
     def quantiles(self, code: int, q: tuple[float, ...] = (0.1, 0.5, 0.9)) -> CurveQuantiles:
-        """The state's P10, P50, P90 of k1 and k2."""
+        """The state's quantiles q (default P10, P50, P90) of k1 and of k2."""
         w = self.weights(code).ravel()
         k1, k2 = (x.ravel() for x in self.curves(code))
         return CurveQuantiles(tuple(_weighted_quantiles(k1, w, q)), tuple(_weighted_quantiles(k2, w, q)),
