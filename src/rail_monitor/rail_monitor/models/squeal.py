@@ -53,6 +53,12 @@ from numpy.typing import ArrayLike, NDArray
 from rail_monitor.models.hertz import HertzContact
 from rail_monitor.models.iec61672 import a_weighting_db
 from rail_monitor.models.kalker import lateral_creep_coefficient
+from rail_monitor.models.squeal_balance import (
+    FULL_BALANCE,
+    BalanceResolution,
+    critical_slip_velocity,
+    harmonic_balance_amplitude,
+)
 
 FloatArray = NDArray[np.float64]
 
@@ -129,48 +135,9 @@ def lateral_creep_stiffness(kalker_stiffness: ArrayLike, mu0: ArrayLike, convent
     raise ValueError(f"unknown k3 convention {convention!r}; use one of {K3_CONVENTIONS}")
 
 
-def critical_slip_velocity(speed: ArrayLike, load: ArrayLike, k3: ArrayLike) -> FloatArray:
-    """u_s = zeta_c V0 = W V0 / k3 [m/s] for rolling speed V0 [m/s], load W [N], k3 [N]."""
-    return np.asarray(load, float) * np.asarray(speed, float) / np.asarray(k3, float)
-
-
 def effective_damping(damping: ArrayLike, k2: ArrayLike, k3: ArrayLike, speed: ArrayLike) -> FloatArray:
     """c + k2 k3 / V0 [N s/m] (UQ paper eq. 5) on the falling branch; negative means unstable."""
     return np.asarray(damping, float) + np.asarray(k2, float) * np.asarray(k3, float) / np.asarray(speed, float)
-
-
-def creep_force(slip_velocity: ArrayLike, speed: ArrayLike, load: ArrayLike,
-                k1: ArrayLike, k2: ArrayLike, k3: ArrayLike) -> FloatArray:
-    """Lateral friction force mu(xi') W [N] at slip velocity Vc + y' [m/s].
-
-    The UQ paper's piecewise-linear curve, extended as an odd function of the creepage (reverse
-    slip saturates at -k1 and falls with the same slope) and floored at mu = 0 (a falling
-    branch never turns friction into propulsion), so that it stays physical where the closed
-    form's assumptions fail.
-    """
-    u, v0, w = (np.asarray(x, float) for x in (slip_velocity, speed, load))
-    xi = u * np.asarray(k3, float) / (v0 * w)
-    ax = np.abs(xi)
-    mu = np.where(ax <= 1.0, k1 * ax, np.maximum(k1 + k2 * (ax - 1.0), 0.0))
-    return np.sign(xi) * mu * w
-
-
-HARMONIC_POINTS = 256  # midpoints over half a cycle: the kinks of the curve cost O(1/n^2), 2e-5, in the integral
-
-
-class BalanceResolution(NamedTuple):
-    """How finely the harmonic balance is solved: midpoints over half a cycle, points of the log
-    grid of A bracketing the balance (1e-3 to 1e3 times Vc + u_s), and halvings of the bracket."""
-
-    points: int = HARMONIC_POINTS
-    bracket: int = 49
-    halvings: int = 32
-
-
-FULL_BALANCE = BalanceResolution()
-# A calibration's many evaluations: an integral error O(1/64^2) = 2e-4 and a bracket of a factor
-# 1.78 halved 16 times (1e-5 of it): about 0.002 dB in a level, at an eighth of the cost.
-COARSE_BALANCE = BalanceResolution(64, 25, 16)
 
 
 class LimitCycle(NamedTuple):
@@ -260,60 +227,6 @@ def limit_cycle_amplitude(
         xi_max = (vc + np.where(unstable, amplitude, 0.0)) / u_s
         friction_positive = k1 + k2 * np.maximum(xi_max - 1.0, 0.0) > 0.0
     return LimitCycle(amplitude, closed, phi, regime.astype(np.int8), unstable, c_eff, u_s, friction_positive)
-
-
-_BALANCE_CHUNK = 2048
-
-
-def _cycle_work(amplitude: FloatArray, speed: FloatArray, crabbing: FloatArray, load: FloatArray,
-                damping: FloatArray, k1: FloatArray, k2: FloatArray, k3: FloatArray,
-                points: int = HARMONIC_POINTS) -> FloatArray:
-    """Work per cycle on the mode over pi A^2 [N s/m] for y' = A cos(theta): the friction's
-    (1 / (pi A)) integral of f(Vc + A cos theta) cos theta d theta, plus the damper's c."""
-    theta = (np.arange(points) + 0.5) * (np.pi / points)
-    cos = np.cos(theta)
-    a = amplitude[:, None]
-    f = creep_force(crabbing[:, None] + a * cos, speed[:, None], load[:, None], k1[:, None], k2[:, None],
-                    k3[:, None])
-    return (2.0 / points) * (f * cos).sum(axis=1) / amplitude + damping
-
-
-def harmonic_balance_amplitude(speed: ArrayLike, crabbing: ArrayLike, load: ArrayLike, damping: ArrayLike,
-                               k1: ArrayLike, k2: ArrayLike, k3: ArrayLike,
-                               resolution: BalanceResolution = FULL_BALANCE) -> FloatArray:
-    """Limit-cycle velocity amplitude A w [m/s] by energy balance over the whole creep curve.
-
-    With y' = A cos(theta), the friction force f = mu(xi') W of :func:`creep_force` (adhesion,
-    falling branch, the zero-friction floor and reverse slip, as an odd function) and the damper
-    do no net work over a cycle:  (1/pi) integral_0^2pi f(Vc + A cos theta) cos theta d theta
-    + c A = 0.  The stable limit cycle is the smallest A > 0 at which the work per cycle turns from
-    feeding the mode to draining it; found on a log grid of A (1e-3 to 1e3 times Vc + u_s) and
-    refined by bisection. Units and inputs as :func:`limit_cycle_amplitude`; 0 where the mode
-    is not fed at small amplitude (no squeal), NaN where no balance exists on the grid.
-    """
-    arrays = np.broadcast_arrays(*(np.asarray(x, float) for x in (speed, crabbing, load, damping, k1, k2, k3)))
-    shape = arrays[0].shape
-    v0, vc, w, c, k1, k2, k3 = (a.ravel() for a in arrays)
-    vc = np.abs(vc)
-    if v0.size > _BALANCE_CHUNK:  # bound the (cases, HARMONIC_POINTS) arrays' memory
-        parts = [harmonic_balance_amplitude(*(a[i:i + _BALANCE_CHUNK] for a in (v0, vc, w, c, k1, k2, k3)),
-                                            resolution=resolution)
-                 for i in range(0, v0.size, _BALANCE_CHUNK)]
-        return np.concatenate(parts).reshape(shape)
-    scale = vc + critical_slip_velocity(v0, w, k3)
-    grid = np.geomspace(1e-3, 1e3, resolution.bracket)
-    args = (v0, vc, w, c, k1, k2, k3, resolution.points)
-    work = np.stack([_cycle_work(g * scale, *args) for g in grid], axis=1)  # (M, grid)
-    turns = (work[:, :-1] < 0.0) & (work[:, 1:] >= 0.0)
-    found = turns.any(axis=1)
-    j = np.argmax(turns, axis=1)
-    lo, hi = grid[j] * scale, grid[np.minimum(j + 1, len(grid) - 1)] * scale
-    for _ in range(resolution.halvings):  # 49 points: a bracket of a factor 1.33, 32 halvings leave 1e-10 of it
-        mid = 0.5 * (lo + hi)
-        feeds = _cycle_work(mid, *args) < 0.0
-        lo, hi = np.where(feeds, mid, lo), np.where(feeds, hi, mid)
-    out = np.where(found, 0.5 * (lo + hi), np.where(work[:, 0] >= 0.0, 0.0, np.nan))
-    return out.reshape(shape)
 
 
 def squeal_frequency(mass: ArrayLike, stiffness: ArrayLike) -> FloatArray:

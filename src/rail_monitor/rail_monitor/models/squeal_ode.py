@@ -2,7 +2,7 @@
 
 The ODE is :mod:`rail_monitor.models.squeal`'s (the UQ paper's eqs. 3-5), m y'' + c y' + k y =
 -mu(xi') W with xi' = (Vc + y') k3 / (V0 W) on the same floored, odd creep curve
-(:func:`rail_monitor.models.squeal.creep_force`), integrated with scipy's DOP853 without events
+(:func:`rail_monitor.models.squeal_balance.creep_force`), integrated with scipy's DOP853 without events
 until the velocity amplitude settles.
 """
 
@@ -14,7 +14,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from rail_monitor.models.squeal import creep_force
+from rail_monitor.models.squeal_balance import creep_force
 
 FloatArray = NDArray[np.float64]
 

@@ -51,6 +51,7 @@ from rail_monitor.core.friction import FRICTION_NAMES
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import squeal
+from rail_monitor.models.squeal_balance import COARSE_BALANCE
 from rail_monitor.squeal.config import RISK_HIGH, RISK_MEDIUM, SquealConfig
 from rail_monitor.squeal.predict import WheelMode, level_and_risk, wheel_mode
 
@@ -140,7 +141,7 @@ class SquealFit:
         col = [x[:, None, None] for x in (passes.speed_mps, cs.crabbing_mps, cs.load_n, mode.damping_nspm)]
         shape = (len(passes), GRID, GRID)
         lc = squeal.limit_cycle_amplitude(*(np.broadcast_to(x, shape) for x in (*col, k1[None], k2[None], k3)),
-                                          resolution=squeal.COARSE_BALANCE)
+                                          resolution=COARSE_BALANCE)
         grid_mode = WheelMode(*(np.broadcast_to(f[:, None, None], shape) for f in mode))
         lev, risk = level_and_risk(self.squeal_cfg, grid_mode, lc.amplitude, lc.unstable)
         return risk >= self.cfg.min_risk, np.where(lc.unstable, lev.level_dba, -np.inf), lev.level_db
