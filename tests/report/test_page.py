@@ -199,3 +199,37 @@ def test_the_loudest_passes_are_heard_predicted_and_recorded_on_one_scale(report
     window = (MARGIN_S, MARGIN_S + want.pass_time_s)
     heard = passby_levels(p.astype(float) * FULL_SCALE_PA, fs, *window)
     assert heard.lpaeq_tp_db == pytest.approx(passby_levels(want.pressure_pa, fs, *window).lpaeq_tp_db, abs=1e-3)
+
+
+def test_a_modifier_mixed_in_from_the_first_day_is_compared_by_friction_state(tmp_path):
+    """A quarter of the passes on the friction modifier from the first day (issue 55's new user):
+    the report compares friction states (one row each, the modifier's predicted squeal 0 %, the
+    other states' predicted cut within Eadie & Santoro's 6.3-22.8 dB(A)) and says so, with no
+    'before' made of the passes ahead of the first modifier pass."""
+    from rail_monitor.core.friction import FRICTION_MODIFIER, FRICTION_NAMES
+    from rail_monitor.report.page import _headline_lines, headline
+    from rail_monitor.site_file import load_parameter_file
+
+    from conftest import SAMPLE
+
+    values = load_parameter_file(SITE_FILE)
+    passes = read_passes(SAMPLE).take(slice(0, 2000))
+    passes.friction_state[1::4] = FRICTION_MODIFIER
+    run = load_run(write_bag(run_models(passes, values), tmp_path / "bag", "curve_250"))
+    cfg = SiteConfig.from_values(values)
+    t = pass_table(run, cfg).as_dict()
+    lim = report_tables.limits(cfg)
+    rows = report_tables.friction_comparison(t, lim)
+    by = {r["friction state"]: r for r in rows}
+    assert sorted(by) == sorted(set(t["friction_state"][t["status"] == "processed"].tolist()))
+    assert by[FRICTION_NAMES[FRICTION_MODIFIER]]["squealing, predicted [%]"] == 0.0
+    assert by[FRICTION_NAMES[FRICTION_MODIFIER]]["passes"] == int((passes.friction_state == FRICTION_MODIFIER).sum())
+    for name, r in by.items():
+        cut = r["friction-modifier cut, predicted, mean of squealing [dB(A)]"]
+        assert name == FRICTION_NAMES[FRICTION_MODIFIER] or r["squealing, predicted [%]"] == 0.0 \
+            or 6.3 <= cut <= 22.8, (name, cut)
+    tables = {"friction": rows, "outlook": [], "noise": [], "classes": []}
+    head = headline(run, t, lim, tables, cfg.site.time_zone)
+    line = next(x for x in _headline_lines(head, lim) if x.startswith("Friction modifier"))
+    assert "friction states compared (the bag holds no applicator start)" in line and "before" not in line
+    assert "published: 6.3-22.8 dB(A)" in line

@@ -18,6 +18,7 @@ import numpy as np
 
 from rail_monitor import __version__
 from rail_monitor.alerts.config import KIND_NAMES
+from rail_monitor.core.friction import FRICTION_MODIFIER, FRICTION_NAMES
 from rail_monitor.core.text import jsonable, printable
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
 from rail_monitor.engine.site_config import SiteConfig
@@ -92,11 +93,28 @@ def headline(run: RunData, t: Mapping[str, np.ndarray], lim: Mapping[str, Any], 
                            "days": worst["days"], "date": worst["date"],
                            "date_range": worst["date range (traffic P90-P10)"],
                            "due": bool(run.states["grinding_due"][-1])}
-    fm = tables["friction"]
-    if fm:
-        out["friction_modifier"] = {"before_squealing_percent": fm[0]["squealing [%]"],
-                                    "after_squealing_percent": fm[1]["squealing [%]"]}
+    rows = {r["friction state"]: r for r in tables["friction"]}
+    if rows:
+        on = rows.pop(FRICTION_NAMES[FRICTION_MODIFIER])
+        off = [r for r in rows.values()]
+        n = sum(r["passes"] for r in off)
+        cuts = [(r["passes"], r["friction-modifier cut, predicted, mean of squealing [dB(A)]"]) for r in off]
+        cuts = [(k, c) for k, c in cuts if np.isfinite(c)]
+        out["friction_modifier"] = {
+            "compared": "friction states (no applicator start in the bag)",
+            "on_squealing_percent": on["squealing, predicted [%]"],
+            "off_squealing_percent": sum(r["passes"] * r["squealing, predicted [%]"] for r in off) / n,
+            "on_measured_percent": on.get("squealing, measured [%]"),
+            "off_measured_percent": _pooled(off, "squealing, measured [%]"),
+            "predicted_cut_dba": sum(k * c for k, c in cuts) / sum(k for k, _ in cuts) if cuts else None,
+            "published_cut_dba": list(report_tables.FM_CUT_PUBLISHED_DBA)}
     return out
+
+
+def _pooled(rows: list[dict], key: str) -> float | None:
+    """A share [%] pooled over rows by their passes (None where no row has it)."""
+    have = [(r["passes"], r[key]) for r in rows if np.isfinite(r.get(key, np.nan))]
+    return sum(k * v for k, v in have) / sum(k for k, _ in have) if have else None
 
 
 def _headline_lines(h: Mapping[str, Any], lim: Mapping[str, Any]) -> list[str]:
@@ -117,8 +135,15 @@ def _headline_lines(h: Mapping[str, Any], lim: Mapping[str, Any]) -> list[str]:
                      f"{n['above limit [%]']:.1f} % of passes above it.")
     fm = h.get("friction_modifier")
     if fm:
-        lines.append(f"Friction modifier: {fm['before_squealing_percent']:.1f} % of passes squealed before it, "
-                     f"{fm['after_squealing_percent']:.1f} % from then on.")
+        heard = (f"; the station heard {fm['on_measured_percent']:.1f} % against {fm['off_measured_percent']:.1f} %"
+                 if fm["on_measured_percent"] is not None and fm["off_measured_percent"] is not None
+                 and np.isfinite(fm["on_measured_percent"]) else "")
+        cut = (f"; on the squealing passes the model predicts a cut of {fm['predicted_cut_dba']:.1f} dB(A) (published: "
+               f"{fm['published_cut_dba'][0]:g}-{fm['published_cut_dba'][1]:g} dB(A))" if fm["predicted_cut_dba"]
+               is not None else "")
+        lines.append(f"Friction modifier, friction states compared (the bag holds no applicator start): "
+                     f"{fm['on_squealing_percent']:.1f} % of passes on the modifier squeal against "
+                     f"{fm['off_squealing_percent']:.1f} % on the other states{heard}{cut}.")
     lines.append(f"Alerts raised: {h['alerts_raised']}.")
     return lines
 
@@ -140,7 +165,7 @@ def write_report(run: RunData, cfg: SiteConfig, out: Path, figures_extra: Mappin
     tables = {"outlook": report_tables.grinding_outlook(run, t, zone),
               "noise": report_tables.noise_percentiles(t, lim, models),
               "classes": report_tables.by_class(t, lim, models),
-              "friction": report_tables.friction_comparison(t, lim, zone),
+              "friction": report_tables.friction_comparison(t, lim),
               "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run),
               "offenders": report_tables.repeat_offenders(t, cfg, zone)}
     head = headline(run, t, lim, tables, zone)
@@ -203,7 +228,7 @@ def _pdf_text_pages(head, tables, lim, meta, run) -> list:
     lines += [*_headline_lines(head, lim), "", "Per vehicle class:", *_text_table(tables["classes"])]
     lines += ["", "Grinding outlook per band:", *_text_table(tables["outlook"], 8)]
     if tables["friction"]:
-        lines += ["", "Friction modifier, before and after:", *_text_table(tables["friction"])]
+        lines += ["", "Friction modifier, squeal per friction state:", *_text_table(tables["friction"])]
     if tables["advice"]:
         lines += ["", "Speed advice per class (at its recent mean speed):", *_text_table(tables["advice"])]
     lines += ["", f"Loudest squealing trains (of {len(tables['squealers'])}, all in squealing_trains.csv):"]
@@ -255,7 +280,10 @@ def _html(run, values, head, tables, lim, figures, meta, listen=()) -> str:
         caption, stem = figs[name]
         return f'<figure><img src="{stem}.png" alt="{e(caption)}"><figcaption>{e(caption)}</figcaption></figure>'
 
-    friction = (f"<h2>Friction modifier: before and after</h2>{_html_table(tables['friction'])}"
+    friction = (f"<h2>Friction modifier: squeal per friction state</h2>{_html_table(tables['friction'])}"
+                "<p class=\"meta\">Friction states compared, not before and after an applicator's start (the "
+                "bag holds no such event). The cut is the model's, on the squealing passes of each state; "
+                "Eadie &amp; Santoro (2006) measured 6.3-22.8 dB(A) at transit curves.</p>"
                 if tables["friction"] else "")
     measured = (f"<h2>Measured noise: wheel-defect suspects (repeat offenders)</h2>"
                 f"{_html_table(tables['offenders'], 25)}{fig('measured')}" if "measured" in figs else "")

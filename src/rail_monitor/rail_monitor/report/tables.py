@@ -87,24 +87,41 @@ def by_class(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], models: list[s
     return rows
 
 
-def friction_comparison(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], zone: str) -> list[dict]:
-    """Squeal before and after the first friction-modifier pass, where the history has both (else
-    an empty list), and per friction state."""
+FM_CUT_PUBLISHED_DBA = (6.3, 22.8)  # Eadie & Santoro (2006): friction modifiers at transit curves
+
+
+def friction_comparison(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list[dict]:
+    """Squeal per friction state, where the history has passes on the friction modifier and on
+    another state (else an empty list): the passes, the share squealing as predicted and, where
+    measured, as the station heard it, the mean level of the squealing, and the cut the model
+    predicts a friction modifier makes on the squealing passes (mean of their benefit).
+
+    A comparison of friction states, not of before and after an applicator's start: the bag holds
+    no such event, and where states mix from the first day the first friction-modifier pass says
+    nothing of one (its 'before' may be a single pass)."""
     ok = _processed(t)
     sq = squealing(t, lim["squeal_min_risk"])
     fm = ok & (t["friction_state"] == FRICTION_NAMES[FRICTION_MODIFIER])
     if not fm.any() or fm.sum() == ok.sum():
         return []
-    start = int(t["stamp_ns"][fm].min())
+    heard = t.get("measured_squeal_detected")
     rows = []
-    for label, m in ((f"before {format_local_ns(start, zone)[:10]} (no friction modifier)",
-                      ok & (t["stamp_ns"] < start)),
-                     ("from then on", ok & (t["stamp_ns"] >= start)),
-                     *((f"friction state: {name}", ok & (t["friction_state"] == name))
-                       for name in FRICTION_NAMES.values())):
-        if m.any():
-            rows.append({"passes": label, "count": int(m.sum()), "squealing [%]": 100.0 * (sq & m).sum() / m.sum(),
-                         "squeal level, mean of squealing [dB(A)]": _mean(t["squeal_level_dba"][sq & m])})
+    for name in FRICTION_NAMES.values():
+        m = ok & (t["friction_state"] == name)
+        if not m.any():
+            continue
+        row = {"friction state": name, "passes": int(m.sum()),
+               "squealing, predicted [%]": 100.0 * (sq & m).sum() / m.sum()}
+        if heard is not None:
+            measured = m & np.array([v != "" for v in heard], bool)
+            row["squealing, measured [%]"] = (100.0 * np.array([bool(v) for v in heard[measured]]).mean()
+                                              if measured.any() else float("nan"))
+        row["squeal level, mean of squealing [dB(A)]"] = _mean(t["squeal_level_dba"][sq & m])
+        benefit = t.get("squeal_friction_modifier_benefit_db")
+        row["friction-modifier cut, predicted, mean of squealing [dB(A)]"] = (
+            _mean(np.asarray(benefit[sq & m], float)) if benefit is not None and name != FRICTION_NAMES[
+                FRICTION_MODIFIER] else float("nan"))
+        rows.append(row)
     return rows
 
 
