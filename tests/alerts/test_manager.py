@@ -319,3 +319,20 @@ def test_squeal_measured_but_not_predicted_or_the_reverse_raises_on_its_share_of
         (KIND_SQUEAL_MISMATCH, "measured, not predicted", True, 12 * DAY // 100),
         (KIND_SQUEAL_MISMATCH, "measured, not predicted", False, 22 * DAY // 100)]
     assert m.on_residuals([_residual(30, "T", 0.0, squeal=(True, 3), model="mechanics")] * 20) == []
+
+
+def test_the_stations_squeal_share_over_a_window_raises_at_the_sites_limit_and_clears_below_it():
+    """Issue 55: what the station hears, whatever the model says: 10 measured passes of which 2 squeal
+    (passes 2 and 6), then 3 squealing in a row: the first of them makes 3 of the last 10 (30 %,
+    raised); then quiet ones until at most 1 of the last 10 squeals (pass 21: cleared)."""
+    from rail_monitor.alerts.config import KIND_SQUEAL_MEASURED
+
+    m = _manager(squeal_measured_window_passes=10, squeal_measured_raise_share=0.3, squeal_measured_clear_share=0.1)
+    seq = [(i in (2, 6), 0) for i in range(10)] + [(True, 0)] * 3 + [(False, 0)] * 10
+    events = m.on_residuals([_residual(i, f"T{i}", 0.0, squeal=q) for i, q in enumerate(seq)])
+    got = [(e.kind, e.key, e.active, e.stamp_ns) for e in events if e.kind == KIND_SQUEAL_MEASURED]
+    assert got == [(KIND_SQUEAL_MEASURED, "site", True, 10 * DAY // 100),
+                   (KIND_SQUEAL_MEASURED, "site", False, 21 * DAY // 100)]
+    assert all("squeal measured" in e.summary for e in events if e.kind == KIND_SQUEAL_MEASURED)
+    with pytest.raises(ConfigError, match="measured squeal alert needs hysteresis"):
+        _manager(squeal_measured_raise_share=0.1, squeal_measured_clear_share=0.1)

@@ -13,11 +13,11 @@ from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 
 # WaysideAlert.KIND_* and SEVERITY_* values.
 (KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED, KIND_WHEEL_DEFECT,
- KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH) = range(1, 9)
+ KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH, KIND_SQUEAL_MEASURED) = range(1, 10)
 KIND_NAMES = {KIND_GRINDING_DUE: "grinding due", KIND_GRINDING_FORECAST: "grinding forecast",
               KIND_NOISE_LIMIT: "noise limit", KIND_SQUEAL: "squeal", KIND_INPUT_REJECTED: "inputs rejected",
               KIND_WHEEL_DEFECT: "wheel defect", KIND_NOISE_DRIFT: "noise drift",
-              KIND_SQUEAL_MISMATCH: "squeal mismatch"}
+              KIND_SQUEAL_MISMATCH: "squeal mismatch", KIND_SQUEAL_MEASURED: "squeal measured"}
 SEVERITY_INFO, SEVERITY_WARNING, SEVERITY_CRITICAL = range(3)
 NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")  # RollingNoise single numbers
 RISK_NAMES = ("none", "low", "medium", "high")
@@ -68,6 +68,11 @@ ALERT_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("squeal_mismatch_raise_share", 0.2, "Share of the window's measured passes that raises either "
               "mismatch alert [-].", 0.0, 1.0),
     ParamSpec("squeal_mismatch_clear_share", 0.1, "Share at or below which it clears [-].", 0.0, 1.0),
+    ParamSpec("squeal_measured_window_passes", 200, "Measured passes over which the station's squeal flags are "
+              "counted [-].", 1, 100_000),
+    ParamSpec("squeal_measured_raise_share", 0.2, "Share of the window's measured passes flagged squealing that "
+              "raises the measured-squeal alert (the site's limit) [-].", 0.0, 1.0),
+    ParamSpec("squeal_measured_clear_share", 0.125, "Share at or below which it clears [-].", 0.0, 1.0),
 )
 # Every alert parameter may be changed on a running alert_manager (ros2 param set): an operator
 # tunes limits and windows without a restart; the same checks refuse a bad value with the reason.
@@ -102,6 +107,9 @@ class AlertConfig:
     squeal_mismatch_window_passes: int
     squeal_mismatch_raise_share: float
     squeal_mismatch_clear_share: float
+    squeal_measured_window_passes: int
+    squeal_measured_raise_share: float
+    squeal_measured_clear_share: float
     lead_time_days: float
 
 
@@ -114,7 +122,9 @@ def alert_config(values: Mapping[str, Any], lead_time_days: float, prefix: str =
                                        ("wheel defect", "wheel_defect_raise_db", "wheel_defect_clear_db"),
                                        ("drift", "drift_raise_db", "drift_clear_db"),
                                        ("squeal mismatch", "squeal_mismatch_raise_share",
-                                        "squeal_mismatch_clear_share")):
+                                        "squeal_mismatch_clear_share"),
+                                       ("measured squeal", "squeal_measured_raise_share",
+                                        "squeal_measured_clear_share")):
         if out[clear_key] >= out[raise_key]:
             raise ConfigError(f"parameter '{prefix}{clear_key}' must be below '{prefix}{raise_key}' "
                               f"(the {name} alert needs hysteresis)")

@@ -20,6 +20,7 @@ from rail_monitor.alerts.config import (
     KIND_NOISE_DRIFT,
     KIND_NOISE_LIMIT,
     KIND_SQUEAL,
+    KIND_SQUEAL_MEASURED,
     KIND_SQUEAL_MISMATCH,
     KIND_WHEEL_DEFECT,
     SEVERITY_CRITICAL,
@@ -68,6 +69,7 @@ class AlertManager:
         self._keys: dict[bytes, list[str]] = {}
         self.offences: Counter[str] = Counter()  # passes flagged per wheel-defect key (repeat offenders)
         self._mismatch = {k: Window(cfg.squeal_mismatch_window_passes) for k in MISMATCHES}
+        self._heard = Window(cfg.squeal_measured_window_passes)
 
     def retune(self, cfg: AlertConfig) -> None:
         """Take new limits and windows (a running node's parameters changed): each window keeps its
@@ -77,6 +79,7 @@ class AlertManager:
         self._squeal = self._squeal.resized(cfg.squeal_window_passes)
         self._rejected = self._rejected.resized(cfg.rejected_window_passes)
         self._mismatch = {k: w.resized(cfg.squeal_mismatch_window_passes) for k, w in self._mismatch.items()}
+        self._heard = self._heard.resized(cfg.squeal_measured_window_passes)
 
     # -- raise / clear ----------------------------------------------------------------------------
     def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
@@ -292,6 +295,8 @@ class AlertManager:
             for key, hits in zip(MISMATCHES, (measured & ~predicted, predicted & ~measured), strict=True):
                 events += self._share(self._mismatch[key], hits, KIND_SQUEAL_MISMATCH, key, stamps,
                                       "squeal_mismatch", f"squeal {key}", full_window=True)
+            events += self._share(self._heard, measured, KIND_SQUEAL_MEASURED, "site", stamps, "squeal_measured",
+                                  "squeal measured", full_window=True)
         return [e for e in events if e]
 
 
