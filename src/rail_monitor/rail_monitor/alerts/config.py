@@ -13,11 +13,12 @@ from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 
 # WaysideAlert.KIND_* and SEVERITY_* values.
 (KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED, KIND_WHEEL_DEFECT,
- KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH, KIND_SQUEAL_MEASURED) = range(1, 10)
+ KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH, KIND_SQUEAL_MEASURED, KIND_SQUEAL_OFFENDER) = range(1, 11)
 KIND_NAMES = {KIND_GRINDING_DUE: "grinding due", KIND_GRINDING_FORECAST: "grinding forecast",
               KIND_NOISE_LIMIT: "noise limit", KIND_SQUEAL: "squeal", KIND_INPUT_REJECTED: "inputs rejected",
               KIND_WHEEL_DEFECT: "wheel defect", KIND_NOISE_DRIFT: "noise drift",
-              KIND_SQUEAL_MISMATCH: "squeal mismatch", KIND_SQUEAL_MEASURED: "squeal measured"}
+              KIND_SQUEAL_MISMATCH: "squeal mismatch", KIND_SQUEAL_MEASURED: "squeal measured",
+              KIND_SQUEAL_OFFENDER: "repeat squealer"}
 SEVERITY_INFO, SEVERITY_WARNING, SEVERITY_CRITICAL = range(3)
 NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")  # RollingNoise single numbers
 RISK_NAMES = ("none", "low", "medium", "high")
@@ -73,6 +74,13 @@ ALERT_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("squeal_measured_raise_share", 0.2, "Share of the window's measured passes flagged squealing that "
               "raises the measured-squeal alert (the site's limit) [-].", 0.0, 1.0),
     ParamSpec("squeal_measured_clear_share", 0.125, "Share at or below which it clears [-].", 0.0, 1.0),
+    ParamSpec("squeal_offender_window_passes", 50, "A vehicle's (or train's) last measured passes over which its "
+              "squeal is weighed [-].", 1, 100_000),
+    ParamSpec("squeal_offender_min_passes", 10, "Measured passes a vehicle (or train) needs before it may be "
+              "named a repeat squealer [-].", 1, 100_000),
+    ParamSpec("squeal_offender_raise_p", 1e-5, "A vehicle is named when the chance of squealing that often, at "
+              "the site's measured share for passes of the same predicted risk, falls below this [-].", 1e-15, 0.5),
+    ParamSpec("squeal_offender_clear_p", 0.01, "It is cleared when that chance rises above this [-].", 1e-15, 1.0),
 )
 # Every alert parameter may be changed on a running alert_manager (ros2 param set): an operator
 # tunes limits and windows without a restart; the same checks refuse a bad value with the reason.
@@ -110,6 +118,10 @@ class AlertConfig:
     squeal_measured_window_passes: int
     squeal_measured_raise_share: float
     squeal_measured_clear_share: float
+    squeal_offender_window_passes: int
+    squeal_offender_min_passes: int
+    squeal_offender_raise_p: float
+    squeal_offender_clear_p: float
     lead_time_days: float
 
 
@@ -128,6 +140,9 @@ def alert_config(values: Mapping[str, Any], lead_time_days: float, prefix: str =
         if out[clear_key] >= out[raise_key]:
             raise ConfigError(f"parameter '{prefix}{clear_key}' must be below '{prefix}{raise_key}' "
                               f"(the {name} alert needs hysteresis)")
+    if out["squeal_offender_clear_p"] <= out["squeal_offender_raise_p"]:
+        raise ConfigError(f"parameter '{prefix}squeal_offender_clear_p' must be above "
+                          f"'{prefix}squeal_offender_raise_p' (the repeat-squealer alert needs hysteresis)")
     if out["noise_raise_count"] > out["noise_window_passes"]:
         raise ConfigError(f"parameter '{prefix}noise_raise_count' exceeds '{prefix}noise_window_passes'")
     out["lead_time_days"] = float(lead_time_days)

@@ -22,6 +22,7 @@ from rail_monitor.alerts.config import (
     KIND_SQUEAL,
     KIND_SQUEAL_MEASURED,
     KIND_SQUEAL_MISMATCH,
+    KIND_SQUEAL_OFFENDER,
     KIND_WHEEL_DEFECT,
     SEVERITY_CRITICAL,
     SEVERITY_INFO,
@@ -29,6 +30,7 @@ from rail_monitor.alerts.config import (
     AlertConfig,
     counts_as_squeal,
 )
+from rail_monitor.alerts.squealers import RepeatSquealers
 from rail_monitor.alerts.windows import Window, hysteresis_changes
 from rail_monitor.core.text import printable
 from rail_monitor.core.timeutil import format_iso_ns
@@ -70,6 +72,8 @@ class AlertManager:
         self.offences: Counter[str] = Counter()  # passes flagged per wheel-defect key (repeat offenders)
         self._mismatch = {k: Window(cfg.squeal_mismatch_window_passes) for k in MISMATCHES}
         self._heard = Window(cfg.squeal_measured_window_passes)
+        self.squealers = RepeatSquealers(cfg.squeal_offender_window_passes, cfg.squeal_offender_min_passes,
+                                         cfg.squeal_offender_raise_p, cfg.squeal_offender_clear_p)
 
     def retune(self, cfg: AlertConfig) -> None:
         """Take new limits and windows (a running node's parameters changed): each window keeps its
@@ -80,6 +84,10 @@ class AlertManager:
         self._rejected = self._rejected.resized(cfg.rejected_window_passes)
         self._mismatch = {k: w.resized(cfg.squeal_mismatch_window_passes) for k, w in self._mismatch.items()}
         self._heard = self._heard.resized(cfg.squeal_measured_window_passes)
+        s = self.squealers
+        s.window, s.min_passes, s.raise_p, s.clear_p = (cfg.squeal_offender_window_passes,
+                                                        cfg.squeal_offender_min_passes,
+                                                        cfg.squeal_offender_raise_p, cfg.squeal_offender_clear_p)
 
     # -- raise / clear ----------------------------------------------------------------------------
     def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
@@ -297,6 +305,17 @@ class AlertManager:
                                       "squeal_mismatch", f"squeal {key}", full_window=True)
             events += self._share(self._heard, measured, KIND_SQUEAL_MEASURED, "site", stamps, "squeal_measured",
                                   "squeal measured", full_window=True)
+            for r in residuals:
+                for v in self.squealers.add(r.stamp_ns, r.train_id, tuple(r.vehicle_id), r.squeal_detected,
+                                            r.squeal_risk):
+                    events.append(self._set(
+                        v.flagged, KIND_SQUEAL_OFFENDER, v.key, v.stamp_ns,
+                        SEVERITY_WARNING if v.flagged else SEVERITY_INFO,
+                        f"repeat squealer: {v.key} heard squealing on {v.squealed} of its last {v.passes} measured "
+                        f"passes, {v.expected:.1f} expected at the site's share for passes alike (chance "
+                        f"{v.chance:.1e})" if v.flagged else f"repeat squealer: {v.key} cleared ({v.squealed} of "
+                        f"{v.passes}, {v.expected:.1f} expected)", v.chance,
+                        cfg.squeal_offender_raise_p if v.flagged else cfg.squeal_offender_clear_p, "-"))
         return [e for e in events if e]
 
 

@@ -35,6 +35,7 @@ class MeasuredSeries:
     measurements: list[Measurement]
     defective: frozenset[str]              # ids of the vehicles with a wheel defect
     vehicles: list[tuple[str, ...]]        # per measurement, its vehicles in running order
+    squealers: frozenset[str] = frozenset()  # ids of the vehicles that squeal more than their class
 
 
 def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np.ndarray, lpafmax_dba: np.ndarray,
@@ -43,13 +44,17 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
                           wheel_spread_db: float = 1.0, weather_sd_db: float = 0.5,
                           instrument_class: int = 1, squealing: np.ndarray | None = None,
                           squeal_error: float = 0.02, squeal_hz: np.ndarray | None = None,
-                          squeal_db: np.ndarray | None = None, squeal_sd_db: float = 1.5) -> MeasuredSeries:
+                          squeal_db: np.ndarray | None = None, squeal_sd_db: float = 1.5, squealers: int = 0,
+                          squealer_rate: float = 0.5) -> MeasuredSeries:
     """Measurements of passes (rows matching the predictions: lp_db (N, B) [dB] on band_hz [Hz],
     the single numbers (N,) [dB(A)]) at receiver_m (distance, height) [m]. squealing: whether
     each pass squeals (the squeal model's prediction, say); the station's flag is that, wrong on
     a share squeal_error of passes (none squeal without it). squeal_hz, squeal_db: each pass's
     squeal tone [Hz] and its level at the microphone [dB re 20 uPa], measured (with an error of sd
-    squeal_sd_db) on the passes that squeal and are flagged; not measured (NaN) without them."""
+    squeal_sd_db) on the passes that squeal and are flagged; not measured (NaN) without them.
+    squealers: vehicles (drawn from the fleets) whose train squeals besides, on a share
+    squealer_rate of their passes (a wheel that squeals more than its class: flagged, its tone
+    not measured)."""
     rng = np.random.Generator(np.random.PCG64(seed))
     classes = sorted(set(passes.vehicle_class.tolist()))
     fleets = {c: [f"{c.upper()}-V{k:03d}" for k in range(fleet_per_class)] for c in classes}
@@ -73,10 +78,14 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
     tone_db = np.where(heard, (squeal_db if squeal_db is not None else 0.0)
                        + tone_rng.normal(0.0, squeal_sd_db, len(passes)), np.nan)
     tone_hz = np.where(heard, squeal_hz if squeal_hz is not None else np.nan, np.nan)
+    loud = frozenset(tone_rng.choice(every, size=min(squealers, len(every)), replace=False).tolist()
+                     if squealers else ())
     for i in range(len(passes)):
         fleet = fleets[passes.vehicle_class[i]]
         n = int(min(max(passes.vehicle_count[i], 1), len(fleet)))
         vehicles = tuple(rng.choice(fleet, size=n, replace=False).tolist())
+        if loud and not loud.isdisjoint(vehicles) and tone_rng.random() < squealer_rate:
+            flags[i] = True
         o = np.array([offset[v] for v in vehicles])
         base = lp_db[i] + weather[int(days[i])]
         leq = base + mid * (energy_sum(o) - 10.0 * np.log10(n)) + rng.normal(0.0, sd, len(band_hz))
@@ -87,7 +96,7 @@ def simulate_measurements(passes: PassTable, lp_db: np.ndarray, lpaeq_tp_dba: np
                                float(lpafmax_dba[i]) + shift, float(tel_dba[i]) + shift, bool(flags[i]), vehicles,
                                own, squeal_frequency_hz=float(tone_hz[i]), squeal_level_db=float(tone_db[i])))
         consists.append(vehicles)
-    return MeasuredSeries(out, bad, consists)
+    return MeasuredSeries(out, bad, consists, loud)
 
 
 def true_values(values: dict, true_creep: dict[str, tuple[float, float]] | None = None) -> dict:
@@ -99,9 +108,11 @@ def true_values(values: dict, true_creep: dict[str, tuple[float, float]] | None 
 
 
 def station_on_true_rail(passes: PassTable, values: dict, k_b_factor: float, seed: int,
-                         true_creep: dict[str, tuple[float, float]] | None = None) -> MeasuredSeries:
+                         true_creep: dict[str, tuple[float, float]] | None = None, squealers: int = 0
+                         ) -> MeasuredSeries:
     """A station measuring every valid pass of a true rail whose K_b is the configured one times
-    k_b_factor and whose creep curves are true_creep's where given (state name -> (k1, k2)),
+    k_b_factor and whose creep curves are true_creep's where given (state name -> (k1, k2)), with
+    ``squealers`` vehicles that squeal more than their class (simulate_measurements),
     kept from the fitting (CNOSSOS-EU's prediction on that rail, with simulate_measurements'
     deviations; its squeal flag the squeal model's risk medium or above there, with the tone's
     frequency and level, spread from the squeal model's receiver to the microphone)."""
@@ -119,4 +130,5 @@ def station_on_true_rail(passes: PassTable, values: dict, k_b_factor: float, see
     sq = truth.squeal
     return simulate_measurements(truth.accepted, p.lp_db, p.lpaeq_tp_dba, p.lpafmax_dba, p.tel_dba, p.band_centre_hz,
                                  (receiver.distance_m, receiver.height_m), seed, squealing=sq["risk"] >= 2,
-                                 squeal_hz=sq["frequency_hz"], squeal_db=sq["level_db"] + spread)
+                                 squeal_hz=sq["frequency_hz"], squeal_db=sq["level_db"] + spread,
+                                 squealers=squealers)
