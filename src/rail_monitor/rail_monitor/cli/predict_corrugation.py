@@ -28,8 +28,9 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     c.add_argument("--friction", choices=tuple(FRICTION_BY_NAME),
                    help="friction state (default: dry, or the history's mix)")
     c.add_argument("--passes-per-day", type=float, help="train passes per day (default: the history's)")
-    c.add_argument("--advise", action="store_true", help="with --history: also propose speed bands per vehicle "
-                   "class at each class's mean speed (noise and squeal not raised)")
+    c.add_argument("--advise", action="store_true", help="also propose speed bands per vehicle class at each "
+                   "class's mean speed (noise and squeal not raised): from the history, or from passes standing for "
+                   "the given distribution (--vehicle-class, else the site's first class)")
     c.add_argument("--json", action="store_true", help="print JSON instead of a table")
     c.add_argument("--plot-receptance", metavar="PNG", help="save the track and wheel receptances to this PNG")
     c.add_argument("--plot-growth", metavar="PNG", help="save growth against wavelength (current and advised)")

@@ -63,8 +63,9 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
     post-grinding rail with the given speeds and weights, or a normal distribution of the
     class's mean and sd (overridden by speed_mean_mps [m/s] and speed_cv [-]), on dry rail
     unless friction names a state; the kernel and axles per train are then vehicle_class's when
-    given, else the site's traffic mix and its traffic-weighted axles per train. RailMonitorError
-    for unusable inputs.
+    given, else the site's traffic mix and its traffic-weighted axles per train. The advice of a
+    bare distribution is the history's advice on passes standing for it (distribution_passes:
+    vehicle_class, or the site's first class). RailMonitorError for unusable inputs.
     """
     site = site_from_values(values)
     est = CorrugationEstimator(site, corrugation_config(values))
@@ -92,12 +93,12 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
         mix = f"class {vehicle_class}" if vehicle_class else "the site's traffic mix (" + ", ".join(
             f"{n} {100 * c.traffic_share:.0f} %" for n, c in site.vehicles.items()) + ")"
         where = f"site {site.site_id}, post-grinding rail, {friction or 'dry'}, kernel of {mix}"
-    if advise and history is None:
-        raise RailMonitorError("--advise needs --history: the advice is per vehicle class, from the passes' speeds, "
-                               "friction and angles of attack")
     try:
         ev = adv.evaluate(est, v, w, state, passes_per_day or 0.0, kernel_class)
-        advice = _advise(values, est) if advise else None
+        advice = None
+        if advise:  # a bare distribution is advised as a history of its passes would be
+            advice = _advise(values, est if history is not None else distribution_estimator(
+                values, kernel_class or next(iter(site.vehicles)), v, w, state))
     except ValueError as exc:
         raise RailMonitorError(str(exc)) from None
     axles = adv.axles_per_train(est, kernel_class)
@@ -107,6 +108,36 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
         return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice)
     return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice, est.forecast_interval(),
                              len(events), refused)
+
+
+DISTRIBUTION_PASSES = 2000  # passes standing for a bare distribution (its quantiles)
+
+
+def distribution_passes(values: Mapping[str, Any], vehicle_class: str, speeds: np.ndarray, weights: np.ndarray,
+                        friction_state: int, n: int = DISTRIBUTION_PASSES) -> PassTable:
+    """n passes of one class standing for a speed distribution: their speeds the distribution's
+    quantiles at (i + 1/2) / n (the weighted speeds' step CDF, interpolated), in its mean consist,
+    on one friction state, no angle of attack, 15 min apart from 2026-09-21 (valid, class defaults
+    filled)."""
+    site = site_from_values(values)
+    cls = site.vehicle(vehicle_class)
+    order = np.argsort(speeds, kind="stable")
+    v, w = np.asarray(speeds, float)[order], np.asarray(weights, float)[order]
+    cdf = (np.cumsum(w) - 0.5 * w) / w.sum()
+    q = np.interp((np.arange(n) + 0.5) / n, cdf, v)
+    return with_class_defaults(PassTable(
+        stamp_ns=(1_790_000_000 + np.arange(n) * 900).astype(np.int64) * 10**9, train_id=[f"D{i}" for i in range(n)],
+        vehicle_class=[vehicle_class] * n, vehicle_count=[max(round(cls.mean_vehicles), 1)] * n, axle_count=[0] * n,
+        speed_mps=q, angle_of_attack_rad=[0.0] * n, wheel_load_n=[0.0] * n,
+        friction_state=np.full(n, friction_state), train_length_m=[0.0] * n), site)
+
+
+def distribution_estimator(values: Mapping[str, Any], vehicle_class: str, speeds: np.ndarray, weights: np.ndarray,
+                           friction_state: int) -> CorrugationEstimator:
+    """A post-grinding state advanced over the passes standing for a distribution (the advice's input)."""
+    est = CorrugationEstimator(site_from_values(values), corrugation_config(values))
+    est.advance(distribution_passes(values, vehicle_class, speeds, weights, friction_state))
+    return est
 
 
 def _advise(values: Mapping[str, Any], est: CorrugationEstimator) -> Any:
