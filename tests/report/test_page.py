@@ -233,3 +233,27 @@ def test_a_modifier_mixed_in_from_the_first_day_is_compared_by_friction_state(tm
     line = next(x for x in _headline_lines(head, lim) if x.startswith("Friction modifier"))
     assert "friction states compared (the bag holds no applicator start)" in line and "before" not in line
     assert "published: 6.3-22.8 dB(A)" in line
+
+
+def test_measured_squeal_by_angle_of_attack_and_the_repeat_squealers_named():
+    """The report's tables of measured against predicted squeal per angle-of-attack band (measured
+    passes only, a rejected pass left out) and of the vehicles the repeat-squealer alert named."""
+    from rail_monitor.alerts.config import KIND_SQUEAL_OFFENDER
+    from rail_monitor.alerts.manager import Alert
+
+    t = {"status": np.array(["processed"] * 5 + ["speed_mps not positive"]),
+         "measured_squeal_detected": np.array([True, False, "", True, True, True], object),
+         "squeal_risk": np.array(["medium", "none", "high", "low", "high", "high"]),
+         "angle_of_attack_mrad": np.array([1.0, 1.5, 3.0, 3.5, 12.0, 12.0]),
+         "stamp_ns": np.arange(6)}
+    rows = report_tables.squeal_by_angle(t, {"squeal_min_risk": "medium"})
+    assert rows == [{"angle of attack [mrad]": "0-2", "measured passes": 2, "squealing, predicted [%]": 50.0,
+                     "squealing, measured [%]": 50.0},
+                    {"angle of attack [mrad]": "2-4", "measured passes": 1, "squealing, predicted [%]": 0.0,
+                     "squealing, measured [%]": 100.0},
+                    {"angle of attack [mrad]": ">= 10", "measured passes": 1, "squealing, predicted [%]": 100.0,
+                     "squealing, measured [%]": 100.0}]
+    named = Alert(KIND_SQUEAL_OFFENDER, "vehicle V7", 1, True, "repeat squealer: vehicle V7 ...", 1e-7, 1e-5, "-",
+                  10**18, 10**18, 0)
+    cleared = Alert(KIND_SQUEAL_OFFENDER, "vehicle V9", 0, False, "cleared", 0.5, 0.01, "-", 10**18, 10**18, 0)
+    assert [r["vehicle or train"] for r in report_tables.repeat_squealers([named, cleared], "UTC")] == ["vehicle V7"]

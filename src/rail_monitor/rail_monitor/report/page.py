@@ -167,7 +167,9 @@ def write_report(run: RunData, cfg: SiteConfig, out: Path, figures_extra: Mappin
               "classes": report_tables.by_class(t, lim, models),
               "friction": report_tables.friction_comparison(t, lim),
               "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run),
-              "offenders": report_tables.repeat_offenders(t, cfg, zone)}
+              "offenders": report_tables.repeat_offenders(t, cfg, zone),
+              "squeal_angles": report_tables.squeal_by_angle(t, lim),
+              "repeat_squealers": report_tables.repeat_squealers(run.alerts, zone)}
     head = headline(run, t, lim, tables, zone)
     figures = [("timeline", "Passes and squealing passes per day, and the day's highest pass-by level against "
                 "the limit.", report_plots.timeline(report_tables.daily(t, lim, models, zone), models, lim, zone))]
@@ -287,6 +289,10 @@ def _html(run, values, head, tables, lim, figures, meta, listen=()) -> str:
                 if tables["friction"] else "")
     measured = (f"<h2>Measured noise: wheel-defect suspects (repeat offenders)</h2>"
                 f"{_html_table(tables['offenders'], 25)}{fig('measured')}" if "measured" in figs else "")
+    if tables["squeal_angles"]:
+        measured += (f"<h2>Measured squeal against the model, by angle of attack</h2>"
+                     f"{_html_table(tables['squeal_angles'])}<h2>Repeat squealers</h2>"
+                     f"{_html_table(tables['repeat_squealers'], 25)}")
     advice = (f"<h2>Speed advice per class</h2>{_html_table(tables['advice'])}<p class=\"meta\">Shares of each "
               "class's trains per speed band at its recent mean speed, cutting the peak corrugation growth "
               "without raising the mean noise by more than the limit or the squealing share.</p>"

@@ -8,6 +8,7 @@ report, the export and the console agree by construction.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 from typing import Any
 
@@ -123,6 +124,39 @@ def friction_comparison(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> 
                 FRICTION_MODIFIER] else float("nan"))
         rows.append(row)
     return rows
+
+
+AOA_BANDS_MRAD = (0.0, 2.0, 4.0, 6.0, 8.0, 10.0, np.inf)  # the squeal table's angle-of-attack bands
+
+
+def squeal_by_angle(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list[dict]:
+    """Squeal predicted and, where a station measured it, heard, per angle-of-attack band: the
+    model against the site where it matters most (empty without measured passes)."""
+    heard = t.get("measured_squeal_detected")
+    if heard is None:
+        return []
+    ok = _processed(t)
+    measured = ok & np.array([v != "" for v in heard], bool)
+    flags = np.array([bool(v) if v != "" else False for v in heard], bool)
+    sq = squealing(t, lim["squeal_min_risk"])
+    aoa = np.abs(np.asarray(t["angle_of_attack_mrad"], float))
+    rows = []
+    for lo, hi in itertools.pairwise(AOA_BANDS_MRAD):
+        m = measured & (aoa >= lo) & (aoa < hi)
+        if m.any():
+            rows.append({"angle of attack [mrad]": f"{lo:g}-{hi:g}" if np.isfinite(hi) else f">= {lo:g}",
+                         "measured passes": int(m.sum()), "squealing, predicted [%]": 100.0 * sq[m].mean(),
+                         "squealing, measured [%]": 100.0 * flags[m].mean()})
+    return rows
+
+
+def repeat_squealers(alerts: list, zone: str) -> list[dict]:
+    """The vehicles (or trains) the repeat-squealer alert named, the latest first."""
+    from rail_monitor.alerts.config import KIND_SQUEAL_OFFENDER
+
+    named = [a for a in alerts if a.kind == KIND_SQUEAL_OFFENDER and a.active]
+    return [{"vehicle or train": a.key, "named (local)": format_local_ns(a.stamp_ns, zone), "why": a.summary}
+            for a in sorted(named, key=lambda a: -a.stamp_ns)]
 
 
 def squealing_trains(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list[dict]:
