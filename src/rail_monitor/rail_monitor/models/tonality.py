@@ -89,9 +89,10 @@ def tones(pressure_pa: ArrayLike, fs_hz: float, low_hz: float = 50.0, high_hz: f
     for c in candidates:
         tone_lines[max(c - LOBE_LINES, 0): c + LOBE_LINES + 1] = True
     out: list[Tone] = []
-    taken: list[float] = []
+    taken: list[tuple[float, float]] = []  # a stronger tone's frequency and half its critical band [Hz]
     for c in candidates[np.argsort(-psd[candidates])]:
-        if any(abs(f[c] - t) < critical_bandwidth_hz(t) / 2.0 for t in taken):
+        fc = float(f[c])
+        if any(abs(fc - t) < half for t, half in taken):
             continue  # within the critical band of a stronger tone: merged into it
         lines = slice(max(c - LOBE_LINES, 0), c + LOBE_LINES + 1)
         level_t = 10.0 * np.log10(np.sum(psd[lines]) * df / P0_PA**2)
@@ -100,7 +101,7 @@ def tones(pressure_pa: ArrayLike, fs_hz: float, low_hz: float = 50.0, high_hz: f
             continue
         level_g = 10.0 * np.log10(np.mean(noise) * band[c] / P0_PA**2)
         audibility = level_t - level_g - float(masking_index_db(f[c]))
-        taken.append(float(f[c]))
+        taken.append((fc, float(critical_bandwidth_hz(fc)) / 2.0))
         if audibility > 0.0:
             out.append(Tone(float(f[c]), float(level_t), float(level_g), float(audibility)))
     return sorted(out, key=lambda t: -t.audibility_db)
