@@ -87,13 +87,13 @@ class AudioArchive:
             reasons.append(LOUDEST)
         return self._keep(Path(source), stamp_ns, train_id, lpafmax_db, reasons)
 
-    def suspect(self, source: str | Path | None, stamp_ns: int, train_id: str, lpafmax_db: float) -> list[str]:
-        """A pass found a wheel-defect suspect (source: its audio, None when no longer at hand)."""
-        if (stamp_ns, train_id) not in self.kept and (source is None or not Path(source).is_file()):
+    def suspect(self, source: str | Path, stamp_ns: int, train_id: str, lpafmax_db: float) -> list[str]:
+        """A pass found a wheel-defect suspect (source: where its audio was)."""
+        if (stamp_ns, train_id) not in self.kept and not Path(source).is_file():
             self.counts["suspect's audio no longer at hand"] += 1
             self.notes.append(f"wheel-defect suspect {train_id}: its audio is no longer in the recorder's folder")
             return []
-        return self._keep(Path(source) if source else Path(), stamp_ns, train_id, lpafmax_db, [SUSPECT])
+        return self._keep(Path(source), stamp_ns, train_id, lpafmax_db, [SUSPECT])
 
     def _among_loudest(self, stamp_ns: int, train_id: str, level: float) -> bool:
         """Whether the pass is among its day's loudest heard so far (kept or not since); the
