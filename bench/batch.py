@@ -20,12 +20,12 @@ import numpy as np
 
 from bench.timing import first_touch_s, peak_rss_mb
 from rail_monitor.batch.bag import run_to_bag
-from rail_monitor.batch.result import BatchResult
 from rail_monitor.batch.run import run_models
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.simulator_params import simulator_config
 from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns, parse_iso_ns
+from rail_monitor.engine.result import SiteOutputs
 from rail_monitor.simulation.simulator import simulate
 
 BUSY_YEAR = 100_000  # train passes a year at a busy site
@@ -58,7 +58,7 @@ def set_up_s(values: Mapping[str, Any]) -> float:
     return time.perf_counter() - t
 
 
-def timed(values: Mapping[str, Any], passes: int, threads: int = 0) -> tuple[int, float, BatchResult]:
+def timed(values: Mapping[str, Any], passes: int, threads: int = 0) -> tuple[int, float, SiteOutputs]:
     table = busy_history(values, passes)
     t = time.perf_counter()
     r = run_models(table, values, threads=threads)

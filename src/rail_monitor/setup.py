@@ -51,6 +51,7 @@ setup(
             "foxglove_server = rail_monitor.nodes.foxglove_server:main",
             "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
             "noise_station = rail_monitor.nodes.noise_station:main",
+            "site_engine = rail_monitor.nodes.site_engine:main",
             "rail-monitor = rail_monitor.cli:main",
         ],
     },

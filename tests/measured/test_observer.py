@@ -95,10 +95,11 @@ def measured_history(sample_passes):
 
 
 def test_any_chunking_and_a_checkpoint_give_the_one_call_state(measured_history, tmp_path):
-    from rail_monitor.batch.run import BatchRun, run_models
+    from rail_monitor.batch.run import run_models
     from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.corrugation.estimator import CorrugationEstimator
     from rail_monitor.engine import checkpoint
+    from rail_monitor.engine.site import SiteEngine
 
     history, measurements, values = measured_history
     whole = run_models(history, values, measurements=measurements)
@@ -106,7 +107,7 @@ def test_any_chunking_and_a_checkpoint_give_the_one_call_state(measured_history,
     assert len(taken) >= 2 and whole.estimator.calibration_surveys == len(taken)
     rng = np.random.default_rng(21)
     cuts = sorted(rng.choice(len(history), 9, replace=False).tolist())
-    run = BatchRun(values, measurements=measurements)
+    run = SiteEngine(values, measurements=measurements)
     for a, b in zip([0, *cuts], [*cuts, len(history)], strict=True):
         run.feed(history.take(slice(a, b)))
     run.finish()
@@ -118,14 +119,14 @@ def test_any_chunking_and_a_checkpoint_give_the_one_call_state(measured_history,
     # (they come after the restart, as a replay sends them): the same state at the end
     half = len(history) // 2 + 7
     cut = history.stamp_ns[half - 3]
-    first = BatchRun(values, measurements=[m for m in measurements if m.stamp_ns <= cut])
+    first = SiteEngine(values, measurements=[m for m in measurements if m.stamp_ns <= cut])
     first.feed(history.take(slice(0, half)))
     assert first.observer.fitted > 0  # the open window has measured passes in it
     assert sum(k[0] > cut for k in first.observer.counted) == 2  # counted, their measurements to come
     checkpoint.save(first.estimator, tmp_path / "state.npz", first.observer)
     est = CorrugationEstimator(first.site, corrugation_config(values))
     checkpoint.load(est, tmp_path / "state.npz")
-    second = BatchRun(values, estimator=est,
+    second = SiteEngine(values, estimator=est,
                       measurements=[m for m in measurements if m.stamp_ns > cut])
     checkpoint.load(CorrugationEstimator(first.site, corrugation_config(values)), tmp_path / "state.npz",
                     second.observer)
@@ -136,9 +137,9 @@ def test_any_chunking_and_a_checkpoint_give_the_one_call_state(measured_history,
 
 def _observer_counts(values, history, measurements):
     """The observer's counts after one call."""
-    from rail_monitor.batch.run import BatchRun
+    from rail_monitor.engine.site import SiteEngine
 
-    run = BatchRun(values, measurements=measurements)
+    run = SiteEngine(values, measurements=measurements)
     run.feed(history)
     run.finish()
     return run.observer.counts

@@ -62,9 +62,9 @@ def _site_file(folder: Path, checkpoint: Path | None = None) -> Path:
     alerts = doc["/**"]["ros__parameters"]["alerts"]
     alerts.update({k.split(".", 1)[1]: v for k, v in ALERTS.items()})
     doc["/**"]["ros__parameters"].setdefault("residual", {}).update(indirect_days=INDIRECT["residual.indirect_days"])
-    if checkpoint is not None:
-        doc["/**/corrugation_estimator"]["ros__parameters"].update(checkpoint_path=str(checkpoint),
-                                                                    checkpoint_every_passes=10)
+    if checkpoint is not None:  # the state's holder in either layout
+        for node in ("corrugation_estimator", "site_engine"):
+            doc[f"/**/{node}"]["ros__parameters"].update(checkpoint_path=str(checkpoint), checkpoint_every_passes=10)
     path = folder / "site.yaml"
     path.write_text(yaml.safe_dump(doc))
     return path
@@ -334,9 +334,9 @@ def test_wayside_monitor_listening_to_another_process_equals_batch(runs, tmp_pat
     with open(tmp_path / "monitor.log", "w") as log:
         monitor = subprocess.Popen(["wayside_monitor", "--ros-args", *ns, "-p", "listen:=true",
                                     "-p", f"output:={tmp_path / 'bag'}"], cwd=TOP, stdout=log, stderr=subprocess.STDOUT)
-    try:
+    try:  # two subscribers on train_pass: site_engine and the recorder
         r = run_cmd("pass_replayer", "--ros-args", "-r", "__ns:=/curve_250", "--params-file", str(runs["site"]),
-                    "-p", f"source:={runs['history']}", "-p", "rate:=0.0", "-p", "wait_for_subscribers:=5",
+                    "-p", f"source:={runs['history']}", "-p", "rate:=0.0", "-p", "wait_for_subscribers:=2",
                     "-p", f"end_offset_s:={DAYS * 86400}", "-p", "progress:=false", timeout=240)
         assert r.returncode == 0, r.stderr[-2000:]
     finally:

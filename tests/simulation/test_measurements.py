@@ -12,8 +12,9 @@ import pytest
 from rail_monitor.alerts.config import KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH, KIND_WHEEL_DEFECT, alert_config
 from rail_monitor.alerts.manager import wheel_defect_score
 from rail_monitor.bagio.reader import read_bag_passes
-from rail_monitor.batch.result import BatchResult
-from rail_monitor.batch.run import BatchRun, run_models
+from rail_monitor.batch.run import run_models
+from rail_monitor.engine.result import SiteOutputs
+from rail_monitor.engine.site import SiteEngine
 from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.simulation.measurements import simulate_measurements
 from rail_monitor.site_file import load_parameter_file
@@ -55,11 +56,11 @@ def test_every_defective_vehicle_is_alerted_with_at_most_one_percent_of_passes_f
 
 def test_any_chunking_gives_the_one_call_residuals(loop, site_values):
     passes, sim, whole = loop
-    run = BatchRun(site_values, measurements=sim.measurements)
+    run = SiteEngine(site_values, measurements=sim.measurements)
     cuts = [0, 7, 800, 801, 2000, len(passes)]
     parts = [run.feed(passes.take(slice(a, b))) for a, b in itertools.pairwise(cuts)]
     held, advice = run.finish()
-    got = BatchResult.merged(parts, held, advice)
+    got = SiteOutputs.merged(parts, held, advice)
     assert len(got.residuals) == len(whole.residuals)
     for a, b in zip(got.residuals, whole.residuals, strict=True):
         assert (a.stamp_ns, a.model) == (b.stamp_ns, b.model)
@@ -87,7 +88,7 @@ def test_a_chunk_longer_than_the_tracker_holds_pairs_every_measurement(loop):
     # 100 kept pairs each measurement all the same, as the default does (the pairing goes block by block).
     passes, sim, whole = loop
     values = {**load_parameter_file(SITE_FILE), "residual.held_predictions": 100}
-    run = BatchRun(values, measurements=sim.measurements)
+    run = SiteEngine(values, measurements=sim.measurements)
     got = run.feed(passes)
     run.finish()
     assert not run.tracker.refused and len(got.residuals) == len(whole.residuals)

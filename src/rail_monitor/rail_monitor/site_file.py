@@ -158,7 +158,7 @@ REFERENCE_SECTIONS: tuple[tuple[str, str, tuple[ParamSpec, ...]], ...] = (
                                                          node_params.MODE_SPECS),
     ("mcap_recorder", "", node_params.RECORDER_SPECS), ("wayside_monitor", "", node_params.MONITOR_SPECS),
     ("Model nodes: batches of passes", "", node_params.BATCH_SPECS),
-    ("corrugation_estimator", "", node_params.ESTIMATOR_SPECS),
+    ("corrugation_estimator and site_engine", "", node_params.ESTIMATOR_SPECS),
     ("rolling_noise_predictor", "", node_params.PREDICTOR_SPECS), ("foxglove_server", "", node_params.FOXGLOVE_SPECS),
 )
 

@@ -9,29 +9,26 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from rail_monitor.advice.plan import SpeedAdvice
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.bagio.mcap_bag import McapBagWriter
 from rail_monitor.bagio.output_folder import Claim, claim_output_folder
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
-from rail_monitor.batch.result import BatchResult
-from rail_monitor.batch.run import BatchRun
-from rail_monitor.codec.cdr import serialize
 from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.core.errors import PassOrderError
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.text import printable
 from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.engine.result import SiteOutputs
+from rail_monitor.engine.site import SiteEngine
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual
-from rail_monitor.messages import fields
+from rail_monitor.messages import fields, outputs
 from rail_monitor.messages.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
 
 
 class BatchBag:
-    """A bag folder taking BatchRun's results one chunk at a time (``add``), then the held-back
+    """A bag folder taking SiteEngine's results one chunk at a time (``add``), then the held-back
     events and the advice (``finish``). site: the site record stored with the bag
     (bagio.site_record), as the recorder stores it."""
 
@@ -43,7 +40,7 @@ class BatchBag:
         self.bag = McapBagWriter(Path(folder), compression=compression, claim=claim, **stored)
         for name, (typename, qos) in GRAPH_TOPICS.items():
             self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
-        self._standing: dict[tuple[int, str], Alert] = {}
+        self._alert_stream = outputs.AlertStream(frame)
 
     def __enter__(self) -> BatchBag:
         return self
@@ -52,20 +49,16 @@ class BatchBag:
         self.bag.close()
 
     def _put(self, name: str, msg: dict[str, Any], stamp_ns: int) -> None:
-        if name in GRAPH_TOPICS:
-            typename = GRAPH_TOPICS[name][0]
-        else:  # declared with its first message, as the recorder records it once it is published
+        self._write(outputs.one(name, msg, stamp_ns))
+
+    def _write(self, messages: outputs.Messages) -> None:
+        """Messages of a graph topic, in order, logged at their stamps (none before 1970); an optional
+        topic is declared with its first message, as the recorder records it once it is published."""
+        name = messages.topic
+        if name not in GRAPH_TOPICS:
             typename, qos = OPTIONAL_TOPICS[name]
             self.bag.add_topic(f"{self.ns}/{name}", typename, [qos.as_metadata()])
-        self.bag.write(f"{self.ns}/{name}", serialize(typename, msg), max(stamp_ns, 0))
-
-    def _write(self, name: str, columns: dict[str, Any], stamp_ns: np.ndarray) -> None:
-        """Messages of a graph topic given as columns, one per stamp (codec.cdr_from_columns)."""
-        self._write_cdr(name, serialize_columns(GRAPH_TOPICS[name][0], columns, len(stamp_ns)), stamp_ns)
-
-    def _write_cdr(self, name: str, datas: list[bytes], stamp_ns: np.ndarray) -> None:
-        """CDR messages of a graph topic, in order, logged at their stamps."""
-        self.bag.write_many(f"{self.ns}/{name}", datas, np.maximum(stamp_ns, 0).tolist())  # no log time before 1970
+        self.bag.write_many(f"{self.ns}/{name}", messages.datas, [max(t, 0) for t in messages.stamps_ns])
 
     def events(self, events: list[MaintenanceEvent]) -> None:
         """Surveys and grinding events given to the run, on the topic the replayer sends them on."""
@@ -76,43 +69,36 @@ class BatchBag:
         """Measurements given to the run (as the replayer sends them) and the residuals computed."""
         for m in measurements:
             self._put("noise/measured", fields.measured_pass_noise_fields(m, self.frame), m.stamp_ns)
-        for r in residuals:
-            self._put("noise/residual", fields.noise_residual_fields(r, self.frame), r.stamp_ns)
+        for msgs in outputs.measured(residuals, (), self.frame):
+            self._write(msgs)
 
-    def add(self, result: BatchResult) -> None:
+    def add(self, result: SiteOutputs) -> None:
         """One chunk's passes and outputs, and its settled alert events."""
-        passes, accepted, traj = result.passes, result.accepted, result.trajectory
-        self._write("train_pass", fields.train_pass_columns(passes, self.frame), passes.stamp_ns)
-        heads = fields.table_heads_columns(accepted, self.frame)
-        self._write("noise/squeal", fields.squeal_prediction_columns(result.squeal, heads), accepted.stamp_ns)
-        self._write_cdr("corrugation/state", fields.corrugation_state_cdr(traj, self.frame), traj.stamp_ns)
-        self._write_cdr("noise/rolling", fields.rolling_noise_cdr(result.noise.values(), heads, result.receiver),
-                        np.repeat(accepted.stamp_ns, len(result.noise)))
+        passes = result.passes
+        datas = serialize_columns(GRAPH_TOPICS["train_pass"][0], fields.train_pass_columns(passes, self.frame),
+                                  len(passes))
+        self._write(outputs.Messages("train_pass", datas, passes.stamp_ns.tolist()))
+        for msgs in outputs.per_pass(result, self.frame):
+            self._write(msgs)
         self._alerts(result.alerts)
         self.events(result.events)
         self.measured(result.measurements, result.residuals)
-        for obs in result.observations:
-            self._put("corrugation/indirect_roughness", fields.indirect_roughness_fields(obs, self.frame), obs.stamp_ns)
+        for msgs in outputs.measured((), result.observations, self.frame):
+            self._write(msgs)
 
     def _alerts(self, events: list[Alert]) -> None:
-        for a in events:
-            self._put("alerts", fields.wayside_alert_fields(a, self.frame), a.stamp_ns)
-            if a.active:
-                self._standing[(a.kind, a.key)] = a
-            else:
-                self._standing.pop((a.kind, a.key), None)
-            self._put("alerts/standing", fields.wayside_alert_array_fields(list(self._standing.values()),
-                                                                           a.stamp_ns, self.frame), a.stamp_ns)
+        for msgs in self._alert_stream.messages(events):
+            self._write(msgs)
 
     def finish(self, held: list[Alert], advice: SpeedAdvice | None, newest_ns: int) -> None:
         """The events held back for a later chunk and the advice on the final state (stamped with its
         newest pass)."""
         self._alerts(held)
         if advice is not None:
-            self._put("speed_advisory", fields.speed_advisory_fields(advice, newest_ns, self.frame), newest_ns)
+            self._write(outputs.advice(advice, newest_ns, self.frame))
 
 
-def write_bag(result: BatchResult, folder: str | Path, namespace: str, compression: str = "zstd",
+def write_bag(result: SiteOutputs, folder: str | Path, namespace: str, compression: str = "zstd",
               site: dict[str, str] | None = None) -> Path:
     """Record a whole history's outputs (run_models) in a new bag folder."""
     with BatchBag(folder, namespace, result.site.site_id, compression, site) as bag:
@@ -143,10 +129,10 @@ class Recorded:
 def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: str | Path, namespace: str,
                site: dict[str, str] | None = None, events: Sequence[MaintenanceEvent] = (),
                measurements: Sequence[Measurement] = (), claim: Claim | None = None) -> Recorded:
-    """BatchRun over an iterable of PassTable chunks in time order (and the history's surveys and
+    """SiteEngine over an iterable of PassTable chunks in time order (and the history's surveys and
     grinding events, and its measured pass-bys), each recorded as it is done (memory: one chunk's
     outputs). claim: the folder, claimed already (else claimed here)."""
-    run = BatchRun(values, events=events, measurements=measurements)
+    run = SiteEngine(values, events=events, measurements=measurements)
     out = Recorded()
     with BatchBag(folder, namespace, run.site.site_id, site=site, claim=claim) as bag:
         for chunk in chunks:

@@ -115,6 +115,9 @@ MONITOR_SPECS: tuple[ParamSpec, ...] = (
               "(like a component container; measured 30x slower here on the sample: rclpy's thread pool costs more "
               "than it gains for Python callbacks under the GIL).", choices=("single_threaded", "multi_threaded")),
     ParamSpec("threads", 4, "Threads of the multi_threaded executor [-].", 1, 64),
+    ParamSpec("models", "engine", "The models hosted: engine (one site_engine node, the site engine batch mode "
+              "runs, each backlog of passes read once) or nodes (the four model nodes of the separate-process "
+              "layout, each reading every pass).", choices=("engine", "nodes")),
 )
 
 
@@ -225,6 +228,7 @@ class MonitorParams:
     drain_timeout_s: float
     executor: str
     threads: int
+    models: str
     source: str
 
 

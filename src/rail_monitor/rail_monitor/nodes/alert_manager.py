@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
+from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from rail_monitor.alerts.config import ALERT_SPECS, KIND_NAMES, NOISE_METRICS, SEVERITY_CRITICAL, alert_config
@@ -173,19 +174,7 @@ class AlertManagerNode(PassConsumerNode):
             self._emit(self.alerts.on_states(**corrugation_series(values, run)))
 
     def _on_set_parameters(self, params: list[Parameter]) -> SetParametersResult:
-        """ros2 param set on alerts.*: checked as at start-up (ranges, hysteresis), then applied to
-        the next inputs; a refusal gives the reason and changes nothing."""
-        mine = {p.name[len("alerts."):]: p.value for p in params if p.name.startswith("alerts.")}
-        if not mine:
-            return SetParametersResult(successful=True)
-        current = {s.name: self.get_parameter(f"alerts.{s.name}").value for s in ALERT_SPECS}
-        try:
-            cfg = alert_config({**current, **mine}, self._lead, prefix="")
-        except ConfigError as exc:
-            return SetParametersResult(successful=False, reason=str(exc))
-        self.alerts.retune(cfg)
-        self.get_logger().info("alerts retuned: " + ", ".join(f"alerts.{k}={v!r}" for k, v in sorted(mine.items())))
-        return SetParametersResult(successful=True)
+        return retune_alerts(self, self.alerts, self._lead, params)
 
     def _publish_initial_standing(self) -> None:
         now = self.get_clock().now().nanoseconds
@@ -222,6 +211,23 @@ class AlertManagerNode(PassConsumerNode):
         if self.alerts.standing:
             return DiagnosticStatus.WARN, f"{len(self.alerts.standing)} alert(s) standing"
         return super()._level()
+
+
+def retune_alerts(node: Node, alerts: AlertManager, lead_time_days: float,
+                  params: list[Parameter]) -> SetParametersResult:
+    """ros2 param set on alerts.*: checked as at start-up (ranges, hysteresis), then applied to
+    the next inputs; a refusal gives the reason and changes nothing."""
+    mine = {p.name[len("alerts."):]: p.value for p in params if p.name.startswith("alerts.")}
+    if not mine:
+        return SetParametersResult(successful=True)
+    current = {s.name: node.get_parameter(f"alerts.{s.name}").value for s in ALERT_SPECS}
+    try:
+        cfg = alert_config({**current, **mine}, lead_time_days, prefix="")
+    except ConfigError as exc:
+        return SetParametersResult(successful=False, reason=str(exc))
+    alerts.retune(cfg)
+    node.get_logger().info("alerts retuned: " + ", ".join(f"alerts.{k}={v!r}" for k, v in sorted(mine.items())))
+    return SetParametersResult(successful=True)
 
 
 def main(args: list[str] | None = None) -> int:

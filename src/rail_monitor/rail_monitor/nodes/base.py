@@ -105,13 +105,19 @@ class RailNode(Node):
 
 def declare_site(node: Node) -> Site:
     """Declare the site parameters, the contact geometry, the track and the rolling-stock table, and build the Site."""
+    return site_from_values(declare_site_values(node))
+
+
+def declare_site_values(node: Node) -> dict[str, Any]:
+    """The site's parameters, the contact geometry, the track and the rolling-stock table declared:
+    their values by dotted name, as a site file gives them."""
     flat = declare(node, SITE_SPECS)
     for prefix, specs in (("contact.", CONTACT_SPECS), ("track.", TRACK_SPECS)):
         flat.update({prefix + k: v for k, v in declare(node, specs, prefix=prefix).items()})
     for name in flat["vehicle_classes"]:
         for key, value in declare(node, VEHICLE_SPECS, prefix=f"vehicle.{name}.").items():
             flat[f"vehicle.{name}.{key}"] = value
-    return site_from_values(flat)
+    return flat
 
 
 def take_queued(sub: Any, limit: int) -> list[Any]:

@@ -26,7 +26,6 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
 
-from rail_monitor.advice import growth, plan
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
 from rail_monitor.core.params import values_of
@@ -47,13 +46,13 @@ from rail_monitor.messages.fields import (
     event_from_msg,
     indirect_roughness_fields,
     measurement_from_msg,
-    speed_advisory_fields,
 )
 from rail_monitor.models.calibration import KbPosterior
-from rail_monitor.nodes.base import declare, subscribe_batched, take_queued, wall_timer
+from rail_monitor.nodes.base import declare, subscribe_batched, take_queued
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
-from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STATE_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.nodes.qos import EVENT_QOS, STATE_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.nodes.state_services import StateServices
 from rail_monitor.noise.config import NOISE_SPECS, noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
@@ -62,11 +61,7 @@ from rail_msgs.msg import (
     IndirectRoughness,
     MeasuredPassNoise,
     RoughnessSurvey,
-    SpeedAdvisory,
 )
-from rail_msgs.srv import EvaluateSpeedDistribution
-
-CLOSE_TIMEOUT_S = 30.0  # the last checkpoint's write at shutdown (a year kept: about 0.1 s)
 
 
 class CorrugationEstimatorNode(PassConsumerNode):
@@ -92,32 +87,18 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.corrugation = CorrugationSite(self.est, observer)
         self.corrugation.on_event = self._on_event
         self.corrugation.on_observation = self._on_observation
-        self.checkpoint = self.params.checkpoint_path
         self.counts: Counter[str] = Counter()
-        self.checkpoint_skipped: list[str] = []
-        if self.checkpoint:
-            # An unreadable checkpoint falls back to the previous one; none readable is a ConfigError
-            # (no silent fresh start).
-            used, self.checkpoint_skipped = checkpoint.resume(self.est, self.checkpoint, self.observer)
-            for why in self.checkpoint_skipped:
-                self.get_logger().error(f"checkpoint skipped: {why}")
-            if used is not None:
-                self.get_logger().info(f"resumed from {used}: {self.est.total_pass_count} passes")
+        self.state_services = StateServices(self, self.est, self.params, self.consequences, self.sent, observer)
+        self.state_services.resume(lambda path: checkpoint.resume(self.est, path, self.observer))
         self.stream_ns = self.est.newest_ns  # the stamp margin counts from the resumed history
-        self.writer = checkpoint.CheckpointWriter(self.checkpoint, on_error=self._checkpoint_failed) \
-            if self.checkpoint else None
-        self._since_checkpoint = 0
         self._last_state_t = float("-inf")
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
-        self.advisory_pub = self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
         self.survey_sub = self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
         self.measured_sub = self.indirect_pub = None
         if self.observer is not None:
             self.measured_sub = subscribe_batched(self, MeasuredPassNoise, "noise/measured", self._on_measured,
                                                   STREAM_SUB_QOS, self.max_batch)
             self.indirect_pub = self.create_publisher(IndirectRoughness, "corrugation/indirect_roughness", STREAM_QOS)
-        self.create_service(EvaluateSpeedDistribution, "evaluate_speed_distribution", self._on_evaluate)
-        wall_timer(self, self.params.advisory_period_s, self.publish_advisory)
         self.listen()
 
     @property
@@ -131,7 +112,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         return self.corrugation.refused
 
     def key_parameters(self) -> dict[str, Any]:
-        return {"checkpoint": self.checkpoint or "none", "passes": self.est.total_pass_count,
+        return {"checkpoint": self.state_services.path or "none", "passes": self.est.total_pass_count,
                 "lead_time_days": f"{self.est.cfg.lead_time_days:g}"}
 
     def _on_train_passes(self, raws: list[bytes]) -> None:
@@ -162,9 +143,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if not len(traj):
             return
         self.counts["counted"] += len(traj)
-        self._since_checkpoint += len(traj)
-        if self._since_checkpoint >= self.params.checkpoint_every_passes:
-            self.save()
+        self.state_services.counted(len(traj))
         now = time.monotonic()
         if self.params.state_period_s == 0.0:
             for data in corrugation_state_cdr(traj, self.site.site_id):
@@ -172,6 +151,10 @@ class CorrugationEstimatorNode(PassConsumerNode):
         elif now - self._last_state_t >= self.params.state_period_s:
             self.publish_state()
             self._last_state_t = now
+
+    def publish_advisory(self) -> None:
+        """The advice on the current state (also every advisory_period_s)."""
+        self.state_services.publish_advisory()
 
     def publish_state(self) -> None:
         self.sent.publish(self.state_pub, corrugation_state_fields(self.est, self.est.forecast(), self.site.site_id))
@@ -187,16 +170,6 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if self._consequences is None:
             self._consequences = Consequences(self.site, self.noise_model(), self._squeal_cfg)
         return self._consequences
-
-    def publish_advisory(self) -> None:
-        if not len(self.est.kept):
-            return
-        try:
-            advised = plan.advise(self.est, self.consequences())
-        except ValueError as exc:
-            self.get_logger().warning(f"no speed advice: {exc}", throttle_duration_sec=60.0)
-            return
-        self.sent.publish(self.advisory_pub, speed_advisory_fields(advised, self.est.newest_ns, self.site.site_id))
 
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         event = event_from_msg(msg)
@@ -221,44 +194,13 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if fit is not None and event.kind == surveys.KIND_SURVEY:
             self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
                                    f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
-        self.save()
-
-    def _on_evaluate(self, req: EvaluateSpeedDistribution.Request,
-                     res: EvaluateSpeedDistribution.Response) -> EvaluateSpeedDistribution.Response:
-        try:
-            ev = growth.evaluate(self.est, req.speed_mps, req.probability, req.friction_state, req.passes_per_day)
-            side = plan.evaluate_consequences(self.est, self.consequences(), req.speed_mps, req.probability)
-        except ValueError as exc:
-            res.success, res.message = False, str(exc)
-            return res
-        res.noise_model, res.noise_change_dba = side.noise_model, side.noise_change_dba.tolist()
-        res.squeal_share_current, res.squeal_share = side.squeal_share_current, side.squeal_share
-        res.success = True
-        res.wavelength_m = self.est.bands.tolist()
-        res.growth_per_axle_pass = ev.growth_per_axle_pass.tolist()
-        res.peak_growth, res.peak_wavelength_m = ev.peak_growth, ev.peak_wavelength_m
-        res.grinding_interval_factor, res.days_to_threshold = ev.grinding_interval_factor, ev.days_to_threshold
-        return res
-
-    def save(self) -> None:
-        """Copy the state here; the writer's thread encodes and writes it (the passes behind wait
-        only for the copy)."""
-        if self.writer is None:
-            return
-        self.writer.submit(checkpoint.snapshot(self.est, self.observer))
-        self._since_checkpoint = 0
-
-    def _checkpoint_failed(self, exc: OSError) -> None:  # on the writer's thread
-        self.get_logger().error(f"checkpoint to {self.checkpoint} failed: {exc}", throttle_duration_sec=60.0)
+        self.state_services.save()
 
     def close(self) -> None:
         """The surveys and grinding later than every pass applied, and a final checkpoint (run_node
         calls it at shutdown)."""
         self.corrugation.finish()
-        if self._since_checkpoint:
-            self.save()
-        if self.writer is not None and not self.writer.close(CLOSE_TIMEOUT_S):
-            self.get_logger().error(f"checkpoint to {self.checkpoint} not written within {CLOSE_TIMEOUT_S:g} s")
+        self.state_services.close()
 
     def diagnostic_values(self) -> dict[str, Any]:
         fc = self.est.forecast()
@@ -269,18 +211,15 @@ class CorrugationEstimatorNode(PassConsumerNode):
                   "state_age_s": f"{(time.time_ns() - self.est.newest_ns) / 1e9:.0f}" if self.est.newest_ns else "",
                   "last_grinding": format_iso_ns(self.est.last_grinding_ns) if self.est.last_grinding_ns else ""}
         values["surveys pending"] = len(self.corrugation.pending)
-        if self.writer is not None:
-            values.update({"checkpoints": self.writer.written, "checkpoint failures": self.writer.failed,
-                           "checkpoints coalesced": self.writer.coalesced})
+        values.update(self.state_services.diagnostic_values())
         if self.observer is not None:
             values.update({f"indirect {k}": v for k, v in sorted(self.observer.counts.items())})
         values.update({f"survey rejected: {why}": n for why, n in sorted(self.surveys_rejected.items())})
-        values.update({f"checkpoint skipped {i + 1}": why for i, why in enumerate(self.checkpoint_skipped)})
         return values
 
     def _level(self) -> tuple[int, str]:
         level, message = super()._level()
-        if self.checkpoint_skipped and level == DiagnosticStatus.OK:
+        if self.state_services.skipped and level == DiagnosticStatus.OK:
             return DiagnosticStatus.WARN, "resumed from the previous checkpoint (newest unreadable)"
         return level, message
 

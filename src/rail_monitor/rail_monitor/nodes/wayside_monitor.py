@@ -1,6 +1,8 @@
 """wayside_monitor: the whole graph in one process (one executor), like a component container:
-the pass source (replayer of ``source``, or the simulator when ``source`` is empty),
-corrugation_estimator, rolling_noise_predictor, squeal_risk_model, alert_manager and mcap_recorder.
+the pass source (replayer of ``source``, or the simulator when ``source`` is empty), the models
+(``models:=engine``, the default: site_engine, the one node holding the site engine that batch mode
+runs; ``models:=nodes``: corrugation_estimator, rolling_noise_predictor, squeal_risk_model and
+alert_manager) and mcap_recorder.
 Runs on pass time; exits when the history has been replayed, every model has taken every pass and
 the recorder holds every message the nodes published (then a final speed advisory on the final
 state); prints a summary.
@@ -46,6 +48,7 @@ from rail_monitor.nodes.process import (
     spin_guarded,
 )
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
+from rail_monitor.nodes.site_engine import SiteEngineNode
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 
 
@@ -68,16 +71,20 @@ class _Settings(RailNode):
         self.cfg = values_of(MonitorParams, declare(self, (*MONITOR_SPECS, SOURCE)))
 
 
-def _real_models() -> list[PassConsumerNode]:
+def _real_models(layout: str) -> list[PassConsumerNode]:
+    if layout == "engine":
+        return [SiteEngineNode()]
     return [CorrugationEstimatorNode(), RollingNoisePredictor(), SquealRiskNode(), AlertManagerNode()]
 
 
-def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node]] = _real_models,
+def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node]] | None = None,
               make_recorder: Callable[[], Node] = McapRecorder) -> MonitorResult:
     """Build the graph in this process, replay, drain, shut down; return what happened.
 
-    make_models, make_recorder: the nodes hosted (the benchmark's no-op graph passes stand-ins
-    with the same topics, types and QoS).
+    make_models, make_recorder: the nodes hosted (default: as the ``models`` parameter says; the
+    benchmark's no-op graph passes stand-ins with the same topics, types and QoS). One model node
+    is the site engine's layout, four the separate nodes' (corrugation_estimator,
+    rolling_noise_predictor, squeal_risk_model, alert_manager, in that order).
     """
     # The flow-control profile is for subscribers in other processes (in-process ones are paced exactly).
     with ros_session(args, flow_control=True, default_site=True) as stop:
@@ -91,7 +98,7 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
             if settings.cfg.listen and settings.cfg.source:  # refused before a bag is begun
                 raise RailMonitorError("listen:=true takes the passes from other processes: leave source empty")
             recorder = make_recorder() if settings.cfg.record else None
-            models = make_models()
+            models = make_models() if make_models is not None else _real_models(settings.cfg.models)
             nodes += ([recorder] if recorder is not None else []) + models
             source = None
             if not settings.cfg.listen:
@@ -130,7 +137,6 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
     """Replay every pass, wait until every model and the recorder took what was published, and
     publish the advice on the final state. After SIGINT or SIGTERM the waits share
     ``stop_timeout_s``: what is taken by then is recorded and the bag finished (no error)."""
-    estimator, predictor, squeal, alerts = models
     recorded_topics = _outputs(models) | {p.topic_name for p in (source.event_pub, source.measured_pub) if p}
     if recorder is not None:
         _wait(lambda: recorded_topics <= set(recorder.counts), cfg.drain_timeout_s,
@@ -143,14 +149,11 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
     def wait(done: Callable[[], bool], what: Callable[[], str]) -> None:
         _wait(done, max(deadline - time.monotonic(), 0.0), what, raise_error=not stopping)
 
-    wait(lambda: all(m.taken >= published for m in models) and not predictor.pending,
+    wait(lambda: all(m.taken >= published for m in models) and _settled(models),
          lambda: f"models took {[m.taken for m in models]} of {published} passes")
-    wait(lambda: alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
-         and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
-         and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name]
-         and alerts.inputs["noise/measured"] >= source.measurements_sent,
-         lambda: f"alert_manager took {dict(alerts.inputs)}")
-    estimator.publish_advisory()  # the advice on the final state
+    wait(lambda: _measured_taken(models) >= source.measurements_sent and _inputs_taken(models),
+         lambda: f"models took {_measured_taken(models)} of {source.measurements_sent} measurements")
+    models[0].publish_advisory()  # the advice on the final state
     sent = {source.pub.topic_name: published}
     for pub, n in ((source.event_pub, source.events_sent), (source.measured_pub, source.measurements_sent)):
         if pub is not None:
@@ -164,13 +167,13 @@ def _listen(models: list[PassConsumerNode], recorder: McapRecorder | None, cfg: 
     stop_timeout_s, the backlog, the advice on the final state and the recorder's catching up."""
     t_listen = time.monotonic()
     stop.wait()
-    estimator, predictor, _, _ = models
+    estimator = models[0]
     deadline = time.monotonic() + cfg.stop_timeout_s
 
     def wait(done: Callable[[], bool], what: Callable[[], str]) -> None:
         _wait(done, max(deadline - time.monotonic(), 0.0), what, raise_error=False)
 
-    wait(lambda: not predictor.pending, lambda: "rolling_noise_predictor still holds passes")
+    wait(lambda: _settled(models), lambda: "rolling_noise_predictor still holds passes")
     estimator.publish_advisory()
     taken = {estimator.resolve_topic_name("train_pass"): estimator.taken}  # the recorder takes them too
     return replace(_finish(models, recorder, taken, wait, estimator.taken, t0, t_listen), listened=True)
@@ -198,17 +201,43 @@ def _finish(models: list[PassConsumerNode], recorder: McapRecorder | None, sent:
     return MonitorResult(published, recorded, bag, time.monotonic() - t0, rejected, replay_s)
 
 
+def _settled(models: list[PassConsumerNode]) -> bool:
+    """No pass waits inside a model (the rolling noise predictor's for its state; the engine holds none)."""
+    return len(models) == 1 or not models[1].pending
+
+
+def _measured_taken(models: list[PassConsumerNode]) -> int:
+    """Measured pass-bys the models took (the engine's, or alert_manager's)."""
+    return models[0].counts["measurements taken"] if len(models) == 1 else models[3].inputs["noise/measured"]
+
+
+def _inputs_taken(models: list[PassConsumerNode]) -> bool:
+    """Every model output of one node taken by the nodes downstream (the engine has none)."""
+    if len(models) == 1:
+        return True
+    estimator, predictor, squeal, alerts = models
+    return (alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
+            and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
+            and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name])
+
+
 def _passes_through(models: list[PassConsumerNode], recorder: McapRecorder | None, topic: str) -> Callable[[], int]:
     """Passes the slowest hosted consumer has taken, downstream queues included: the pass source
     keeps its backlog below their depth, so no queue overflows (model outputs per pass: one squeal
     prediction, one rolling-noise message per source model)."""
-    _, predictor, squeal, alerts = models
-    per_pass = len(predictor.model.models)
-    noise, squeal_topic = predictor.pub.topic_name, squeal.pub.topic_name
+    if len(models) == 1:
+        engine = models[0]
+        per_pass = len(engine.engine.model.models)
+        noise, squeal_topic = engine.pubs["noise/rolling"].topic_name, engine.pubs["noise/squeal"].topic_name
+    else:
+        _, predictor, squeal, alerts = models
+        per_pass = len(predictor.model.models)
+        noise, squeal_topic = predictor.pub.topic_name, squeal.pub.topic_name
 
     def taken() -> int:
         counts = [m.taken for m in models]
-        counts += [alerts.inputs["noise/squeal"], alerts.inputs["noise/rolling"] // per_pass]
+        if len(models) > 1:
+            counts += [alerts.inputs["noise/squeal"], alerts.inputs["noise/rolling"] // per_pass]
         if recorder is not None:
             got = recorder.counts
             counts += [got.get(topic, 0), got.get(squeal_topic, 0), got.get(noise, 0) // per_pass]
@@ -247,7 +276,8 @@ def parameters() -> ParamGroups:
     """Every parameter of the hosted nodes, each once (for --help)."""
     seen: set[str] = set()
     out = []
-    hosted = (McapRecorder, CorrugationEstimatorNode, RollingNoisePredictor, SquealRiskNode, AlertManagerNode,
+    hosted = (McapRecorder, SiteEngineNode, CorrugationEstimatorNode, RollingNoisePredictor, SquealRiskNode,
+              AlertManagerNode,
               PassReplayer, PassSimulator)
     for prefix, specs in (("", (*MONITOR_SPECS, SOURCE)), *(g for cls in hosted for g in cls.PARAMETERS)):
         new = tuple(s for s in specs if prefix + s.name not in seen)

@@ -9,9 +9,9 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.alerts.config import alert_config
-from rail_monitor.batch.result import BatchResult
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.timeutil import NS_PER_DAY
+from rail_monitor.engine.result import SiteOutputs
 from rail_monitor.measured.config import residual_config
 from rail_monitor.measured.indirect import IndirectRoughness, indirect_rail_roughness
 from rail_monitor.noise.config import noise_config
@@ -19,7 +19,7 @@ from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation
 
 
-def indirect_of_run(result: BatchResult, values: Mapping[str, Any], days: float) -> IndirectRoughness:
+def indirect_of_run(result: SiteOutputs, values: Mapping[str, Any], days: float) -> IndirectRoughness:
     """The indirect rail roughness on the corrugation state's bands from the measured passes of the
     last ``days`` [day] of a run (``alerts.residual_model``'s residuals), against the final state."""
     est = result.estimator

@@ -86,22 +86,22 @@ def _hostile_history(passes):
 
 
 def _chunked(passes, values, cuts, events=()):
-    from rail_monitor.batch.run import BatchRun
+    from rail_monitor.engine.site import SiteEngine
 
-    run = BatchRun(values, events=events)
+    run = SiteEngine(values, events=events)
     parts = [run.feed(passes.take(slice(a, b))) for a, b in zip([0, *cuts], [*cuts, len(passes)], strict=True)]
     held, advice = run.finish()
     return run, parts, held, advice
 
 
 def test_any_chunking_of_a_history_gives_the_one_call_outputs_alerts_included(site_values, sample_passes):
-    """BatchRun carries the state, the alert windows and standing alerts, the stream's references and
+    """SiteEngine carries the state, the alert windows and standing alerts, the stream's references and
     the states a later pass is predicted on: random chunk boundaries (an empty chunk, a boundary
     inside a run of equal stamps) give the one call's outputs bit for bit (exact equality)."""
     import numpy as np
 
-    from rail_monitor.batch.result import BatchResult
     from rail_monitor.batch.run import run_models
+    from rail_monitor.engine.result import SiteOutputs
 
     history = _hostile_history(sample_passes)
     whole = run_models(history, site_values)
@@ -113,7 +113,7 @@ def test_any_chunking_of_a_history_gives_the_one_call_outputs_alerts_included(si
     for cuts in (sorted({*rng.choice(len(history), 9, replace=False).tolist(), tie, tie}),
                  [tie, 1500, 1500, 3000], [1]):
         run, parts, held, advice = _chunked(history, site_values, cuts)
-        got = BatchResult.merged(parts, held, advice)
+        got = SiteOutputs.merged(parts, held, advice)
         _assert_same_result(got, whole)
         assert got.left_out == whole.left_out == run.left_out
         assert advice.lines() == whole.advice.lines()
@@ -152,13 +152,13 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
     random chunk boundaries give the one call's outputs bit for bit."""
     import numpy as np
 
-    from rail_monitor.batch.result import BatchResult
     from rail_monitor.batch.run import run_models
     from rail_monitor.core.passes import rejection_reasons, with_class_defaults
     from rail_monitor.core.site import site_from_values
     from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.corrugation.estimator import CorrugationEstimator
     from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent, apply_event
+    from rail_monitor.engine.result import SiteOutputs
 
     history = _hostile_history(sample_passes)
     est = CorrugationEstimator(site_from_values(site_values), corrugation_config(site_values))
@@ -197,7 +197,7 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
     rng = np.random.default_rng(12)
     for cuts in (sorted(rng.choice(len(history), 11, replace=False).tolist()), [1, 2, 3]):
         run, parts, held, advice = _chunked(history, site_values, cuts, events)
-        got = BatchResult.merged(parts, held, advice)
+        got = SiteOutputs.merged(parts, held, advice)
         _assert_same_result(got, whole)
         assert sum(run.events_refused.values()) == 2
         assert [e.stamp_ns for e in got.events + run.trailing_events] == [e.stamp_ns for e in whole.events]
@@ -207,11 +207,11 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
 def test_a_chunk_older_than_an_earlier_one_is_refused_and_leaves_the_run_as_it_was(site_values, sample_passes):
     import pytest
 
-    from rail_monitor.batch.run import BatchRun
     from rail_monitor.core.errors import PassOrderError
+    from rail_monitor.engine.site import SiteEngine
 
     history = sample_passes.sorted().take(slice(0, 600))
-    run = BatchRun(site_values)
+    run = SiteEngine(site_values)
     run.feed(history.take(slice(300, 600)))
     before = (run.estimator.total_pass_count, run.newest_ns, run.newest_sent_ns, dict(run.alerts.standing))
     with pytest.raises(PassOrderError, match="out of time order"):

@@ -24,8 +24,8 @@ from rail_monitor.noise.records import NoisePrediction
 
 
 @dataclass
-class BatchResult:
-    """Model outputs over a history, or over one chunk of it (BatchRun.feed). Arrays over
+class SiteOutputs:
+    """Model outputs over a history, or over one chunk of it (SiteEngine.feed). Arrays over
     ``accepted`` rows unless named otherwise."""
 
     site: Site
@@ -47,8 +47,8 @@ class BatchResult:
     observations: list[Observation] = field(default_factory=list)  # indirect roughness windows closed
 
     @classmethod
-    def merged(cls, parts: Sequence[BatchResult], held: list[Alert], advice: SpeedAdvice | None) -> BatchResult:
-        """BatchRun's chunk results, in order, with what its finish() returned, as the one result of
+    def merged(cls, parts: Sequence[SiteOutputs], held: list[Alert], advice: SpeedAdvice | None) -> SiteOutputs:
+        """SiteEngine's chunk results, in order, with what its finish() returned, as the one result of
         the whole history (equal to run_models on it)."""
         last = parts[-1]
         starts = np.cumsum([0, *(len(p.accepted) for p in parts[:-1])]).tolist()
