@@ -117,7 +117,7 @@ def start_up(site: str, probe: Probe, source: str, timeout_s: float = 60.0) -> d
         probe.first_output = 0.0
         t0 = time.monotonic()
         proc = _spawn("wayside_monitor", site, f"source:={source}", f"output:={Path(tmp) / 'bag'}",
-                      "progress:=false", f"wait_for_subscribers:={len(MODEL_EXECUTABLES) + 2}")
+                      "progress:=false", "wait_for_subscribers:=3")  # site_engine, recorder, probe
         try:
             while not probe.first_output and time.monotonic() - t0 < timeout_s and proc.poll() is None:
                 time.sleep(0.002)

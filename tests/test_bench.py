@@ -56,11 +56,12 @@ def test_batch_of_an_empty_history_gives_empty_outputs(site_values):
 def test_batch_in_chunks_equals_one_call(site_values, sample_passes, monkeypatch):
     # Batch mode bounds its memory by advancing the corrugation state and predicting the noise in
     # chunks of passes; the state carries over, so the chunks give the one call's numbers exactly.
+    import rail_monitor.engine.noise_chunks as noise_chunks
     import rail_monitor.engine.site as batch
 
     whole = run_models(sample_passes, site_values)
     monkeypatch.setattr(batch, "HISTORY_CHUNK", 700)
-    monkeypatch.setattr(batch, "NOISE_CHUNK", 900)
+    monkeypatch.setattr(noise_chunks, "NOISE_CHUNK", 900)
     chunked = run_models(sample_passes, site_values)
     a, b = whole.trajectory, chunked.trajectory
     assert np.array_equal(a.index, b.index) and np.array_equal(a.total_pass_count, b.total_pass_count)

@@ -28,6 +28,7 @@ from rail_monitor.bagio.reader import read_messages
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.engine.site import OUT_OF_ORDER
 from rail_monitor.measured.records import Measurement
 from rail_monitor.messages.fields import measured_pass_noise_fields, train_pass_fields
 from rail_monitor.nodes import process
@@ -37,6 +38,7 @@ from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STATE_QOS, STREAM_QOS
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor
+from rail_monitor.nodes.site_engine import SiteEngineNode
 from rail_monitor.nodes.squeal_risk_model import SquealRiskNode
 from rail_monitor.noise.config import band_centres_hz
 from rail_msgs.msg import (
@@ -243,3 +245,61 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
           f"diagnostic and {len(requests)} service requests into the running graph",
           "no node stopped; each refused and counted by reason; no alert from them; state of the valid passes; "
           "the 4 valid passes after them fully predicted and recorded", 0)
+
+
+def test_the_site_engine_node_takes_the_same_storm(ros_context, site, site_values, tmp_path):
+    """site_engine (the one-process graph's models) under the same hostile passes, surveys,
+    measurements and service requests, and a pass older than one already taken: it stops not,
+    counts each refusal by reason, and its state is that of the valid passes alone; the valid
+    passes after the storm get every output."""
+    params = [Parameter(k, value=v) for k, v in site_values.items() if not k.startswith("simulator.")]
+    params.append(Parameter("use_sim_time", value=True))
+    node = SiteEngineNode(context=ros_context, namespace=NS, parameter_overrides=params)
+    hostile = Node("hostile", context=ros_context, namespace=NS)
+    got: dict[str, list] = {"squeal": [], "rolling": []}
+    hostile.create_subscription(SquealPrediction, "noise/squeal", got["squeal"].append, STREAM_QOS)
+    hostile.create_subscription(RollingNoise, "noise/rolling", got["rolling"].append, STREAM_QOS)
+    pubs = {t: hostile.create_publisher(m, t, q) for t, m, q in (
+        ("/clock", Clock, CLOCK_QOS), ("train_pass", TrainPass, STREAM_QOS),
+        ("roughness_survey", RoughnessSurvey, EVENT_QOS), ("noise/measured", MeasuredPassNoise, STREAM_QOS))}
+    client = hostile.create_client(EvaluateSpeedDistribution, "evaluate_speed_distribution")
+    process.CALLBACK_ERRORS.clear()
+    try:
+        with spinning(ros_context, node, hostile):
+            assert wait_until(lambda: client.service_is_ready()
+                              and all(p.get_subscription_count() >= 1 for t, p in pubs.items() if t != "/clock"), 20)
+            first = _valid_passes(site, 3, T0)
+            for i in range(3):
+                pubs["train_pass"].publish(to_msg(TrainPass, train_pass_fields(first.row(i), "curve_250")))
+            assert wait_until(lambda: node.counts["counted"] == 3, 10)
+            older = first.take(np.array([0]))  # a copy
+            older.stamp_ns[0] -= 10**9  # before a pass already taken
+            bad_passes = [*_hostile_passes(site), to_msg(TrainPass, train_pass_fields(older.row(0), "curve_250"))]
+            for topic, msgs in (("train_pass", bad_passes), ("roughness_survey", _hostile_surveys()),
+                                ("noise/measured", _hostile_measurements(first))):
+                for m in msgs:
+                    pubs[topic].publish(m)
+            futures = [client.call_async(EvaluateSpeedDistribution.Request(speed_mps=s, probability=p))
+                       for s, p in (([math.nan], [1.0]), ([15.0, 20.0], [1.0]), ([], []), ([15.0], [-1.0]))]
+            assert wait_until(lambda: all(f.done() for f in futures), 20)
+            assert not any(f.result().success for f in futures)
+            assert wait_until(lambda: node.taken == 3 + len(bad_passes)
+                              and sum(node.engine.corrugation.refused.values()) == len(_hostile_surveys()), 20), \
+                (node.taken, node.engine.corrugation.refused)
+            assert sum(node.rejected.values()) == len(bad_passes) and not node.model_errors, node.rejected
+            assert node.rejected[OUT_OF_ORDER] == 1, node.rejected
+            after = _valid_passes(site, 4, T0 + 7200)
+            for i in range(4):
+                pubs["train_pass"].publish(to_msg(TrainPass, train_pass_fields(after.row(i), "curve_250")))
+            assert wait_until(lambda: node.counts["counted"] == 7 and len(got["squeal"]) == 7
+                              and len(got["rolling"]) == 14, 30), (node.counts, len(got["squeal"]))
+            assert wait_until(lambda: sum(node.engine.tracker.refused.values()) == 7, 20), node.engine.tracker.refused
+    finally:
+        node.close()
+        for n in (node, hostile):
+            n.destroy_node()
+    pure = CorrugationEstimator(site, corrugation_config(site_values))
+    pure.advance(PassTable.concat([first, after]))
+    np.testing.assert_array_equal(node.engine.estimator.log_components, pure.log_components)
+    assert [m.train_id for m in got["squeal"]] == [*first.train_id.tolist(), *after.train_id.tolist()]
+    assert not process.CALLBACK_ERRORS, process.CALLBACK_ERRORS

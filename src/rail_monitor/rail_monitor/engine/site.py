@@ -19,7 +19,7 @@ import bisect
 import os
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -32,23 +32,23 @@ from rail_monitor.core.errors import PassOrderError
 from rail_monitor.core.passes import PassTable, publishable, reject_ahead, rejection_reasons, with_class_defaults
 from rail_monitor.core.timeutil import fits_time_msg, format_iso_ns
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.corrugation.records import StateSnapshot, Trajectory
+from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
 from rail_monitor.engine import checkpoint
 from rail_monitor.engine.corrugation_site import CorrugationSite
+from rail_monitor.engine.noise_chunks import noise_on_states
 from rail_monitor.engine.result import SiteOutputs
 from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.measured.observer import IndirectObserver, Observation
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual, ResidualTracker, predictions_of
 from rail_monitor.noise.predict import RollingNoiseModel
-from rail_monitor.noise.records import Corrugation, NoisePrediction, NoiseRows
+from rail_monitor.noise.records import NoisePrediction, NoiseRows
 from rail_monitor.noise.state_of_pass import state_index
 from rail_monitor.squeal.predict import predict as predict_squeal
 
 HISTORY_CHUNK = 16_384  # passes per advance_history call: bounds its (passes x bands x components) arrays,
 #                         and the noise of one chunk is predicted while the next is advanced
-NOISE_CHUNK = 8_192  # passes per noise prediction (every model): bounds its (passes x bands) arrays
 OUT_OF_ORDER = "older than a pass already taken (the engine takes passes in stamp order)"
 PAIR_BLOCK = 1_000  # passes whose predictions are given to the residual tracker at once (at most half it holds)
 
@@ -114,9 +114,11 @@ class SiteEngine:
         self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
         self.newest_taken_ns = self.estimator.newest_ns  # the nodes' reference
         self.newest_ns = np.iinfo(np.int64).min          # newest stamp given so far (time order check)
-        self._floor_ns = self.newest_ns                  # the newest before the chunk being fed
+        self._floor_ns = self.newest_ns                  # passes older are out of order
+        self._newest_accepted_ns = self.newest_ns        # a rejected pass (one far ahead) sets no floor
         self._clock_ns: int | None = None                # the live clock of the chunk being fed
         self.late_events = 0                             # events applied after later passes were counted
+        self.measured_live = False                       # measurements may come after their passes (live)
         self.left_out: Counter[str] = Counter()
         self._tail = _Tail(np.zeros(0, np.int64), [], np.zeros((0, len(self.estimator.bands))))
         self._held: list[Alert] = []                     # events a later chunk may still precede
@@ -161,7 +163,8 @@ class SiteEngine:
         if not late and len(stamps) and int(stamps.min()) < self.newest_ns:
             raise PassOrderError(f"passes out of time order: a chunk has a pass at {format_iso_ns(int(stamps.min()))}, "
                              f"before {format_iso_ns(self.newest_ns)} of an earlier one")
-        self._floor_ns, self._clock_ns = self.newest_ns, clock_ns
+        self._floor_ns = self._newest_accepted_ns if late else self.newest_ns
+        self._clock_ns = clock_ns
         self.newest_ns = max(self.newest_ns, int(stamps.max(initial=self.newest_ns)))
         self._parts = []
         for part in self.corrugation.segments(passes):
@@ -186,15 +189,16 @@ class SiteEngine:
         return self.corrugation.apply(event)
 
     def take_measurements(self, measurements: Sequence[Measurement]) -> None:
-        """Measured pass-bys arriving (live): taken with the passes up to their stamps (or settle())."""
+        """Measured pass-bys arriving (live, ``measured_live``: every prediction is held for them,
+        residual.held_predictions at most): taken with the passes up to their stamps (or settle())."""
         for m in measurements:
             bisect.insort(self._measurements, m, key=lambda x: x.key)
 
     def settle(self) -> tuple[list[Measurement], list[Residual], list[Alert]]:
         """What the inputs so far give without a later pass (live, when the stream is idle): the
-        waiting measurements of passes already fed, paired and scored, and every alert event,
+        waiting measurements of passes already accepted, paired and scored, and every alert event,
         those held back for a later chunk included (the same events in (stamp, kind, key) order)."""
-        taken, residuals = self._take_measurements(self.newest_ns)
+        taken, residuals = self._take_measurements(self._newest_accepted_ns)
         self.alerts.on_residuals(residuals)
         events, self._held = sorted(self._held + self.alerts.take_events(), key=_alert_key), []
         return taken, residuals, events
@@ -223,6 +227,7 @@ class SiteEngine:
         self.newest_taken_ns = reject_ahead(table.stamp_ns, reasons, self.newest_taken_ns, self.margins,
                                            self._clock_ns)
         accepted = with_class_defaults(table.take(reasons == ""), self.site)
+        self._newest_accepted_ns = max(self._newest_accepted_ns, int(accepted.stamp_ns.max(initial=self._floor_ns)))
         with ThreadPoolExecutor(max_workers=self.threads) as pool:
             squeal_job = pool.submit(predict_squeal, self.cfg.squeal, self.site, accepted)
             # The corrugation history in chunks on this thread, each chunk's noise on the pool while
@@ -234,7 +239,7 @@ class SiteEngine:
                 traj = self.corrugation.advance(part)
                 states = self._tail.then(traj)
                 on = state_index(states.stamp_ns, states.train_id, part.stamp_ns, part.train_id)
-                noise_jobs += _noise_on_states(pool, self.model, part, states.amplitude, traj.constants, on, rows, lo)
+                noise_jobs += noise_on_states(pool, self.model, part, states.amplitude, traj.constants, on, rows, lo)
                 self._tail = states.last_stamp()
                 trajs.append((lo, traj))
             traj = trajs[0][1] if len(trajs) == 1 else Trajectory.concat(trajs)
@@ -261,7 +266,7 @@ class SiteEngine:
                   squeal_risk: np.ndarray) -> tuple[list[Measurement], list[Residual]]:
         """The measurements of this chunk's passes (stamped up to its last), paired with the
         predictions as alert_manager pairs them."""
-        if not (self._measurements or self.tracker.queue):
+        if not (self.measured_live or self._measurements or self.tracker.queue):
             return [], []
         taken: list[Measurement] = []
         out: list[Residual] = []
@@ -306,37 +311,6 @@ class SiteEngine:
         held, self._held = self._held, []
         with ThreadPoolExecutor(max_workers=self.threads) as pool:
             return held, advise_or_none(self.estimator, Consequences(self.site, self.model, self.cfg.squeal), pool)
-
-
-def _noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable,
-                     amplitude: np.ndarray, constants: StateSnapshot, state_of_pass: np.ndarray, out: NoiseRows,
-                     first_row: int) -> list[Future]:
-    """Every model's noise of every accepted pass, each on its state (row of amplitude; -1: passes
-    before any state, on none), as tasks of pool that put their rows into out (the passes being
-    its rows from first_row on)."""
-    have = state_of_pass >= 0
-    state = Corrugation(constants.bands, amplitude[state_of_pass[have]], constants.grinding_amplitude)
-    jobs = _noise_chunks(pool, model, accepted.take(have), out, first_row + np.flatnonzero(have), state)
-    return jobs if have.all() else jobs + _noise_chunks(pool, model, accepted.take(~have), out,
-                                                        first_row + np.flatnonzero(~have))
-
-
-def _noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable, out: NoiseRows,
-                  rows: np.ndarray, corrugation: Corrugation | None = None) -> list[Future]:
-    """model.predict_models over chunks of NOISE_CHUNK passes (each independent), a task each putting
-    their predictions at rows of out; in class order, so the model reads a class's rows as a slice."""
-    order = passes.class_order()
-    passes, rows = passes.take(order), rows[order]
-    corrugation = None if corrugation is None else corrugation.of_passes(order)
-
-    def task(part: slice, state: Corrugation | None) -> None:
-        out.put(rows[part], model.predict_models(passes.take(part), (), state))
-
-    jobs = []
-    for i in range(0, max(len(passes), 1), NOISE_CHUNK):
-        part = slice(i, i + NOISE_CHUNK)
-        jobs.append(pool.submit(task, part, None if corrugation is None else corrugation.of_passes(part)))
-    return jobs
 
 
 def _alert_key(a: Alert) -> tuple[int, int, str, bool]:

@@ -81,6 +81,7 @@ class SiteEngineNode(PassConsumerNode):
         values.update({f"stamps.{k}": v for k, v in asdict(self.margins).items()})
         # numpy kernels (numba's import stays out of a live start-up); one thread: the executor's.
         self.engine = SiteEngine(values, threads=1, engine="numpy")
+        self.engine.measured_live = True  # a station's measurement comes after its pass
         self._consequences: Consequences | None = None
         self.state_services = StateServices(self, self.engine.estimator, self.params, self.consequences, self.sent,
                                       self.engine.observer)
@@ -141,7 +142,9 @@ class SiteEngineNode(PassConsumerNode):
                                     throttle_duration_sec=self.log_throttle_s)
             return
         reasons = result.reasons
-        for why, n in Counter(reasons[reasons != ""].tolist()).items():
+        # What a pass source would not have sent (a stamp no Time holds, or far ahead of its stream)
+        # is left out before the models; here it came anyway: a rejection like any other.
+        for why, n in (Counter(reasons[reasons != ""].tolist()) + Counter(result.left_out)).items():
             self.rejected[why] += n
             self.get_logger().warning(f"{n} pass(es) rejected: {why}", throttle_duration_sec=self.log_throttle_s)
         if len(result.accepted):
