@@ -10,8 +10,9 @@ source, executor and flow control are the real ones.
 ``python -m bench.bare_graph NODE --site SITE`` runs one stand-in as its own process, as the
 model's executable runs (its session, executor and flow control): the separate-process layout of
 the no-op graph for bench.live. ``python -m bench.bare_graph wayside_monitor --site SITE
---ros-args ...`` runs every stand-in and the real recorder in one process through
-``wayside_monitor.run_graph`` (``-p listen:=true``: the one-process layout of the no-op graph).
+--ros-args ...`` runs site_engine's stand-in (one node with every model's topics) and the real
+recorder in one process through ``wayside_monitor.run_graph`` (``-p listen:=true``: the
+one-process layout of the no-op graph).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from __future__ import annotations
 import argparse
 from collections import Counter
 from collections.abc import Callable, Mapping
+from types import SimpleNamespace
 from typing import Any
 
 from rclpy.node import Node
@@ -29,11 +31,23 @@ from rail_monitor.messages import fields
 from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
 from rail_monitor.nodes.convert import to_cdr
 from rail_monitor.nodes.mcap_recorder import McapRecorder
-from rail_monitor.nodes.qos import ALERT_QOS, LATEST_QOS, STATE_QOS, STATE_SUB_QOS, STREAM_QOS, STREAM_SUB_QOS
+from rail_monitor.nodes.qos import (
+    ALERT_QOS,
+    EVENT_QOS,
+    LATEST_QOS,
+    STATE_QOS,
+    STATE_SUB_QOS,
+    STREAM_QOS,
+    STREAM_SUB_QOS,
+)
+from rail_monitor.nodes.site_engine import output_publishers
 from rail_monitor.nodes.topic_tap import TAKE_AT_ONCE
 from rail_msgs.msg import (
     CorrugationState,
+    MeasuredPassNoise,
     RollingNoise,
+    RoughnessSurvey,
+    SpeedAdvisory,
     SquealPrediction,
     TrainPass,
     WaysideAlert,
@@ -107,6 +121,26 @@ class _Alerts(_StandIn):
                               max_batch)
 
 
+class _Engine(_StandIn):
+    """site_engine's stand-in: one node taking train_pass (and the survey and measured inputs) and
+    publishing every output topic, per pass its state, rolling noise per model and squeal."""
+
+    def __init__(self, state: bytes, noise: dict[str, bytes], squeal: bytes, max_batch: int) -> None:
+        super().__init__("site_engine", max_batch)
+        self.counts: Counter[str] = Counter()
+        self.engine = SimpleNamespace(model=_Models(tuple(noise)))
+        self.pubs = output_publishers(self)
+        self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
+        self.outputs = [(self.pubs["noise/squeal"], squeal), (self.pubs["corrugation/state"], state),
+                        *((self.pubs["noise/rolling"], m) for m in noise.values())]
+        self.create_subscription(RoughnessSurvey, "roughness_survey", lambda _: None, EVENT_QOS)
+        subscribe_batched(self, MeasuredPassNoise, "noise/measured", lambda msgs: self.counts.update(
+            {"measurements taken": len(msgs)}), STREAM_SUB_QOS, max_batch)
+
+    def publish_advisory(self) -> None:
+        """As _Estimator's."""
+
+
 class _CountingRecorder(McapRecorder):
     """mcap_recorder with a callback that counts and writes nothing."""
 
@@ -141,13 +175,14 @@ def stand_ins(passes: PassTable, values: Mapping[str, Any], max_batch: int) -> d
 
 def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
                ) -> tuple[Callable[[], list[Node]], Callable[[], Node]]:
-    """make_models and make_recorder for run_graph. The stand-ins publish the outputs the real
-    models give for the first of ``passes`` (so every message has a real run's size); every
-    callback takes up to max_batch queued messages (1: one per callback, rclpy's default)."""
-    makers = stand_ins(passes, values, max_batch)
+    """make_models and make_recorder for run_graph: site_engine's stand-in, which publishes the
+    outputs the real models give for the first of ``passes`` (so every message has a real run's
+    size), and the counting recorder; every callback takes up to max_batch queued messages (1: one
+    per callback, rclpy's default)."""
+    state, noise, squeal = _outputs(passes, values)
     recorder = type("CountingRecorder", (_CountingRecorder,),
                     {"take_at_once": TAKE_AT_ONCE if max_batch > 1 else 1})
-    return (lambda: [make() for make in makers.values()]), recorder
+    return (lambda: [_Engine(state, noise, squeal, max_batch)]), recorder
 
 
 def main() -> None:
@@ -166,10 +201,11 @@ def main() -> None:
     ap.add_argument("--source", default="bags/sample")
     ns, ros_args = ap.parse_known_args()
     values = load_parameter_file(ns.site)
-    makers = stand_ins(read_passes(ns.source), values, resolve(BATCH_SPECS, values)["max_batch"])
+    passes, max_batch = read_passes(ns.source), resolve(BATCH_SPECS, values)["max_batch"]
     if ns.node == "wayside_monitor":
-        run_graph(["bare_wayside_monitor", *ros_args], make_models=lambda: [make() for make in makers.values()])
+        run_graph(["bare_wayside_monitor", *ros_args], make_models=bare_graph(passes, values, max_batch)[0])
         return
+    makers = stand_ins(passes, values, max_batch)
     raise SystemExit(run_node(makers[ns.node], ["bare_" + ns.node, "--ros-args", "--log-level", "warn"]))
 
 

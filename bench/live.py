@@ -148,7 +148,8 @@ def busy_checkpoint(site: str, days: float, path: Path) -> int:
 def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle_s: float,
                layout: str = "separate", state: Path | None = None) -> dict[str, Any]:
     """A graph's idle CPU, then per rate its CPU share and latency percentiles. layout: "separate"
-    (a process per node, as the launch file), "one" (wayside_monitor listening), "bare" (the
+    (a process per node, as the launch file), "one" (wayside_monitor listening: site_engine),
+    "one-nodes" (the same with the four model nodes, models:=nodes), "bare" (the
     separate layout with bench.bare_graph's no-op stand-ins for the models and the real recorder)
     or "bare-one" (those stand-ins and the real recorder in one process, listening).
     state: a checkpoint the estimator resumes from (copied: the node writes its own)."""
@@ -159,9 +160,12 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
         if state is not None:
             shutil.copy(state, Path(tmp) / "state.npz")
             # Named for the node: the site file's section for it wins over a parameter for every node.
-            resume = [f"corrugation_estimator:checkpoint_path:={Path(tmp) / 'state.npz'}"]
-        if layout == "one":
-            procs, names = [_spawn("wayside_monitor", site, "listen:=true", bag, *resume)], ["wayside_monitor"]
+            holder = "site_engine" if layout == "one" else "corrugation_estimator"  # one-nodes: the four
+            resume = [f"{holder}:checkpoint_path:={Path(tmp) / 'state.npz'}"]
+        if layout in ("one", "one-nodes"):
+            models = ["models:=nodes"] if layout == "one-nodes" else []
+            procs = [_spawn("wayside_monitor", site, "listen:=true", bag, *resume, *models)]
+            names = ["wayside_monitor"]
         elif layout == "bare-one":
             procs = [_spawn([sys.executable, "-m", "bench.bare_graph", "wayside_monitor", "--site", site], site,
                             "listen:=true", bag)]
@@ -179,7 +183,9 @@ def live_graph(site: str, probe: Probe, rates: list[float], seconds: float, idle
             names = [*MODEL_EXECUTABLES, "mcap_recorder"]
         try:
             t0 = time.monotonic()
-            while probe.subscribers() < len(MODEL_EXECUTABLES) + 2 and time.monotonic() - t0 < 60:
+            # train_pass subscribers: the models (site_engine alone in one process) and the recorder
+            models = 1 if layout in ("one", "bare-one") else len(MODEL_EXECUTABLES)
+            while probe.subscribers() < models + 2 and time.monotonic() - t0 < 60:
                 time.sleep(0.05)
             warm = [probe.send(i) for i in range(3)]  # first outputs: lazy set-up paid before measuring
             while timed and np.isnan(probe.latencies_ms(warm)).any() and time.monotonic() - t0 < 120:
@@ -242,6 +248,7 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             g = live_graph(site, probe, rates, seconds, idle_s, state=state)
             bare = live_graph(site, probe, rates, seconds, idle_s, layout="bare")
             one = live_graph(site, probe, rates, seconds, idle_s, layout="one", state=state)
+            one_nodes = live_graph(site, probe, rates, seconds, idle_s, layout="one-nodes", state=state)
             bare_one = live_graph(site, probe, rates, seconds, idle_s, layout="bare-one")
     finally:
         probe.close()
@@ -266,7 +273,11 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
     out.append(("one-process graph idle (wayside_monitor listen:=true)", f"{100 * one['idle_core']:.1f} % of a core",
                 f"over {idle_s:g} s with no passes"))
     out += [_rate_row(f"one-process graph, {rate:g} passes/s arriving one at a time", one[rate],
-                      "; wayside_monitor listen:=true, the passes from the probe's process") for rate in rates]
+                      "; wayside_monitor listen:=true (site_engine), the passes from the probe's process")
+            for rate in rates]
+    out += [_rate_row(f"one-process graph of four model nodes, {rate:g} passes/s arriving one at a time",
+                      one_nodes[rate], "; wayside_monitor listen:=true models:=nodes (the layout of 0.24.0)")
+            for rate in rates]
     out += [_rate_row(f"no-op one-process graph, {rate:g} passes/s arriving one at a time", bare_one[rate],
                       "; the no-op graph's stand-ins and the real recorder in one process, listening as "
                       "wayside_monitor listen:=true does", latency=False) for rate in rates]

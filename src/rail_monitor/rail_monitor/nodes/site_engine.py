@@ -27,6 +27,7 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
+from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from rail_monitor.advice.consequences import Consequences
@@ -68,6 +69,15 @@ PUBLISHED = ("noise/squeal", "corrugation/state", "noise/rolling", "alerts", "al
              "corrugation/indirect_roughness")
 
 
+def output_publishers(node: Node) -> dict[str, Any]:
+    """The publishers of the model outputs (PUBLISHED), by topic, with the graph's QoS."""
+    pubs = {}
+    for topic in PUBLISHED:
+        typename, qos = GRAPH_TOPICS.get(topic) or OPTIONAL_TOPICS[topic]
+        pubs[topic] = node.create_publisher(message_class(typename), topic, profile(qos))
+    return pubs
+
+
 class SiteEngineNode(PassConsumerNode):
     EXECUTABLE = "site_engine"
     PARAMETERS = (*PassConsumerNode.PARAMETERS, ("", ESTIMATOR_SPECS), *MODEL_SECTIONS)
@@ -88,10 +98,7 @@ class SiteEngineNode(PassConsumerNode):
         self.state_services.resume(self.engine.resume)
         self.stream_ns = self.engine.estimator.newest_ns
         self.add_on_set_parameters_callback(self._on_set_parameters)
-        self.pubs = {}
-        for topic in PUBLISHED:
-            typename, qos = GRAPH_TOPICS.get(topic) or OPTIONAL_TOPICS[topic]
-            self.pubs[topic] = self.create_publisher(message_class(typename), topic, profile(qos))
+        self.pubs = output_publishers(self)
         self.alert_stream = outputs.AlertStream(self.site.site_id)
         self.counts: Counter[str] = Counter()
         self._events_seen = (0, 0)
