@@ -217,3 +217,21 @@ def test_a_chunk_older_than_an_earlier_one_is_refused_and_leaves_the_run_as_it_w
     with pytest.raises(PassOrderError, match="out of time order"):
         run.feed(history.take(slice(0, 300)))
     assert (run.estimator.total_pass_count, run.newest_ns, run.newest_sent_ns, dict(run.alerts.standing)) == before
+
+
+def test_one_thread_in_the_callers_thread_gives_the_pools_outputs(site_values, sample_passes):
+    """threads=1 (the live node's engine) runs every task in the caller's thread instead of a pool:
+    the same outputs, bit for bit, as a pool of two in one call, when fed one pass at a time as the
+    live node feeds them (late=True)."""
+    from rail_monitor.engine.result import SiteOutputs
+    from rail_monitor.engine.site import SiteEngine
+
+    history = sample_passes.sorted().take(slice(0, 400))
+    pool = SiteEngine(site_values, threads=2, engine="numpy")
+    first = pool.feed(history)
+    held, advice = pool.finish()
+    whole = SiteOutputs.merged([first], held, advice)
+    run = SiteEngine(site_values, threads=1, engine="numpy")
+    parts = [run.feed(history.take(slice(i, i + 1)), late=True) for i in range(len(history))]
+    held, advice = run.finish()
+    _assert_same_result(SiteOutputs.merged(parts, held, advice), whole)

@@ -3,7 +3,9 @@ tasks of a thread pool over bounded sub-chunks (no rclpy)."""
 
 from __future__ import annotations
 
-from concurrent.futures import Future, ThreadPoolExecutor
+from collections.abc import Callable
+from concurrent.futures import Executor, Future, ThreadPoolExecutor
+from typing import Any
 
 import numpy as np
 
@@ -15,7 +17,25 @@ from rail_monitor.noise.records import Corrugation, NoiseRows
 NOISE_CHUNK = 8_192  # passes per noise prediction (every model): bounds its (passes x bands) arrays
 
 
-def noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted: PassTable,
+class InThisThread(Executor):
+    """An executor that runs each task at once in the caller's thread: one thread's worth of
+    work without starting a pool (a live pass costs less than a thread's start)."""
+
+    def submit(self, fn: Callable[..., Any], /, *args: Any, **kwargs: Any) -> Future:
+        done: Future = Future()
+        try:
+            done.set_result(fn(*args, **kwargs))
+        except BaseException as exc:  # handed to the caller through result(), as a pool does
+            done.set_exception(exc)
+        return done
+
+
+def pool_of(threads: int) -> Executor:
+    """A thread pool of ``threads`` workers, or the caller's thread for one."""
+    return ThreadPoolExecutor(max_workers=threads) if threads > 1 else InThisThread()
+
+
+def noise_on_states(pool: Executor, model: RollingNoiseModel, accepted: PassTable,
                      amplitude: np.ndarray, constants: StateSnapshot, state_of_pass: np.ndarray, out: NoiseRows,
                      first_row: int) -> list[Future]:
     """Every model's noise of every accepted pass, each on its state (row of amplitude; -1: passes
@@ -28,7 +48,7 @@ def noise_on_states(pool: ThreadPoolExecutor, model: RollingNoiseModel, accepted
                                                         first_row + np.flatnonzero(~have))
 
 
-def noise_chunks(pool: ThreadPoolExecutor, model: RollingNoiseModel, passes: PassTable, out: NoiseRows,
+def noise_chunks(pool: Executor, model: RollingNoiseModel, passes: PassTable, out: NoiseRows,
                   rows: np.ndarray, corrugation: Corrugation | None = None) -> list[Future]:
     """model.predict_models over chunks of NOISE_CHUNK passes (each independent), a task each putting
     their predictions at rows of out; in class order, so the model reads a class's rows as a slice."""

@@ -19,7 +19,6 @@ import bisect
 import os
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -36,7 +35,7 @@ from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
 from rail_monitor.engine import checkpoint
 from rail_monitor.engine.corrugation_site import CorrugationSite
-from rail_monitor.engine.noise_chunks import noise_on_states
+from rail_monitor.engine.noise_chunks import noise_on_states, pool_of
 from rail_monitor.engine.result import SiteOutputs
 from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.measured.observer import IndirectObserver, Observation
@@ -228,7 +227,7 @@ class SiteEngine:
                                            self._clock_ns)
         accepted = with_class_defaults(table.take(reasons == ""), self.site)
         self._newest_accepted_ns = max(self._newest_accepted_ns, int(accepted.stamp_ns.max(initial=self._floor_ns)))
-        with ThreadPoolExecutor(max_workers=self.threads) as pool:
+        with pool_of(self.threads) as pool:
             squeal_job = pool.submit(predict_squeal, self.cfg.squeal, self.site, accepted)
             # The corrugation history in chunks on this thread, each chunk's noise on the pool while
             # the next is advanced (the estimator carries the kept passes, _Tail the states a later
@@ -309,7 +308,7 @@ class SiteEngine:
             self.tracker.add_measurement(m)
         self.tracker.finish()
         held, self._held = self._held, []
-        with ThreadPoolExecutor(max_workers=self.threads) as pool:
+        with pool_of(self.threads) as pool:
             return held, advise_or_none(self.estimator, Consequences(self.site, self.model, self.cfg.squeal), pool)
 
 
