@@ -9,27 +9,9 @@ import numpy as np
 import pytest
 
 from rail_monitor.advice import plan
-from rail_monitor.advice.consequences import Consequences
-from rail_monitor.core.passes import FRICTION_DRY, KMH_PER_MPS, PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.passes import FRICTION_DRY, KMH_PER_MPS, PassTable, with_class_defaults
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
-from rail_monitor.noise.config import noise_config
-from rail_monitor.noise.predict import RollingNoiseModel
-from rail_monitor.squeal.config import squeal_config
-
-
-@pytest.fixture(scope="module")
-def world(sample_passes):
-    from rail_monitor.site_file import load_parameter_file, load_site
-
-    from conftest import SITE_FILE
-
-    site, values = load_site(SITE_FILE), load_parameter_file(SITE_FILE)
-    cons = Consequences(site, RollingNoiseModel(site, noise_config(values)), squeal_config(values))
-    est = CorrugationEstimator(site, corrugation_config(values))
-    ok = rejection_reasons(sample_passes, site) == ""
-    est.advance(with_class_defaults(sample_passes.take(ok), site))
-    return site, values, cons, est
 
 
 def test_the_advice_on_the_sample_respects_every_constraint(world):

@@ -22,7 +22,7 @@ import numpy as np
 
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.advice.growth import growth_at_speeds
-from rail_monitor.advice.speed_plan import optimise_speed_plan, plan_growth
+from rail_monitor.advice.speed_plan import SpeedPlan, optimise_speed_plan, plan_growth
 from rail_monitor.core.passes import KMH_PER_MPS
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.noise.records import Corrugation
@@ -105,12 +105,12 @@ def advice_of_message(msg: Any) -> SpeedAdvice:
     return SpeedAdvice(**values)
 
 
-def _bands(est: CorrugationEstimator, classes: list[str]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _bands(est: CorrugationEstimator, classes: list[str], band_kmh: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Common band edges (S + 1,) [m/s] and each class's band limits (C, S) low, high [m/s]: the
     grid clipped to the class's speed range, a clipped end under half a band wide joined to its
     neighbour (nobody publishes "60-60.1 km/h"); low == high for a band the class does not use."""
     cfg = est.cfg
-    width = cfg.advice_band_kmh / KMH_PER_MPS
+    width = band_kmh / KMH_PER_MPS
     lo = np.array([max(est.site.vehicle(c).speed_min_mps, cfg.advice_min_speed_mps) for c in classes])
     hi = np.array([min(est.site.vehicle(c).speed_max_mps, cfg.advice_max_speed_mps or np.inf) for c in classes])
     if np.any(hi <= lo):
@@ -133,17 +133,49 @@ def _points(low: np.ndarray, high: np.ndarray) -> np.ndarray:
     return low[..., None] + (high - low)[..., None] * u
 
 
-def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor | None = None) -> SpeedAdvice:
-    """The plan for the kept passes (ValueError when there are none, or no plan fits the limits);
-    pool: threads for the classes' growth, noise and squeal on their speed points (independent,
-    so the split changes no number)."""
+@dataclass(frozen=True)
+class AdviceProblem:
+    """The advice's linear programme for the kept passes (advice.speed_plan), with what the advice
+    reports of it. C classes, S bands, R band components, M noise models."""
+
+    classes: list[str]
+    present: np.ndarray      # (C,) the classes' indices in the growth tables
+    edges: np.ndarray        # (S + 1,) band grid [m/s]
+    low: np.ndarray          # (C, S) each class's band limits [m/s] (low == high: not used)
+    high: np.ndarray
+    allowed: np.ndarray      # (C, S) bool
+    growth: np.ndarray       # (C, R, S) [1/axle pass]
+    noise: np.ndarray        # (M, C, S) LpAFmax [dB(A)]
+    squeal: np.ndarray       # (C, S) share of passes at a squeal risk [-]
+    current: np.ndarray      # (C, S) shares of each class's recent passes [-]
+    pass_weight: np.ndarray  # (C,) each class's share of the passes
+    axle_weight: np.ndarray  # (C,) each class's share of the axle passes
+    mean: np.ndarray         # (C,) each class's mean speed, kept [m/s]
+    cap: np.ndarray          # (C,) largest share in one band [-]
+    limits: list[tuple[np.ndarray, float]]  # noise (per model), then squeal: (A (C, S), b) with A p <= b
+
+    @property
+    def centres(self) -> np.ndarray:
+        return 0.5 * (self.low + self.high)
+
+    def solve(self, cap: np.ndarray | None = None, limits: list[tuple[np.ndarray, float]] | None = None) -> SpeedPlan:
+        """The plan of least peak growth, under the problem's cap and limits or those given."""
+        return optimise_speed_plan(self.growth, self.axle_weight, self.centres, self.allowed, self.mean,
+                                   self.cap if cap is None else cap, self.limits if limits is None else limits)
+
+
+def advice_problem(est: CorrugationEstimator, consequences: Consequences, pool: Executor | None = None,
+                   band_kmh: float | None = None) -> AdviceProblem:
+    """The advice's programme for the kept passes (ValueError when there are none); band_kmh: the
+    band width (default the site's advice_band_kmh); pool: threads for the classes' growth, noise
+    and squeal on their speed points (independent, so the split changes no number)."""
     k = est.kept
     if not len(k):
         raise ValueError("no recent passes to advise on")
     cfg = est.cfg
     present = np.unique(k.class_idx)
     classes = [est.tables.classes[i] for i in present]
-    edges, low, high = _bands(est, classes)
+    edges, low, high = _bands(est, classes, band_kmh or cfg.advice_band_kmh)
     allowed = high > low + 1e-9
     pts = _points(low, high)
     nc, ns = low.shape
@@ -169,25 +201,34 @@ def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor
         v = np.clip(k.speed[rows], low[c, used[0]], high[c, used[-1]])
         band = used[np.clip(np.searchsorted(low[c, used], v, side="right") - 1, 0, len(used) - 1)]
         current[c] = np.bincount(band, minlength=ns) / passes[c]
-    g = np.stack(growth)                       # (C, R, S)
     lp = np.stack(noise, axis=1)               # (M, C, S)
     sq = np.stack(squeal_share)                # (C, S)
-    centres = 0.5 * (low + high)
-    mean = (current * centres).sum(axis=1)
+    mean = (current * 0.5 * (low + high)).sum(axis=1)
     pass_w, axle_w = passes / passes.sum(), axles / axles.sum()
     cap = np.maximum.reduce([np.full(nc, cfg.advice_max_share), 1.0 / allowed.sum(axis=1), current.max(axis=1)])
     limits = [(pass_w[:, None] * lp[m], float((pass_w[:, None] * lp[m] * current).sum()) + cfg.advice_noise_rise_dba)
               for m in range(len(lp))]
     limits.append((pass_w[:, None] * sq, float((pass_w[:, None] * sq * current).sum()) + 1e-12))
-    plan = optimise_speed_plan(g, axle_w, centres, allowed, mean, cap, limits)
-    now = plan_growth(g, axle_w, current)
+    return AdviceProblem(classes=classes, present=present, edges=edges, low=low, high=high, allowed=allowed,
+                         growth=np.stack(growth), noise=lp, squeal=sq, current=current, pass_weight=pass_w,
+                         axle_weight=axle_w, mean=mean, cap=cap, limits=limits)
+
+
+def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor | None = None) -> SpeedAdvice:
+    """The plan for the kept passes (ValueError when there are none, or no plan fits the limits);
+    pool: as for advice_problem."""
+    p = advice_problem(est, consequences, pool)
+    plan = p.solve()
+    g, lp, sq, current, pass_w, low, high = p.growth, p.noise, p.squeal, p.current, p.pass_weight, p.low, p.high
+    now = plan_growth(g, p.axle_weight, current)
     cur_peak, rec_peak = float(now.max()), min(plan.peak_growth, float(now.max()))
     rec = plan.share
     per_band = g.shape[1] // len(est.bands)
-    show = allowed & ((current > 1e-6) | (rec > 1e-6))
+    show = p.allowed & ((current > 1e-6) | (rec > 1e-6))
     ci_rows = np.nonzero(show)[0]
     class_noise_current, class_noise_rec = (lp * current).sum(axis=2), (lp * rec).sum(axis=2)
     class_squeal_current, class_squeal_rec = (sq * current).sum(axis=1), (sq * rec).sum(axis=1)
+    classes, mean, edges = p.classes, p.mean, p.edges
     return SpeedAdvice(
         mean_speed_mps=float(pass_w @ mean), min_speed_mps=float(low.min()), max_speed_mps=float(high.max()),
         speed_bin_centres_mps=0.5 * (edges[:-1] + edges[1:]),
@@ -201,7 +242,7 @@ def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor
         noise_model=list(consequences.noise.models),
         class_noise_current_dba=class_noise_current.T.ravel(), class_noise_recommended_dba=class_noise_rec.T.ravel(),
         noise_current_dba=class_noise_current @ pass_w, noise_recommended_dba=class_noise_rec @ pass_w,
-        noise_rise_limit_dba=cfg.advice_noise_rise_dba,
+        noise_rise_limit_dba=est.cfg.advice_noise_rise_dba,
         squeal_share_current=float(pass_w @ class_squeal_current),
         squeal_share_recommended=float(pass_w @ class_squeal_rec),
         band_vehicle_class=[classes[c] for c in ci_rows], band_low_mps=low[show], band_high_mps=high[show],

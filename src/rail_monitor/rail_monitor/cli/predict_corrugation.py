@@ -80,7 +80,7 @@ def _print_table(r, data: dict) -> None:
               f"{sum(r.events_refused.values())} refused")
     if advice is not None:
         print("advice:")
-        for line in advice.lines():
+        for line in advice.lines() + r.explained.lines():
             print(f"  {line}")
 
 

@@ -68,6 +68,8 @@ CORRUGATION_SPECS: tuple[ParamSpec, ...] = (
               "to the recent share, or to one over the class's bands, where that is more) [-].", 0.01, 1.0),
     ParamSpec("advice_noise_rise_dba", 0.5, "Most the advice may raise the pass-weighted mean rolling noise "
               "(LpAFmax of each noise model) [dB(A)].", 0.0, 20.0),
+    ParamSpec("advice_length_m", 500.0, "Length of track over which the advised speeds hold (the curve with its "
+              "approaches): the advice's timetable cost is the running time over it [m].", 1.0, 1.0e5),
 )
 
 
@@ -99,6 +101,7 @@ class CorrugationConfig:
     advice_band_kmh: float
     advice_max_share: float
     advice_noise_rise_dba: float
+    advice_length_m: float
 
     @property
     def k_b(self) -> np.ndarray:

@@ -38,6 +38,7 @@ class CorrugationWhatIf:
     interval: ForecastInterval | None = None  # P10/P50/P90 of the history's forecast (None without one)
     events: int = 0                           # surveys and grinding events given with the history
     events_refused: dict[str, int] = field(default_factory=dict)
+    explained: Any = None           # rail_monitor.advice.explain.AdviceExplained with the advice
 
 
 def speed_distribution(mean_mps: float, cv: float) -> tuple[np.ndarray, np.ndarray]:
@@ -95,9 +96,9 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
         where = f"site {site.site_id}, post-grinding rail, {friction or 'dry'}, kernel of {mix}"
     try:
         ev = adv.evaluate(est, v, w, state, passes_per_day or 0.0, kernel_class)
-        advice = None
+        advice = explained = None
         if advise:  # a bare distribution is advised as a history of its passes would be
-            advice = _advise(values, est if history is not None else distribution_estimator(
+            advice, explained = _advise(values, est if history is not None else distribution_estimator(
                 values, kernel_class or next(iter(site.vehicles)), v, w, state))
     except ValueError as exc:
         raise RailMonitorError(str(exc)) from None
@@ -105,9 +106,9 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
     fc = est.forecast(adv.growth_at_speeds(est, v, state, kernel_class) @ (w / w.sum()), passes_per_day, axles)
     axles = axles or (est.traffic()[1] if len(est.kept) else site.mean_axles_per_train)
     if history is None:
-        return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice)
+        return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice, explained=explained)
     return CorrugationWhatIf(where, est, v, w, state, kernel_class, axles, ev, fc, advice, est.forecast_interval(),
-                             len(events), refused)
+                             len(events), refused, explained)
 
 
 DISTRIBUTION_PASSES = 2000  # passes standing for a bare distribution (its quantiles)
@@ -140,12 +141,14 @@ def distribution_estimator(values: Mapping[str, Any], vehicle_class: str, speeds
     return est
 
 
-def _advise(values: Mapping[str, Any], est: CorrugationEstimator) -> Any:
-    """The speed advice on the history (noise and squeal of the site weighed)."""
+def _advise(values: Mapping[str, Any], est: CorrugationEstimator) -> tuple[Any, Any]:
+    """The speed advice on the history (noise and squeal of the site weighed), and what limits it."""
     from rail_monitor.advice.consequences import Consequences
+    from rail_monitor.advice.explain import explain
     from rail_monitor.advice.plan import advise
 
-    return advise(est, Consequences.of_values(est.site, values))
+    consequences = Consequences.of_values(est.site, values)
+    return advise(est, consequences), explain(est, consequences)
 
 
 def summary(r: CorrugationWhatIf) -> dict[str, Any]:
@@ -170,6 +173,11 @@ def summary(r: CorrugationWhatIf) -> dict[str, Any]:
     if r.advice is not None:
         out["advice"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in vars(r.advice).items()}
         out["advice"]["summary"] = r.advice.lines()
+        x = r.explained
+        out["advice"]["limits"] = [vars(lim) for lim in x.relaxed]
+        out["advice"]["timetable"] = {"length_m": x.length_m, "extra_running_time_s": x.extra_running_time_s,
+                                      "worst_extra_running_time_s": x.worst_extra_running_time_s}
+        out["advice"]["explanation"] = x.lines()
     out["bands"] = [{"wavelength_m": float(est.bands[i]), "growth_per_axle_pass": float(ev.growth_per_axle_pass[i]),
                      "amplitude_m": float(est.amplitude[i]), "threshold_m": float(est.threshold[i]),
                      **({} if iv is None else {"days_to_threshold_p10_p50_p90": iv.band_days[:, i].tolist()})}
