@@ -55,6 +55,7 @@ class CorrugationSite:
         self.pending: list[MaintenanceEvent] = []  # surveys and grinding waiting for a later pass, by stamp
         self.refused: Counter[str] = Counter()     # events refused, by reason (each changed nothing)
         self.applied: Counter[str] = Counter()     # events applied, by kind ("surveys", "grindings", ...)
+        self.late = 0                              # events taken after passes later than them were counted
         self.on_event: Callable[[MaintenanceEvent, KbPosterior | None, str], None] = _no_event
         self.on_observation: Callable[[Observation], None] = _no_observation
 
@@ -111,6 +112,22 @@ class CorrugationSite:
         self.applied[EVENT_COUNT.get(event.kind, "surveys")] += 1
         self.on_event(event, fit, "")
         return True
+
+    def take(self, event: MaintenanceEvent, why: str = "") -> bool:
+        """A survey or grinding arriving while passes are taken (live): one stamped at or after the
+        newest counted pass waits for the first pass stamped later; an older one is applied at once
+        and counted in ``late``; why: a reason found on arrival to refuse it. Whether it was
+        applied now."""
+        if not why and event.stamp_ns <= max([self.est.last_survey_ns, *(e.stamp_ns for e in self.pending)]):
+            why = "not newer than the last survey or grinding applied"
+        if why:
+            self.refuse(event, why)
+            return False
+        if event.stamp_ns >= self.est.newest_ns:
+            self.pending.append(event)  # stamps rise (checked above)
+            return False
+        self.late += 1
+        return self.apply(event)
 
     def refuse(self, event: MaintenanceEvent, why: str) -> None:
         """Count a refused event by reason and report it (it changes nothing)."""

@@ -5,7 +5,7 @@ It holds the corrugation state with its pending surveys and grinding and its ind
 windows (:mod:`rail_monitor.engine.corrugation_site`), the alert windows and standing alerts, the
 residual tracker and its baselines, and the states a later pass may be predicted on. Inputs:
 passes (:meth:`SiteEngine.feed`, a chunk at a time: a history's chunk in batch, a callback's
-backlog live), surveys and grinding (:meth:`SiteEngine.take_event`) and measured pass-bys
+backlog live), surveys and grinding (``corrugation.take``) and measured pass-bys
 (:meth:`SiteEngine.take_measurements`). Outputs: what the live graph publishes, pass for pass
 (:class:`rail_monitor.engine.result.SiteOutputs`): the squeal prediction of every accepted pass,
 the corrugation state after every counted pass, the rolling noise of every accepted pass on the
@@ -92,7 +92,7 @@ class SiteEngine:
 
     events: the history's surveys and grinding events (MaintenanceEvent), each applied before the
     first pass stamped later than it (those after the last pass at finish()); more arrive through
-    :meth:`take_event`. One refused is counted in ``events_refused`` by reason and changes nothing.
+    ``corrugation.take``. One refused is counted in ``events_refused`` by reason and changes nothing.
     measurements: measured pass-bys (rail_monitor.measured), more through
     :meth:`take_measurements`, each taken once the passes up to its stamp are, paired and scored
     (``tracker.refused`` counts the refused), their residuals feeding the alerts; with
@@ -116,7 +116,6 @@ class SiteEngine:
         self._floor_ns = self.newest_ns                  # passes older are out of order
         self._newest_accepted_ns = self.newest_ns        # a rejected pass (one far ahead) sets no floor
         self._clock_ns: int | None = None                # the live clock of the chunk being fed
-        self.late_events = 0                             # events applied after later passes were counted
         self.measured_live = False                       # measurements may come after their passes (live)
         self.left_out: Counter[str] = Counter()
         self._tail = _Tail(np.zeros(0, np.int64), [], np.zeros((0, len(self.estimator.bands))))
@@ -170,22 +169,6 @@ class SiteEngine:
             self._parts.append(self._segment(part))
         parts, self._parts = self._parts, []
         return parts[0] if len(parts) == 1 else SiteOutputs.merged(parts, [], None)
-
-    def take_event(self, event: MaintenanceEvent, why: str = "") -> bool:
-        """A survey or grinding arriving while passes are taken (live): one stamped at or after the
-        newest counted pass waits for the first pass stamped later; an older one is applied at once
-        (``late_events``); why: a reason found on arrival to refuse it. Whether it was applied now."""
-        pending = self.corrugation.pending
-        if not why and event.stamp_ns <= max([self.estimator.last_survey_ns, *(e.stamp_ns for e in pending)]):
-            why = "not newer than the last survey or grinding applied"
-        if why:
-            self.corrugation.refuse(event, why)
-            return False
-        if event.stamp_ns >= self.estimator.newest_ns:
-            pending.append(event)  # stamps rise (checked above)
-            return False
-        self.late_events += 1
-        return self.corrugation.apply(event)
 
     def take_measurements(self, measurements: Sequence[Measurement]) -> None:
         """Measured pass-bys arriving (live, ``measured_live``: every prediction is held for them,

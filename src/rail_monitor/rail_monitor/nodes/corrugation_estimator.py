@@ -173,18 +173,9 @@ class CorrugationEstimatorNode(PassConsumerNode):
 
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         event = event_from_msg(msg)
-        why = self.stamp_ahead(event.stamp_ns)  # one far-future survey would refuse every later one
-        pending = self.corrugation.pending
-        if not why and event.stamp_ns <= max([self.est.last_survey_ns, *(e.stamp_ns for e in pending)]):
-            why = "not newer than the last survey or grinding applied"
-        if why:
-            self.corrugation.refuse(event, why)
-        elif event.stamp_ns >= self.est.newest_ns:
-            pending.append(event)  # stamps rise (checked above)
-        else:
-            self.counts["applied late (passes after its stamp already counted)"] += 1
-            if self.corrugation.apply(event):
-                self.publish_state()
+        # Checked against the clock on arrival: one far-future survey would refuse every later one.
+        if self.corrugation.take(event, self.stamp_ahead(event.stamp_ns)):
+            self.publish_state()
 
     def _on_event(self, event: MaintenanceEvent, fit: KbPosterior | None, why: str) -> None:
         """A survey, grinding or indirect observation applied (checkpointed) or refused (logged)."""
@@ -205,6 +196,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
     def diagnostic_values(self) -> dict[str, Any]:
         fc = self.est.forecast()
         values = {**super().diagnostic_values(), **self.counts, **self.corrugation.applied,
+                  "applied late (passes after its stamp already counted)": self.corrugation.late,
                   "amplitude_worst_um": f"{1e6 * self.est.amplitude[fc.worst_band]:.3g}",
                   "days_to_threshold": f"{fc.days_to_threshold:.4g}",
                   "grinding_due": fc.grinding_due,

@@ -141,13 +141,13 @@ class PassConsumerNode(RailNode):
         self.last_pass_ns = heads[-1].stamp_ns
         # A model failing on one accepted pass must not stop the node, nor the other passes.
         isolate_failures(len(heads), lambda rows: self.on_passes(table.take(rows), heads[rows]),
-                         lambda i, exc: self.model_error(heads[i], exc))
+                         lambda i, exc: self.model_error(f"pass {heads[i].train_id!r}", exc))
 
-    def model_error(self, head: PassHead, exc: Exception) -> None:
-        """Count and log a model raising on an accepted pass (diagnostics go to ERROR)."""
+    def model_error(self, what: str, exc: Exception) -> None:
+        """Count and log a model raising on accepted passes (what: which; diagnostics go to ERROR)."""
         why = f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"
         self.model_errors[why] += 1
-        self.get_logger().error(f"pass {head.train_id!r}: model error {why}", throttle_duration_sec=self.log_throttle_s)
+        self.get_logger().error(f"{what}: model error {why}", throttle_duration_sec=self.log_throttle_s)
 
     def diagnostic_values(self) -> dict[str, Any]:
         values: dict[str, Any] = {

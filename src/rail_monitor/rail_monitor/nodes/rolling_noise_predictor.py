@@ -156,7 +156,7 @@ class RollingNoisePredictor(PassConsumerNode):
             for data in rolling_noise_cdr(values, heads_columns([p.head for p in passes]), self.model.receiver):
                 self.sent.send(self.pub, data)
 
-        isolate_failures(len(ready), predict, lambda i, exc: self.model_error(ready[i].head, exc))
+        isolate_failures(len(ready), predict, lambda i, exc: self.model_error(f"pass {ready[i].head.train_id!r}", exc))
 
     def diagnostic_values(self) -> dict[str, Any]:
         last = self.states[-1][0] if self.states else 0

@@ -144,9 +144,7 @@ class SiteEngineNode(PassConsumerNode):
         try:
             result = self.engine.feed(table, late=True, clock_ns=self._live_clock_ns())
         except Exception as exc:  # a bug in a model: counted and logged, the node goes on
-            self.model_errors[f"{type(exc).__name__}: {(str(exc).splitlines() or [''])[0]}"] += 1
-            self.get_logger().error(f"{len(table)} pass(es) not handled: model error {exc!r}",
-                                    throttle_duration_sec=self.log_throttle_s)
+            self.model_error(f"{len(table)} pass(es)", exc)
             return
         reasons = result.reasons
         # What a pass source would not have sent (a stamp no Time holds, or far ahead of its stream)
@@ -205,8 +203,7 @@ class SiteEngineNode(PassConsumerNode):
 
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         event = event_from_msg(msg)
-        if self.engine.take_event(event, self.stamp_ahead(event.stamp_ns)):
-            self.counts["applied late (passes after its stamp already counted)"] += 1
+        if self.engine.corrugation.take(event, self.stamp_ahead(event.stamp_ns)):
             self._send(outputs.one("corrugation/state", *self._state_now()))
         self._events()
 
@@ -247,6 +244,7 @@ class SiteEngineNode(PassConsumerNode):
         e = self.engine
         fc = e.estimator.forecast()
         values = {**super().diagnostic_values(), **self.counts, **e.corrugation.applied,
+                  "applied late (passes after its stamp already counted)": e.corrugation.late,
                   "days_to_threshold": f"{fc.days_to_threshold:.4g}", "grinding_due": fc.grinding_due,
                   "surveys pending": len(e.corrugation.pending), "standing": len(e.alerts.standing),
                   "raised": e.alerts.raised, "cleared": e.alerts.cleared,
