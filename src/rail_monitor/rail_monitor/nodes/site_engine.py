@@ -69,10 +69,10 @@ PUBLISHED = ("noise/squeal", "corrugation/state", "noise/rolling", "alerts", "al
              "corrugation/indirect_roughness")
 
 
-def output_publishers(node: Node) -> dict[str, Any]:
+def output_publishers(node: Node, topics: tuple[str, ...] = PUBLISHED) -> dict[str, Any]:
     """The publishers of the model outputs (PUBLISHED), by topic, with the graph's QoS."""
     pubs = {}
-    for topic in PUBLISHED:
+    for topic in topics:
         typename, qos = GRAPH_TOPICS.get(topic) or OPTIONAL_TOPICS[topic]
         pubs[topic] = node.create_publisher(message_class(typename), topic, profile(qos))
     return pubs
@@ -98,7 +98,9 @@ class SiteEngineNode(PassConsumerNode):
         self.state_services.resume(self.engine.resume)
         self.stream_ns = self.engine.estimator.newest_ns
         self.add_on_set_parameters_callback(self._on_set_parameters)
-        self.pubs = output_publishers(self)
+        # The indirect roughness only where its windows are kept (as corrugation_estimator offers it).
+        self.pubs = output_publishers(self, tuple(t for t in PUBLISHED if self.engine.observer is not None
+                                                  or t != "corrugation/indirect_roughness"))
         self.alert_stream = outputs.AlertStream(self.site.site_id)
         self.counts: Counter[str] = Counter()
         self._events_seen = (0, 0)
