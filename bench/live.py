@@ -128,6 +128,28 @@ def start_up(site: str, probe: Probe, source: str, timeout_s: float = 60.0) -> d
     return {"seconds": seconds, "cpu_s": cpu, "rss_mb": mem}
 
 
+def start_up_listening(site: str, probe: Probe, timeout_s: float = 60.0) -> dict[str, float]:
+    """wayside_monitor listen:=true, as a site runs it behind a detector's driver: spawn to the
+    first output of one pass the probe sends once site_engine and the recorder subscribe [s]
+    (no replayer, so no settling of the graph), its CPU time [s] and resident memory [MB] then."""
+    with tempfile.TemporaryDirectory() as tmp:
+        probe.first_output = 0.0
+        t0 = time.monotonic()
+        proc = _spawn("wayside_monitor", site, "listen:=true", f"output:={Path(tmp) / 'bag'}")
+        try:
+            while probe.subscribers() < 3 and time.monotonic() - t0 < timeout_s:  # engine, recorder, probe
+                time.sleep(0.002)
+            probe.send(0)
+            while not probe.first_output and time.monotonic() - t0 < timeout_s and proc.poll() is None:
+                time.sleep(0.002)
+            seconds = probe.first_output - t0 if probe.first_output else float("nan")
+            cpu, mem = (cpu_s(proc.pid), rss_mb(proc.pid)) if proc.poll() is None else (float("nan"),) * 2
+        finally:
+            proc.send_signal(signal.SIGINT)
+            proc.wait(timeout=timeout_s)
+    return {"seconds": seconds, "cpu_s": cpu, "rss_mb": mem}
+
+
 def busy_checkpoint(site: str, days: float, path: Path) -> int:
     """Write to path the corrugation state of a busy site (bench.batch's) after ``days`` of traffic
     ending a minute ago, as the estimator node checkpoints it; returns the passes it keeps."""
@@ -239,6 +261,7 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             one = write_passes_bag(passes.take(slice(0, 1)), Path(tmp) / "one", "curve_250")
             cold = start_up(site, probe, str(one))  # the site's tables built, unless cached before
             s = start_up(site, probe, str(one))
+            heard = start_up_listening(site, probe)
             if kept_days is None:
                 kept_days = corrugation_config(load_parameter_file(site)).history_days
             state, kept = None, 0
@@ -256,6 +279,10 @@ def rows(site: str, source: str, rates: list[float], seconds: float, idle_s: flo
             f"{s['cpu_s']:.1f} CPU-s, {s['rss_mb']:.0f} MB resident then; a one-pass history, the site's tables "
             f"from the disk cache (the run before: {cold['seconds']:.2f} s); includes the {GRAPH_SETTLE_S:g} s its "
             "replayer lets the graph settle when another process listens (the probe)"),
+           ("wayside_monitor start-up to first output, listening", f"{heard['seconds']:.2f} s",
+            f"{heard['cpu_s']:.1f} CPU-s, {heard['rss_mb']:.0f} MB resident then; listen:=true, as behind a "
+            "detector's driver: one pass sent once site_engine and the recorder subscribe (no replayer, no "
+            "settling)"),
            ("corrugation state the graphs resume from", f"{kept:,} passes kept",
             f"{kept_days:g} days of a busy site's traffic ({BUSY_YEAR_TEXT}) up to now" if kept else "empty"),
            (f"live graph idle ({g['processes']} processes)", f"{100 * g['idle_core']:.1f} % of a core",

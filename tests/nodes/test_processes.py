@@ -299,3 +299,14 @@ def test_a_teardown_that_hangs_after_the_outputs_are_closed_ends_the_process(tmp
     assert marker.read_text() == "closed"
     assert p.returncode == 1 and took < 15.0, (p.returncode, took, err[-1500:])
     assert "Timeout" in err and "in destroy_node" in err, err[-1500:]
+
+
+def test_a_node_process_starts_without_the_scipy_packages_only_later_work_needs():
+    """Start-up to a first output (docs/benchmarks.md): importing scipy.signal and scipy.stats cost
+    a node 0.9 s of CPU before it subscribed; only the station's time weighting and the speed
+    advice need them, so the graph's modules leave them to be imported on first use."""
+    code = ("import sys, rail_monitor.nodes.wayside_monitor, rail_monitor.nodes.site_engine; "
+            "print(' '.join(m for m in ('scipy.signal', 'scipy.stats', 'scipy.optimize') if m in sys.modules))")
+    out = run_cmd(sys.executable, "-c", code, cwd=TOP, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "", f"imported at start-up: {out.stdout.strip()}"

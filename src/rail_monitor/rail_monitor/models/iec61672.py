@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import fft, signal
+from scipy import fft
 
 F1_HZ, F2_HZ, F3_HZ, F4_HZ = 20.598997, 107.65265, 737.86223, 12194.217
 A1000_DB = -2.000
@@ -63,5 +63,7 @@ def a_weighted_pressure(pressure_pa: ArrayLike, fs_hz: float) -> NDArray[np.floa
 def time_weighted_square(square_pa2: ArrayLike, fs_hz: float, tau_s: float = TAU_FAST_S) -> NDArray[np.float64]:
     """Exponentially time-weighted mean square [Pa^2] of a squared pressure [Pa^2] sampled at fs_hz
     [Hz], time constant tau_s [s] (IEC 61672-1:2013, 3.8): starts from rest (0 before the record)."""
+    from scipy import signal  # here: importing it costs a node's start-up half a second
+
     a = np.exp(-1.0 / (fs_hz * tau_s))
     return signal.lfilter([1.0 - a], [1.0, -a], np.asarray(square_pa2, float))
