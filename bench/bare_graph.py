@@ -30,6 +30,7 @@ from rail_monitor.core.passes import PassTable
 from rail_monitor.messages import fields
 from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
 from rail_monitor.nodes.convert import to_cdr
+from rail_monitor.nodes.hosted_models import OneEngine
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.qos import (
     ALERT_QOS,
@@ -174,7 +175,7 @@ def stand_ins(passes: PassTable, values: Mapping[str, Any], max_batch: int) -> d
 
 
 def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
-               ) -> tuple[Callable[[], list[Node]], Callable[[], Node]]:
+               ) -> tuple[Callable[[], OneEngine], Callable[[], Node]]:
     """make_models and make_recorder for run_graph: site_engine's stand-in, which publishes the
     outputs the real models give for the first of ``passes`` (so every message has a real run's
     size), and the counting recorder; every callback takes up to max_batch queued messages (1: one
@@ -182,7 +183,7 @@ def bare_graph(passes: PassTable, values: Mapping[str, Any], max_batch: int = 1
     state, noise, squeal = _outputs(passes, values)
     recorder = type("CountingRecorder", (_CountingRecorder,),
                     {"take_at_once": TAKE_AT_ONCE if max_batch > 1 else 1})
-    return (lambda: [_Engine(state, noise, squeal, max_batch)]), recorder
+    return (lambda: OneEngine(_Engine(state, noise, squeal, max_batch))), recorder
 
 
 def main() -> None:

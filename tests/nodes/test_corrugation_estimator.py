@@ -20,6 +20,7 @@ from rail_monitor.messages.fields import train_pass_fields
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
 from rail_monitor.nodes.qos import EVENT_QOS, LATEST_QOS, STREAM_QOS
+from rail_monitor.nodes.site_engine import SiteEngineNode
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.squeal.config import squeal_config
@@ -38,9 +39,9 @@ def _passes(site, n: int, start: int = 0) -> PassTable:
         train_length_m=[0.0] * n), site)
 
 
-def _node(ctx, site_values, **extra) -> CorrugationEstimatorNode:
+def _node(ctx, site_values, cls=CorrugationEstimatorNode, **extra) -> CorrugationEstimatorNode:
     params = [Parameter(k, value=v) for k, v in {**site_values, **extra}.items() if not k.startswith("simulator.")]
-    return CorrugationEstimatorNode(context=ctx, namespace="/curve_250", parameter_overrides=params)
+    return cls(context=ctx, namespace="/curve_250", parameter_overrides=params)
 
 
 class Probe:
@@ -148,6 +149,36 @@ def test_node_state_rejections_identity_surveys_service_and_advisory(ros_context
                           and probe.diag().get("applied late (passes after its stamp already counted)") == "1")
         surveys.apply_survey(pure, pure.bands, 2 * pure.post_grinding, int(after.stamp_ns[0]) - 10**9)
         assert wait_until(lambda: np.allclose(probe.states[-1].amplitude_m, pure.amplitude, rtol=1e-12, atol=0))
+
+
+@pytest.mark.parametrize("cls", [CorrugationEstimatorNode, SiteEngineNode], ids=["estimator", "engine"])
+def test_state_period_sends_the_whole_state_at_most_that_often(ros_context, site, site_values, cls):
+    """state_period_s > 0 (docs/parameters.md): the state is not sent per pass but, at most every
+    state_period_s of wall time, the whole state then (the same helper in both nodes); a survey
+    applied on arrival sends it at once. The state sent must equal an estimator advanced by the
+    passes counted when it was sent."""
+    node = _node(ros_context, site_values, cls=cls, state_period_s=3600.0)
+    probe = Probe(ros_context)
+    good = _passes(site, 30)
+    topic = "/curve_250/corrugation/state"
+    with spinning(ros_context, node, probe.node):
+        assert wait_until(lambda: probe.passes.get_subscription_count() >= 1)
+        probe.send(good)
+        assert wait_until(lambda: node.taken == 30 and len(probe.states) == 1)
+        assert node.sent[topic] == 1, "one state within the period, not one per pass"
+        first = probe.states[0]
+        pure = CorrugationEstimator(site, corrugation_config(site_values))
+        pure.advance(good.take(slice(0, first.total_pass_count)))
+        np.testing.assert_allclose(first.amplitude_m, pure.amplitude, rtol=1e-12)
+        # A survey stamped among the counted passes is applied on arrival: the state goes out now.
+        pure = CorrugationEstimator(site, corrugation_config(site_values))
+        pure.advance(good)
+        late = RoughnessSurvey(kind=RoughnessSurvey.KIND_SURVEY, wavelength_m=pure.bands.tolist(),
+                               amplitude_m=(2 * pure.post_grinding).tolist())
+        late.header.stamp = time_msg(int(good.stamp_ns[-1]) - 10**9)
+        probe.surveys.publish(late)
+        assert wait_until(lambda: node.sent[topic] == 2 and len(probe.states) == 2)
+        assert probe.states[-1].total_pass_count == 30
 
 
 def test_restart_resumes_from_the_checkpoint(ros_context, site, site_values, tmp_path):

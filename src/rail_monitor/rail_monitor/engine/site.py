@@ -112,9 +112,9 @@ class SiteEngine:
         self.threads = threads or os.cpu_count() or 1
         self.newest_sent_ns = 0                          # the pass source's ahead-of-stream reference
         self.newest_taken_ns = self.estimator.newest_ns  # the nodes' reference
-        self.newest_ns = np.iinfo(np.int64).min          # newest stamp given so far (time order check)
-        self._floor_ns = self.newest_ns                  # passes older are out of order
-        self._newest_accepted_ns = self.newest_ns        # a rejected pass (one far ahead) sets no floor
+        self.newest_ns = np.iinfo(np.int64).min          # newest stamp given so far (a chunk's order check)
+        self._newest_accepted_ns = self.newest_ns        # the floor: older passes are out of order (a
+                                                         # rejected pass, one far ahead, sets none)
         self._clock_ns: int | None = None                # the live clock of the chunk being fed
         self.measured_live = False                       # measurements may come after their passes (live)
         self.left_out: Counter[str] = Counter()
@@ -155,18 +155,20 @@ class SiteEngine:
     def feed(self, passes: PassTable, late: bool = False, clock_ns: int | None = None) -> SiteOutputs:
         """The outputs of the next chunk of passes, with the events due within it applied. A pass
         older than an earlier chunk's newest refuses the chunk (PassOrderError, the run left as it
-        was), or with ``late`` is rejected alone (OUT_OF_ORDER). clock_ns: a live clock [ns] the
-        passes may not lie too far ahead of (stamps.max_ahead_of_clock_s)."""
+        was); with ``late``, a pass older than the newest accepted is rejected alone (OUT_OF_ORDER).
+        clock_ns: a live clock [ns] the passes may not lie too far ahead of
+        (stamps.max_ahead_of_clock_s)."""
         stamps = passes.stamp_ns[fits_time_msg(passes.stamp_ns)]
         if not late and len(stamps) and int(stamps.min()) < self.newest_ns:
             raise PassOrderError(f"passes out of time order: a chunk has a pass at {format_iso_ns(int(stamps.min()))}, "
                              f"before {format_iso_ns(self.newest_ns)} of an earlier one")
-        self._floor_ns = self._newest_accepted_ns if late else self.newest_ns
+        # In order (not late), no pass is older than the floor: the chunk check above is stricter.
+        floor_ns = self._newest_accepted_ns
         self._clock_ns = clock_ns
         self.newest_ns = max(self.newest_ns, int(stamps.max(initial=self.newest_ns)))
         self._parts = []
         for part in self.corrugation.segments(passes):
-            self._parts.append(self._segment(part))
+            self._parts.append(self._segment(part, floor_ns))
         parts, self._parts = self._parts, []
         return parts[0] if len(parts) == 1 else SiteOutputs.merged(parts, [], None)
 
@@ -200,16 +202,16 @@ class SiteEngine:
     def _on_observation(self, obs: Observation) -> None:
         self._parts[-1].observations.append(obs)
 
-    def _segment(self, passes: PassTable) -> SiteOutputs:
+    def _segment(self, passes: PassTable, floor_ns: int) -> SiteOutputs:
         table, left_out = publishable(passes, self.margins, self.newest_sent_ns)
         self.left_out.update(left_out)
         self.newest_sent_ns = max(self.newest_sent_ns, int(table.stamp_ns.max(initial=0)))
         reasons = rejection_reasons(table, self.site)
-        reasons[(reasons == "") & (table.stamp_ns < self._floor_ns)] = OUT_OF_ORDER
+        reasons[(reasons == "") & (table.stamp_ns < floor_ns)] = OUT_OF_ORDER
         self.newest_taken_ns = reject_ahead(table.stamp_ns, reasons, self.newest_taken_ns, self.margins,
                                            self._clock_ns)
         accepted = with_class_defaults(table.take(reasons == ""), self.site)
-        self._newest_accepted_ns = max(self._newest_accepted_ns, int(accepted.stamp_ns.max(initial=self._floor_ns)))
+        self._newest_accepted_ns = int(accepted.stamp_ns.max(initial=self._newest_accepted_ns))
         with pool_of(self.threads) as pool:
             squeal_job = pool.submit(predict_squeal, self.cfg.squeal, self.site, accepted)
             # The corrugation history in chunks on this thread, each chunk's noise on the pool while

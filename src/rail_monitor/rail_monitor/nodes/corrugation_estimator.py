@@ -42,7 +42,6 @@ from rail_monitor.measured.observer import IndirectObserver, Observation
 from rail_monitor.messages.fields import (
     PassHead,
     corrugation_state_cdr,
-    corrugation_state_fields,
     event_from_msg,
     indirect_roughness_fields,
     measurement_from_msg,
@@ -88,11 +87,11 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.corrugation.on_event = self._on_event
         self.corrugation.on_observation = self._on_observation
         self.counts: Counter[str] = Counter()
-        self.state_services = StateServices(self, self.est, self.params, self.consequences, self.sent, observer)
+        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
+        self.state_services = StateServices(self, self.est, self.params, self.consequences, self.sent,
+                                            self.state_pub, observer)
         self.state_services.resume(lambda path: checkpoint.resume(self.est, path, self.observer))
         self.stream_ns = self.est.newest_ns  # the stamp margin counts from the resumed history
-        self._last_state_t = float("-inf")
-        self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.survey_sub = self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
         self.measured_sub = self.indirect_pub = None
         if self.observer is not None:
@@ -144,20 +143,15 @@ class CorrugationEstimatorNode(PassConsumerNode):
             return
         self.counts["counted"] += len(traj)
         self.state_services.counted(len(traj))
-        now = time.monotonic()
         if self.params.state_period_s == 0.0:
             for data in corrugation_state_cdr(traj, self.site.site_id):
                 self.sent.send(self.state_pub, data)
-        elif now - self._last_state_t >= self.params.state_period_s:
-            self.publish_state()
-            self._last_state_t = now
+        else:
+            self.state_services.publish_state_if_due()
 
     def publish_advisory(self) -> None:
         """The advice on the current state (also every advisory_period_s)."""
         self.state_services.publish_advisory()
-
-    def publish_state(self) -> None:
-        self.sent.publish(self.state_pub, corrugation_state_fields(self.est, self.est.forecast(), self.site.site_id))
 
     def noise_model(self) -> RollingNoiseModel:
         """The site's noise model (built at the first use: its tables are not needed until then)."""
@@ -175,7 +169,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         event = event_from_msg(msg)
         # Checked against the clock on arrival: one far-future survey would refuse every later one.
         if self.corrugation.take(event, self.stamp_ahead(event.stamp_ns)):
-            self.publish_state()
+            self.state_services.publish_state()
 
     def _on_event(self, event: MaintenanceEvent, fit: KbPosterior | None, why: str) -> None:
         """A survey, grinding or indirect observation applied (checkpointed) or refused (logged)."""

@@ -20,7 +20,6 @@ takes passes in stamp order). Parameters: the site file's ``/**`` section and ``
 from __future__ import annotations
 
 import sys
-import time
 from collections import Counter
 from dataclasses import asdict
 from typing import Any
@@ -45,7 +44,6 @@ from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual
 from rail_monitor.messages import outputs
 from rail_monitor.messages.fields import (
-    corrugation_state_fields,
     event_from_msg,
     measurement_from_msg,
     passes_from_columns,
@@ -93,18 +91,17 @@ class SiteEngineNode(PassConsumerNode):
         self.engine = SiteEngine(values, threads=1, engine="numpy")
         self.engine.measured_live = True  # a station's measurement comes after its pass
         self._consequences: Consequences | None = None
-        self.state_services = StateServices(self, self.engine.estimator, self.params, self.consequences, self.sent,
-                                      self.engine.observer)
-        self.state_services.resume(self.engine.resume)
-        self.stream_ns = self.engine.estimator.newest_ns
-        self.add_on_set_parameters_callback(self._on_set_parameters)
         # The indirect roughness only where its windows are kept (as corrugation_estimator offers it).
         self.pubs = output_publishers(self, tuple(t for t in PUBLISHED if self.engine.observer is not None
                                                   or t != "corrugation/indirect_roughness"))
+        self.state_services = StateServices(self, self.engine.estimator, self.params, self.consequences, self.sent,
+                                            self.pubs["corrugation/state"], self.engine.observer)
+        self.state_services.resume(self.engine.resume)
+        self.stream_ns = self.engine.estimator.newest_ns
+        self.add_on_set_parameters_callback(self._on_set_parameters)
         self.alert_stream = outputs.AlertStream(self.site.site_id)
         self.counts: Counter[str] = Counter()
-        self._events_seen = (0, 0)
-        self._last_state_t = float("-inf")  # (applied, refused) already logged and checkpointed
+        self._events_seen = (0, 0)  # (applied, refused) already logged and checkpointed
         self.survey_sub = self.create_subscription(RoughnessSurvey, "roughness_survey", self._on_survey, EVENT_QOS)
         self.measured_sub = subscribe_batched(self, MeasuredPassNoise, "noise/measured", self._on_measured,
                                               STREAM_SUB_QOS, self.max_batch)
@@ -160,20 +157,13 @@ class SiteEngineNode(PassConsumerNode):
         self.counts["counted"] += len(result.trajectory)
         self.state_services.counted(len(result.trajectory))
         for msgs in outputs.per_pass(result, self.site.site_id):
-            if msgs.topic == "corrugation/state" and self.params.state_period_s > 0.0:
-                msgs = self._state_due(msgs)
-            self._send(msgs)
+            if msgs.topic != "corrugation/state" or self.params.state_period_s == 0.0:
+                self._send(msgs)
+            elif msgs.datas:
+                self.state_services.publish_state_if_due()
         self._events()
         self._publish(result.alerts, result.residuals, result.observations)
         self._settle()
-
-    def _state_due(self, msgs: outputs.Messages) -> outputs.Messages:
-        """The newest state of a chunk alone, at most every state_period_s [s] of wall time."""
-        now = time.monotonic()
-        if not msgs.datas or now - self._last_state_t < self.params.state_period_s:
-            return outputs.Messages(msgs.topic, [], [])
-        self._last_state_t = now
-        return outputs.Messages(msgs.topic, msgs.datas[-1:], msgs.stamps_ns[-1:])
 
     def _send(self, msgs: outputs.Messages) -> None:
         pub = self.pubs[msgs.topic]
@@ -206,12 +196,8 @@ class SiteEngineNode(PassConsumerNode):
     def _on_survey(self, msg: RoughnessSurvey) -> None:
         event = event_from_msg(msg)
         if self.engine.corrugation.take(event, self.stamp_ahead(event.stamp_ns)):
-            self._send(outputs.one("corrugation/state", *self._state_now()))
+            self.state_services.publish_state()
         self._events()
-
-    def _state_now(self) -> tuple[dict[str, Any], int]:
-        est = self.engine.estimator
-        return corrugation_state_fields(est, est.forecast(), self.site.site_id), est.newest_ns
 
     def _events(self) -> None:
         """Surveys and grinding applied since the last look: checkpointed; refused: logged."""

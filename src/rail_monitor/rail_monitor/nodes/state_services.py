@@ -1,11 +1,13 @@
-"""What a node holding a site's corrugation state offers besides its outputs: the speed advisory
-(latched, every ``advisory_period_s``), the ``evaluate_speed_distribution`` service, and the
-checkpoint (written by a thread of its own, rail_monitor.engine.checkpoint.CheckpointWriter).
+"""What a node holding a site's corrugation state offers besides its per-pass outputs: the whole
+state now (after a survey or grinding, or every ``state_period_s``), the speed advisory (latched,
+every ``advisory_period_s``), the ``evaluate_speed_distribution`` service, and the checkpoint
+(written by a thread of its own, rail_monitor.engine.checkpoint.CheckpointWriter).
 corrugation_estimator and site_engine hold one each.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -15,7 +17,7 @@ from rail_monitor.core.node_params import EstimatorParams
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.engine import checkpoint
 from rail_monitor.measured.observer import IndirectObserver
-from rail_monitor.messages.fields import speed_advisory_fields
+from rail_monitor.messages.fields import corrugation_state_fields, speed_advisory_fields
 from rail_monitor.nodes.base import RailNode, Sent, wall_timer
 from rail_monitor.nodes.qos import LATEST_QOS
 from rail_msgs.msg import SpeedAdvisory
@@ -25,16 +27,18 @@ CLOSE_TIMEOUT_S = 30.0  # the last checkpoint's write at shutdown (a year kept: 
 
 
 class StateServices:
-    """The advisory, the service and the checkpoint of the state ``est`` held by ``node``.
+    """The whole state, the advisory, the service and the checkpoint of the state ``est`` held by ``node``.
 
     consequences: the noise model and squeal parameters the advice weighs (built at first use);
-    observer: the indirect roughness windows checkpointed with the state (None: none).
+    state_pub: the node's corrugation/state publisher; observer: the indirect roughness windows
+    checkpointed with the state (None: none).
     """
 
     def __init__(self, node: RailNode, est: CorrugationEstimator, params: EstimatorParams,
-                 consequences: Callable[[], Consequences], sent: Sent,
+                 consequences: Callable[[], Consequences], sent: Sent, state_pub: Any,
                  observer: IndirectObserver | None = None) -> None:
-        self.node, self.est, self.params, self.sent = node, est, params, sent
+        self.node, self.est, self.params, self.sent, self.state_pub = node, est, params, sent, state_pub
+        self._last_state_t = float("-inf")  # time.monotonic() of the last periodic state [s]
         self.observer = observer
         self._consequences = consequences
         self.path = params.checkpoint_path
@@ -61,6 +65,19 @@ class StateServices:
         self.since_checkpoint += n
         if self.since_checkpoint >= self.params.checkpoint_every_passes:
             self.save()
+
+    def publish_state(self) -> None:
+        """The whole state and its forecast, now."""
+        self.sent.publish(self.state_pub, corrugation_state_fields(self.est, self.est.forecast(),
+                                                                   self.node.site.site_id))
+
+    def publish_state_if_due(self) -> None:
+        """The whole state now if state_period_s [s] of wall time have passed since the last
+        (state_period_s > 0: the nodes publish it at most that often, not per pass)."""
+        now = time.monotonic()
+        if now - self._last_state_t >= self.params.state_period_s:
+            self.publish_state()
+            self._last_state_t = now
 
     def save(self) -> None:
         """Copy the state here; the writer's thread encodes and writes it (the passes behind wait

@@ -32,8 +32,8 @@ from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.nodes.alert_manager import AlertManagerNode
 from rail_monitor.nodes.base import RailNode, declare
 from rail_monitor.nodes.corrugation_estimator import CorrugationEstimatorNode
+from rail_monitor.nodes.hosted_models import FourNodes, HostedModels, OneEngine
 from rail_monitor.nodes.mcap_recorder import McapRecorder
-from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.pass_replayer import PassReplayer
 from rail_monitor.nodes.pass_simulator import PassSimulator
 from rail_monitor.nodes.process import (
@@ -71,20 +71,19 @@ class _Settings(RailNode):
         self.cfg = values_of(MonitorParams, declare(self, (*MONITOR_SPECS, SOURCE)))
 
 
-def _real_models(layout: str) -> list[PassConsumerNode]:
+def _real_models(layout: str) -> HostedModels:
     if layout == "engine":
-        return [SiteEngineNode()]
-    return [CorrugationEstimatorNode(), RollingNoisePredictor(), SquealRiskNode(), AlertManagerNode()]
+        return OneEngine(SiteEngineNode())
+    return FourNodes(CorrugationEstimatorNode(), RollingNoisePredictor(), SquealRiskNode(), AlertManagerNode())
 
 
-def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node]] | None = None,
+def run_graph(args: list[str] | None = None, make_models: Callable[[], HostedModels] | None = None,
               make_recorder: Callable[[], Node] = McapRecorder) -> MonitorResult:
     """Build the graph in this process, replay, drain, shut down; return what happened.
 
     make_models, make_recorder: the nodes hosted (default: as the ``models`` parameter says; the
-    benchmark's no-op graph passes stand-ins with the same topics, types and QoS). One model node
-    is the site engine's layout, four the separate nodes' (corrugation_estimator,
-    rolling_noise_predictor, squeal_risk_model, alert_manager, in that order).
+    benchmark's no-op graph passes stand-ins with the same topics, types and QoS), the models as
+    their layout (nodes.hosted_models).
     """
     # The flow-control profile is for subscribers in other processes (in-process ones are paced exactly).
     with ros_session(args, flow_control=True, default_site=True) as stop:
@@ -99,15 +98,15 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
                 raise RailMonitorError("listen:=true takes the passes from other processes: leave source empty")
             recorder = make_recorder() if settings.cfg.record else None
             models = make_models() if make_models is not None else _real_models(settings.cfg.models)
-            nodes += ([recorder] if recorder is not None else []) + models
+            nodes += ([recorder] if recorder is not None else []) + models.nodes
             source = None
             if not settings.cfg.listen:
                 source = PassReplayer() if settings.cfg.source else PassSimulator()
                 nodes.append(source)
-                hosted = len(models) + (recorder is not None)
+                hosted = len(models.nodes) + (recorder is not None)
                 source.foreign_subscribers = source.cfg.wait_for_subscribers > hosted
                 source.cfg = replace(source.cfg, wait_for_subscribers=max(source.cfg.wait_for_subscribers, hosted))
-                source.consumed = _passes_through(models, recorder, source.pub.topic_name)
+                source.consumed = models.passes_through(recorder, source.pub.topic_name)
             executor = _make_executor(settings.cfg.executor, settings.cfg.threads, settings.cfg.listen)
             for n in nodes:
                 executor.add_node(n)
@@ -132,12 +131,12 @@ def run_graph(args: list[str] | None = None, make_models: Callable[[], list[Node
             destroy_nodes(list(reversed(nodes)))
 
 
-def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode], recorder: McapRecorder | None,
+def _replay(source: PassReplayer | PassSimulator, models: HostedModels, recorder: McapRecorder | None,
             cfg: MonitorParams, stop: threading.Event, t0: float) -> MonitorResult:
     """Replay every pass, wait until every model and the recorder took what was published, and
     publish the advice on the final state. After SIGINT or SIGTERM the waits share
     ``stop_timeout_s``: what is taken by then is recorded and the bag finished (no error)."""
-    recorded_topics = _outputs(models) | {p.topic_name for p in (source.event_pub, source.measured_pub) if p}
+    recorded_topics = models.output_topics() | {p.topic_name for p in (source.event_pub, source.measured_pub) if p}
     if recorder is not None:
         _wait(lambda: recorded_topics <= set(recorder.counts), cfg.drain_timeout_s,
               lambda: f"recorder did not subscribe to {sorted(recorded_topics - set(recorder.counts))}")
@@ -149,11 +148,11 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
     def wait(done: Callable[[], bool], what: Callable[[], str]) -> None:
         _wait(done, max(deadline - time.monotonic(), 0.0), what, raise_error=not stopping)
 
-    wait(lambda: all(m.taken >= published for m in models) and _settled(models),
-         lambda: f"models took {[m.taken for m in models]} of {published} passes")
-    wait(lambda: _measured_taken(models) >= source.measurements_sent and _inputs_taken(models),
-         lambda: f"models took {_measured_taken(models)} of {source.measurements_sent} measurements")
-    models[0].publish_advisory()  # the advice on the final state
+    wait(lambda: models.took(published) and models.settled(),
+         lambda: f"models took {[m.taken for m in models.nodes]} of {published} passes")
+    wait(lambda: models.measured_taken() >= source.measurements_sent and models.inputs_taken(),
+         lambda: f"models took {models.measured_taken()} of {source.measurements_sent} measurements")
+    models.head.publish_advisory()  # the advice on the final state
     sent = {source.pub.topic_name: published}
     for pub, n in ((source.event_pub, source.events_sent), (source.measured_pub, source.measurements_sent)):
         if pub is not None:
@@ -161,25 +160,25 @@ def _replay(source: PassReplayer | PassSimulator, models: list[PassConsumerNode]
     return _finish(models, recorder, sent, wait, published, t0, t_replay)
 
 
-def _listen(models: list[PassConsumerNode], recorder: McapRecorder | None, cfg: MonitorParams,
+def _listen(models: HostedModels, recorder: McapRecorder | None, cfg: MonitorParams,
             stop: threading.Event, t0: float) -> MonitorResult:
     """Take the passes other processes publish until SIGINT or SIGTERM; then, within
     stop_timeout_s, the backlog, the advice on the final state and the recorder's catching up."""
     t_listen = time.monotonic()
     stop.wait()
-    estimator = models[0]
+    head = models.head
     deadline = time.monotonic() + cfg.stop_timeout_s
 
     def wait(done: Callable[[], bool], what: Callable[[], str]) -> None:
         _wait(done, max(deadline - time.monotonic(), 0.0), what, raise_error=False)
 
-    wait(lambda: _settled(models), lambda: "rolling_noise_predictor still holds passes")
-    estimator.publish_advisory()
-    taken = {estimator.resolve_topic_name("train_pass"): estimator.taken}  # the recorder takes them too
-    return replace(_finish(models, recorder, taken, wait, estimator.taken, t0, t_listen), listened=True)
+    wait(models.settled, lambda: "rolling_noise_predictor still holds passes")
+    head.publish_advisory()
+    taken = {head.resolve_topic_name("train_pass"): head.taken}  # the recorder takes them too
+    return replace(_finish(models, recorder, taken, wait, head.taken, t0, t_listen), listened=True)
 
 
-def _finish(models: list[PassConsumerNode], recorder: McapRecorder | None, sent: dict[str, int],
+def _finish(models: HostedModels, recorder: McapRecorder | None, sent: dict[str, int],
             wait: Callable[[Callable[[], bool], Callable[[], str]], None], published: int, t0: float,
             t_first: float) -> MonitorResult:
     """Wait until the recorder holds every message sent (the models' and ``sent``), finish the bag."""
@@ -187,7 +186,7 @@ def _finish(models: list[PassConsumerNode], recorder: McapRecorder | None, sent:
     bag = None
     if recorder is not None:
         sent = dict(sent)
-        for m in models:
+        for m in models.nodes:
             sent.update(m.sent)
         wait(lambda: recorder.writer.error or all(recorder.counts.get(t, 0) >= n for t, n in sent.items()),
              lambda: f"recorder got {dict(recorder.counts)} of {sent}")
@@ -197,59 +196,8 @@ def _finish(models: list[PassConsumerNode], recorder: McapRecorder | None, sent:
     if recorder is not None:
         bag = str(recorder.close())
         recorded = dict(recorder.counts)
-    rejected = {m.get_name(): sum(m.rejected.values()) for m in models}
+    rejected = {m.get_name(): sum(m.rejected.values()) for m in models.nodes}
     return MonitorResult(published, recorded, bag, time.monotonic() - t0, rejected, replay_s)
-
-
-def _settled(models: list[PassConsumerNode]) -> bool:
-    """No pass waits inside a model (the rolling noise predictor's for its state; the engine holds none)."""
-    return len(models) == 1 or not models[1].pending
-
-
-def _measured_taken(models: list[PassConsumerNode]) -> int:
-    """Measured pass-bys the models took (the engine's, or alert_manager's)."""
-    return models[0].counts["measurements taken"] if len(models) == 1 else models[3].inputs["noise/measured"]
-
-
-def _inputs_taken(models: list[PassConsumerNode]) -> bool:
-    """Every model output of one node taken by the nodes downstream (the engine has none)."""
-    if len(models) == 1:
-        return True
-    estimator, predictor, squeal, alerts = models
-    return (alerts.inputs["noise/squeal"] >= sum(squeal.sent.values())
-            and alerts.inputs["noise/rolling"] >= sum(predictor.sent.values())
-            and alerts.inputs["corrugation/state"] >= estimator.sent[estimator.state_pub.topic_name])
-
-
-def _passes_through(models: list[PassConsumerNode], recorder: McapRecorder | None, topic: str) -> Callable[[], int]:
-    """Passes the slowest hosted consumer has taken, downstream queues included: the pass source
-    keeps its backlog below their depth, so no queue overflows (model outputs per pass: one squeal
-    prediction, one rolling-noise message per source model)."""
-    if len(models) == 1:
-        engine = models[0]
-        per_pass = len(engine.engine.model.models)
-        noise, squeal_topic = engine.pubs["noise/rolling"].topic_name, engine.pubs["noise/squeal"].topic_name
-    else:
-        _, predictor, squeal, alerts = models
-        per_pass = len(predictor.model.models)
-        noise, squeal_topic = predictor.pub.topic_name, squeal.pub.topic_name
-
-    def taken() -> int:
-        counts = [m.taken for m in models]
-        if len(models) > 1:
-            counts += [alerts.inputs["noise/squeal"], alerts.inputs["noise/rolling"] // per_pass]
-        if recorder is not None:
-            got = recorder.counts
-            counts += [got.get(topic, 0), got.get(squeal_topic, 0), got.get(noise, 0) // per_pass]
-        return min(counts)
-
-    return taken
-
-
-def _outputs(models: list[PassConsumerNode]) -> set[str]:
-    """The topics the model nodes publish (resolved), but /diagnostics and /rosout."""
-    return {p.topic_name for m in models for p in m.publishers
-            if not p.topic_name.startswith(("/diagnostics", "/rosout", "/parameter_events"))}
 
 
 def _wait(done: Callable[[], bool], timeout_s: float, what: Callable[[], str], raise_error: bool = True) -> None:
