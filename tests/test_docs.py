@@ -4,6 +4,7 @@ outside the repository."""
 
 from __future__ import annotations
 
+import ast
 import re
 
 import yaml
@@ -67,3 +68,52 @@ def test_one_version_everywhere():
     assert citation["version"] == version and citation["license"] == "Apache-2.0"
     assert "<license>Apache-2.0</license>" in (TOP / "src" / "rail_monitor" / "package.xml").read_text()
     assert "Apache License" in (TOP / "LICENSE").read_text() and "Version 2.0" in (TOP / "LICENSE").read_text()
+
+
+# The model modules whose public functions are documented as pvlib documents its own (issue 53):
+# numpydoc Parameters (each with its unit in brackets), Returns and References. Grows module by module.
+NUMPYDOC_MODULES = ("corrugation", "hertz", "kalker", "squeal")
+
+
+def _numpydoc_sections(doc: str) -> dict[str, list[str]]:
+    """A docstring's numpydoc sections: title -> its lines (a title is underlined with dashes)."""
+    lines, out, title = doc.splitlines(), {}, None
+    for i, line in enumerate(lines):
+        if i + 1 < len(lines) and re.fullmatch(r"-{3,}", lines[i + 1].strip()) and line.strip():
+            title = line.strip()
+            out[title] = []
+        elif title is not None and not re.fullmatch(r"-{3,}", line.strip()):
+            out[title].append(line)
+    return out
+
+
+def _numpydoc_faults(fn: ast.FunctionDef) -> list[str]:
+    doc = ast.get_docstring(fn) or ""
+    sections = _numpydoc_sections(doc)
+    faults = [f"no {s}" for s in ("Parameters", "Returns", "References") if s not in sections]
+    names = [a.arg for a in (*fn.args.posonlyargs, *fn.args.args, *fn.args.kwonlyargs)]
+    entries: dict[str, str] = {}
+    current: list[str] = []
+    for line in sections.get("Parameters", []):
+        if line and not line.startswith(" ") and " : " in line:
+            current = [n.strip() for n in line.split(" : ")[0].split(",")]
+            entries.update({n: line for n in current})
+        else:
+            entries.update({n: entries[n] + line for n in current})
+    faults += [f"parameter {n} undocumented" for n in names if n not in entries]
+    faults += [f"parameter {n} without a unit [..]" for n in names
+               if n in entries and not re.search(r"\[[^\]]*\]", entries[n])]
+    if "References" in sections and not any(".. [" in line for line in sections["References"]):
+        faults.append("References without an entry")
+    return faults
+
+
+def test_public_model_functions_are_documented_with_units_and_references():
+    checked = 0
+    for name in NUMPYDOC_MODULES:
+        path = TOP / "src" / "rail_monitor" / "rail_monitor" / "models" / f"{name}.py"
+        for fn in ast.parse(path.read_text()).body:
+            if isinstance(fn, ast.FunctionDef) and not fn.name.startswith("_"):
+                assert not _numpydoc_faults(fn), f"models/{name}.py: {fn.name}: {_numpydoc_faults(fn)}"
+                checked += 1
+    assert checked >= 30

@@ -52,9 +52,29 @@ class HertzContact(NamedTuple):
 def contact_modulus(
     e1: ArrayLike, nu1: ArrayLike, e2: ArrayLike | None = None, nu2: ArrayLike | None = None
 ) -> FloatArray:
-    """Contact modulus E* [Pa] from Young's moduli [Pa] and Poisson's ratios [-] (Johnson eq. 3.64).
+    """Contact modulus E* of two elastic bodies, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2.
 
     With only the first body given, both bodies are of the same material.
+
+    Parameters
+    ----------
+    e1 : array_like
+        Young's modulus of body 1 [Pa].
+    nu1 : array_like
+        Poisson's ratio of body 1 [-].
+    e2 : array_like, optional
+        Young's modulus of body 2 [Pa] (default: e1).
+    nu2 : array_like, optional
+        Poisson's ratio of body 2 [-] (default: nu1).
+
+    Returns
+    -------
+    ndarray
+        E* [Pa].
+
+    References
+    ----------
+    .. [1] K. L. Johnson, *Contact Mechanics*, Cambridge University Press, Cambridge, 1985, eq. (3.64).
     """
     e1, nu1 = np.asarray(e1, float), np.asarray(nu1, float)
     e2 = e1 if e2 is None else np.asarray(e2, float)
@@ -122,19 +142,31 @@ def contact_ellipse(
     e_star: ArrayLike,
     load: ArrayLike,
 ) -> HertzContact:
-    """Hertz contact ellipse of two bodies with aligned principal axes (Johnson 1985, section 4.2).
+    """Hertz contact ellipse of two bodies with aligned principal axes.
+
+    The elliptic-integral solution is exact; the axis ratio depends on the geometry only, so it is
+    solved once per distinct geometry.
 
     Parameters
     ----------
-    r1x, r1y, r2x, r2y : principal radii of curvature of bodies 1 and 2 along the rolling
-        direction x and the lateral direction y [m] (negative: concave; ``np.inf``: straight).
-    e_star : contact modulus E* [Pa] (:func:`contact_modulus`).
-    load : normal load P [N] (> 0).
+    r1x, r1y, r2x, r2y : array_like
+        Principal radii of curvature of bodies 1 and 2 along the rolling direction x and the
+        lateral direction y [m] (negative: concave; ``np.inf``: straight).
+    e_star : array_like
+        Contact modulus E* [Pa] (:func:`contact_modulus`).
+    load : array_like
+        Normal load P [N] (> 0).
 
     Returns
     -------
-    HertzContact with a along x and b along y. The elliptic-integral solution is exact; the
-    axis ratio depends on the geometry only, so it is solved once per distinct geometry.
+    HertzContact
+        Semi-axes a along x and b along y [m], peak pressure p0 [Pa], approach [m] and the
+        linearised contact stiffness [N/m].
+
+    References
+    ----------
+    .. [1] K. L. Johnson, *Contact Mechanics*, Cambridge University Press, Cambridge, 1985,
+       section 4.2, eqs. (3.60)-(3.64).
     """
     r1x, r1y, r2x, r2y, e_star, load = (np.asarray(v, float) for v in (r1x, r1y, r2x, r2y, e_star, load))
     curv_x = 0.5 * (1.0 / r1x + 1.0 / r2x)

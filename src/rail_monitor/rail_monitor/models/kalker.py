@@ -71,17 +71,51 @@ class CreepCoefficients(NamedTuple):
 
 
 def creep_coefficients(a_over_b: ArrayLike, nu: ArrayLike) -> CreepCoefficients:
-    """C11, C22, C23 [-] for the ellipse ratio a/b [-] (a along rolling) and Poisson's ratio [-].
+    """Kalker's linear creep coefficients C11, C22, C23 of an elliptical contact.
 
-    Kalker (1990) Table E.3, interpolated linearly in ln(a/b) and quadratically in nu
-    (0 <= nu <= 0.5). Exact at the table's nodes.
+    Interpolated linearly in ln(a/b) and quadratically in nu (0 <= nu <= 0.5) from Kalker's table;
+    exact at the table's nodes. Outside 0.1 <= a/b <= 10 a ValueError is raised.
+
+    Parameters
+    ----------
+    a_over_b : array_like
+        Ellipse ratio a/b, a along rolling [-].
+    nu : array_like
+        Poisson's ratio [-].
+
+    Returns
+    -------
+    CreepCoefficients
+        C11, C22, C23 [-].
+
+    References
+    ----------
+    .. [1] J. J. Kalker, *Three-Dimensional Elastic Bodies in Rolling Contact*, Kluwer Academic
+       Publishers, Dordrecht, 1990, Appendix E, Table E.3.
+    .. [2] K. L. Johnson, *Contact Mechanics*, Cambridge University Press, Cambridge, 1985, Table 8.1.
     """
     c = _interpolated(a_over_b, nu, (0, 1, 2))
     return CreepCoefficients(c[..., 0], c[..., 1], c[..., 2])
 
 
 def lateral_creep_coefficient(a_over_b: ArrayLike, nu: ArrayLike) -> FloatArray:
-    """C22 [-] alone, as :func:`creep_coefficients` gives it (the other two columns not read)."""
+    """Kalker's lateral creep coefficient C22 alone, as :func:`creep_coefficients` gives it.
+
+    Parameters
+    ----------
+    a_over_b, nu : array_like
+        As for :func:`creep_coefficients`: the ellipse ratio a/b [-] and Poisson's ratio [-].
+
+    Returns
+    -------
+    ndarray
+        C22 [-].
+
+    References
+    ----------
+    .. [1] J. J. Kalker, *Three-Dimensional Elastic Bodies in Rolling Contact*, Kluwer Academic
+       Publishers, Dordrecht, 1990, Appendix E, Table E.3.
+    """
     return _interpolated(a_over_b, nu, (1,))[..., 0]
 
 

@@ -81,25 +81,60 @@ REFERENCE_VELOCITY_MPS = 1.0  # 20 lg(A w / 1 m/s) when no other reference is ch
 
 
 def shear_modulus(young_pa: ArrayLike, poisson: ArrayLike) -> FloatArray:
-    """G = E / (2 (1 + nu)) [Pa]."""
+    """Shear modulus of an isotropic elastic material, G = E / (2 (1 + nu)).
+
+    Parameters
+    ----------
+    young_pa : array_like
+        Young's modulus E [Pa].
+    poisson : array_like
+        Poisson's ratio nu [-].
+
+    Returns
+    -------
+    ndarray
+        Shear modulus G [Pa].
+
+    References
+    ----------
+    .. [1] K. L. Johnson, *Contact Mechanics*, Cambridge University Press, 1985, section 2.2.
+    """
     return np.asarray(young_pa, float) / (2.0 * (1.0 + np.asarray(poisson, float)))
 
 
 def kalker_lateral_stiffness(contact: HertzContact, young_pa: ArrayLike, poisson: ArrayLike) -> FloatArray:
-    """G a b C22 [N]: Kalker's linear lateral creep force per unit creepage of a Hertz contact
-    between two bodies of the same material (E [Pa], nu [-]); C22 from
-    :func:`rail_monitor.models.kalker.lateral_creep_coefficient` at the contact's a/b (a along rolling)."""
+    """Kalker's linear lateral creep force per unit creepage, G a b C22, of a Hertz contact.
+
+    The two bodies are of the same material; C22 is
+    :func:`rail_monitor.models.kalker.lateral_creep_coefficient` at the contact's a/b (a along rolling).
+
+    Parameters
+    ----------
+    contact : HertzContact
+        The contact ellipse, semi-axes a (rolling) and b (lateral) [m] (models.hertz).
+    young_pa, poisson : array_like
+        Young's modulus E [Pa] and Poisson's ratio nu [-] of both bodies.
+
+    Returns
+    -------
+    ndarray
+        G a b C22 [N].
+
+    References
+    ----------
+    .. [1] J. J. Kalker, *Three-Dimensional Elastic Bodies in Rolling Contact*, Kluwer Academic
+       Publishers, Dordrecht, 1990 (the linear creep coefficients).
+    """
     c22 = lateral_creep_coefficient(contact.a / contact.b, poisson)
     return shear_modulus(young_pa, poisson) * contact.a * contact.b * c22
 
 
 def lateral_creep_stiffness(kalker_stiffness: ArrayLike, mu0: ArrayLike, convention: str = "reduced_kalker",
                             reduction_factor: ArrayLike = RIG_PEAK_FRICTION) -> FloatArray:
-    """k3 [N]: the lateral creep stiffness that normalises the creepage, xi' = zeta k3 / W.
+    """The lateral creep stiffness k3 that normalises the creepage, xi' = zeta k3 / W.
 
-    kalker_stiffness is Kalker's linear lateral creep force per unit creepage, G a b C22 [N]
-    (:func:`kalker_lateral_stiffness`); mu0 the friction peak k1 [-]. The creep curve saturates
-    at the creepage zeta_c = W / k3 and its adhesion slope is k1 k3 per unit creepage. Conventions:
+    The creep curve saturates at the creepage zeta_c = W / k3 and its adhesion slope is k1 k3 per
+    unit creepage. Conventions:
 
     ``reduced_kalker`` (default)
         k3 = k_A G a b C22 / mu0: the adhesion branch is Kalker's slope times a reduction factor
@@ -107,11 +142,11 @@ def lateral_creep_stiffness(kalker_stiffness: ArrayLike, mu0: ArrayLike, convent
         zeta_c = mu0 W / (k_A G a b C22) scales with each state's friction peak, as it does for
         any creep law whose initial slope is Kalker's and whose limit is Coulomb's. Kalker's
         linear theory overestimates measured initial creep slopes and reduction factors well
-        below 1 are needed to fit measured curves (O. Polach, Wear 258 (2005) 992-1000). k_A is
-        calibrated once on the UQ paper's rig: k_A = 0.27, the rig's friction peak, gives the rig
-        k3 = G a b C22 = 1.48e5 N (zeta_c = 0.0068), with which the paper's A w = 0.33 m/s at
-        Vc = 0.39 m/s, halving at -34 % Vc, are reproduced (tests). For full-size wheels on dry
-        rail it puts the squeal onset at 5-10 mrad angle of attack, as observed.
+        below 1 are needed to fit measured curves [2]_. k_A is calibrated once on the UQ paper's
+        rig: k_A = 0.27, the rig's friction peak, gives the rig k3 = G a b C22 = 1.48e5 N
+        (zeta_c = 0.0068), with which the paper's A w = 0.33 m/s at Vc = 0.39 m/s, halving at
+        -34 % Vc, are reproduced (tests). For full-size wheels on dry rail it puts the squeal
+        onset at 5-10 mrad angle of attack, as observed.
     ``kalker_unit``
         k3 = G a b C22 whatever the friction: the saturation creepage does not depend on mu0
         (version 0.2's default; equal to ``reduced_kalker`` where mu0 = k_A).
@@ -122,6 +157,30 @@ def lateral_creep_stiffness(kalker_stiffness: ArrayLike, mu0: ArrayLike, convent
     ``saturation_3x``
         Saturation at three times the linear intercept (the cubic Vermeulen-Johnson curve
         saturates there): k3 = G a b C22 / (3 mu0).
+
+    Parameters
+    ----------
+    kalker_stiffness : array_like
+        Kalker's linear lateral creep force per unit creepage, G a b C22 [N]
+        (:func:`kalker_lateral_stiffness`).
+    mu0 : array_like
+        The friction peak k1 [-].
+    convention : str
+        One of K3_CONVENTIONS [-].
+    reduction_factor : array_like
+        k_A of ``reduced_kalker`` [-].
+
+    Returns
+    -------
+    ndarray
+        k3 [N].
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eq. 4.
+    .. [2] O. Polach, "Creep forces in simulations of traction vehicles running on adhesion limit",
+       *Wear* 258 (2005) 992-1000.
     """
     g_ab_c22 = np.asarray(kalker_stiffness, float)
     if convention == "reduced_kalker":
@@ -136,7 +195,32 @@ def lateral_creep_stiffness(kalker_stiffness: ArrayLike, mu0: ArrayLike, convent
 
 
 def effective_damping(damping: ArrayLike, k2: ArrayLike, k3: ArrayLike, speed: ArrayLike) -> FloatArray:
-    """c + k2 k3 / V0 [N s/m] (UQ paper eq. 5) on the falling branch; negative means unstable."""
+    """The damping seen by small oscillations about the sliding state, c + k2 k3 / V0 (UQ eq. 5).
+
+    Negative means unstable: the falling branch of the creep curve feeds the mode more energy than
+    its damping takes.
+
+    Parameters
+    ----------
+    damping : array_like
+        Modal damping c [N s/m].
+    k2 : array_like
+        Slope of mu against xi' on the sliding branch [-] (< 0 falling).
+    k3 : array_like
+        Lateral creep stiffness [N] (:func:`lateral_creep_stiffness`).
+    speed : array_like
+        Rolling speed V0 [m/s].
+
+    Returns
+    -------
+    ndarray
+        c + k2 k3 / V0 [N s/m].
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eq. 5.
+    """
     return np.asarray(damping, float) + np.asarray(k2, float) * np.asarray(k3, float) / np.asarray(speed, float)
 
 
@@ -187,16 +271,42 @@ def limit_cycle_amplitude(
     k3: ArrayLike,
     resolution: BalanceResolution = FULL_BALANCE,
 ) -> LimitCycle:
-    """Closed-form squeal velocity amplitude by energy balance (module docstring; UQ paper eq. 7 corrected).
+    """Squeal velocity amplitude by energy balance over one cycle (module docstring; UQ eq. 7 corrected).
+
+    The closed form holds while the contact does not slip backwards and the falling branch stays
+    above mu = 0; past either, the balance is solved over the whole curve
+    (:func:`rail_monitor.models.squeal_balance.harmonic_balance_amplitude`).
 
     Parameters
     ----------
-    speed : rolling speed V0 [m/s]; crabbing : crabbing velocity Vc [m/s] (sign ignored: the
-        creep curve is odd); load : normal load W [N]; damping : modal damping c [N s/m];
-    k1 : friction peak, slope of mu against xi' on the adhesion branch [-];
-    k2 : slope of mu against xi' on the sliding branch [-] (< 0 falling);
-    k3 : lateral creep stiffness [N] (:func:`lateral_creep_stiffness`);
-    resolution : of the harmonic balance where the closed form does not hold.
+    speed : array_like
+        Rolling speed V0 [m/s].
+    crabbing : array_like
+        Crabbing velocity Vc [m/s] (sign ignored: the creep curve is odd).
+    load : array_like
+        Normal load W [N].
+    damping : array_like
+        Modal damping c [N s/m].
+    k1 : array_like
+        Friction peak, the slope of mu against xi' on the adhesion branch [-].
+    k2 : array_like
+        Slope of mu against xi' on the sliding branch [-] (< 0 falling).
+    k3 : array_like
+        Lateral creep stiffness [N] (:func:`lateral_creep_stiffness`).
+    resolution : BalanceResolution
+        Grid of the harmonic balance where the closed form does not hold [-].
+
+    Returns
+    -------
+    LimitCycle
+        Amplitude A w [m/s], the closed form [m/s], phi [rad], regime, instability, effective
+        damping [N s/m], critical slip [m/s], friction positive over the cycle; broadcast over the
+        inputs.
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eqs. 3-7, Figures 6-7.
     """
     v0, vc, w, c, k1, k2, k3 = np.broadcast_arrays(
         *(np.asarray(x, float) for x in (speed, crabbing, load, damping, k1, k2, k3))
@@ -230,7 +340,26 @@ def limit_cycle_amplitude(
 
 
 def squeal_frequency(mass: ArrayLike, stiffness: ArrayLike) -> FloatArray:
-    """Natural frequency sqrt(k/m) / (2 pi) [Hz] of the squealing mode (mass [kg], stiffness [N/m])."""
+    """Natural frequency of the squealing mode, sqrt(k / m) / (2 pi).
+
+    Parameters
+    ----------
+    mass : array_like
+        Modal mass m [kg].
+    stiffness : array_like
+        Modal stiffness k [N/m].
+
+    Returns
+    -------
+    ndarray
+        Frequency [Hz] of the squeal's tone: the mode's undamped natural frequency (a damping
+        ratio zeta would scale it by sqrt(1 - zeta^2)).
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eq. 3 (the one-mode wheel).
+    """
     return np.sqrt(np.asarray(stiffness, float) / np.asarray(mass, float)) / (2.0 * np.pi)
 
 
@@ -252,19 +381,45 @@ def radiated_level(
     distance: ArrayLike = 7.5,
     solid_angle: float = 2.0 * np.pi,
 ) -> RadiatedLevel:
-    """Level at a receiver from a wheel vibrating at velocity amplitude A w [m/s] at frequency [Hz].
+    """Sound levels at a receiver from a wheel vibrating at a velocity amplitude A w at one frequency.
 
-    Sound power W = rho0 c0 sigma S <v^2> with <v^2> = spatial_average (A w)^2 / 2 the
-    surface- and time-averaged squared velocity (Thompson, *Railway Noise and Vibration*,
-    Elsevier 2009, sections 5.2 and 13: radiation efficiency sigma ~ 1 for wheel axial modes
-    above about 1 kHz; a mode with nodal diameters averages cos^2 to 1/2 around the
-    circumference, hence spatial_average 0.5 relative to the contact point). S: radiating
-    area [m2] (both sides of a 0.84 m wheel's web and tread, about 0.9 m2). The wheel is a
-    compact source at distance r [m] radiating into solid_angle [sr] (2 pi: hemisphere above
-    a reflecting ground): p^2 = rho0 c0 W / (solid_angle r^2), so
-    Lp = Lw - 10 lg(solid_angle r^2 / 1 m2) + 10 lg(rho0 c0 / 400), the last term 0.14 dB. The squeal is a tone at the
-    mode's frequency; the A-weighted level adds A(f) (IEC 61672-1). Level changes follow
-    20 lg(A w / A w_ref), as in the UQ paper's Figure 7a.
+    Sound power W = rho0 c0 sigma S <v^2> with <v^2> = spatial_average (A w)^2 / 2 the surface- and
+    time-averaged squared velocity: radiation efficiency sigma ~ 1 for wheel axial modes above about
+    1 kHz, and a mode with nodal diameters averages cos^2 to 1/2 around the circumference, hence
+    spatial_average 0.5 relative to the contact point [2]_. The wheel is a compact source radiating
+    into solid_angle (2 pi: a hemisphere above a reflecting ground): p^2 = rho0 c0 W / (solid_angle
+    r^2), so Lp = Lw - 10 lg(solid_angle r^2 / 1 m2) + 10 lg(rho0 c0 / 400), the last term 0.14 dB.
+    The squeal is a tone at the mode's frequency; the A-weighted level adds A(f) (IEC 61672-1).
+    Level changes follow 20 lg(A w / A w_ref), as in the UQ paper's Figure 7a.
+
+    Parameters
+    ----------
+    amplitude : array_like
+        Velocity amplitude A w [m/s].
+    frequency : array_like
+        Frequency of the tone [Hz].
+    radiating_area : array_like
+        Radiating area S [m2] (both sides of a 0.84 m wheel's web and tread, about 0.9 m2).
+    radiation_efficiency : array_like
+        sigma [-].
+    spatial_average : array_like
+        Surface average of the squared velocity relative to the contact point's [-].
+    distance : array_like
+        Source to receiver r [m].
+    solid_angle : float
+        Solid angle the wheel radiates into [sr].
+
+    Returns
+    -------
+    RadiatedLevel
+        Lw [dB re 1 pW], Lp [dB re 20 uPa], Lp A-weighted [dB(A)].
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 3.3, Figure 7a.
+    .. [2] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of
+       Control*, Elsevier, Oxford, 2009, sections 5.2 and 13.
     """
     amp = np.asarray(amplitude, float)
     mean_square = np.asarray(spatial_average, float) * amp**2 / 2.0
@@ -277,6 +432,26 @@ def radiated_level(
 
 
 def relative_level(amplitude: ArrayLike, reference: ArrayLike = REFERENCE_VELOCITY_MPS) -> FloatArray:
-    """Level change 20 lg(A w / A w_ref) [dB] (sound power ~ velocity squared; UQ paper section 3.3)."""
+    """Level change of a squeal amplitude against a reference, 20 lg(A w / A w_ref).
+
+    Sound power goes with the velocity squared, so the level changes by 20 lg of the amplitude ratio.
+
+    Parameters
+    ----------
+    amplitude : array_like
+        Velocity amplitude A w [m/s].
+    reference : array_like
+        Reference amplitude A w_ref [m/s].
+
+    Returns
+    -------
+    ndarray
+        Level change [dB] (-inf for a zero amplitude).
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 3.3, Figure 7a.
+    """
     with np.errstate(divide="ignore"):
         return 20.0 * np.log10(np.asarray(amplitude, float) / np.asarray(reference, float))
