@@ -35,9 +35,35 @@ class AxleLayout:
 
 def axle_layout(length_m: ArrayLike, vehicle_count: ArrayLike, axle_count: ArrayLike, bogie_centre_ratio: ArrayLike,
                 semi_wheelbase_m: ArrayLike) -> AxleLayout:
-    """The AxleLayout of trains [m, -, -, -, m per pass]: k = axles / vehicles (rounded, at least
-    1); bogie centres bogie_centre_ratio x P apart; axles of a bogie semi_wheelbase_m either side
-    of its centre (k / 2 = 3: one at the centre too)."""
+    """The axles of trains as identical vehicles of pitch P = length / vehicles.
+
+    k = axles / vehicles (rounded, at least 1); bogie centres bogie_centre_ratio x P apart; axles of
+    a bogie semi_wheelbase_m either side of its centre (k / 2 = 3: one at the centre too). The
+    layout is this package's (docs/models.md, the pass-by's sources); the pass it spans is ISO 3095's.
+
+    Parameters
+    ----------
+    length_m : array_like
+        Train length per pass [m].
+    vehicle_count : array_like
+        Vehicles per pass [-].
+    axle_count : array_like
+        Axles per pass [-].
+    bogie_centre_ratio : array_like
+        Distance between a vehicle's bogie centres over its pitch [-].
+    semi_wheelbase_m : array_like
+        Half a bogie's wheelbase [m].
+
+    Returns
+    -------
+    AxleLayout
+        Vehicles [-], pitch P [m] and each axle's offset from its vehicle's front [m] per pass.
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, clause 3 (the pass from the train's front to its rear).
+    """
     length = np.atleast_1d(np.asarray(length_m, float))
     vehicles = np.maximum(np.atleast_1d(np.asarray(vehicle_count, np.int64)), 1)
     k = np.clip(np.rint(np.atleast_1d(np.asarray(axle_count, float)) / vehicles).astype(np.int64), 1,

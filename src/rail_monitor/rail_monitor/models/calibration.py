@@ -54,20 +54,78 @@ class KbPosterior:
 
 
 def prior(scale_sd: float, ratio_sd: float, states: int = 4) -> KbPosterior:
-    """The prior: u ~ N(0, scale_sd^2 1 1^T + ratio_sd^2 I) (standard deviations of ln K_b)."""
+    """The prior of u = ln(K_b / K_b default): u ~ N(0, scale_sd^2 1 1^T + ratio_sd^2 I).
+
+    Parameters
+    ----------
+    scale_sd : float
+        Standard deviation of the common scale of ln K_b [-].
+    ratio_sd : float
+        Standard deviation of each state's ratio to the others, in ln K_b [-].
+    states : int
+        Friction states [-].
+
+    Returns
+    -------
+    KbPosterior
+        Mean 0 and that covariance, no survey taken.
+
+    References
+    ----------
+    .. [1] A. Gelman, J. B. Carlin, H. S. Stern, D. B. Dunson, A. Vehtari and D. B. Rubin, *Bayesian
+       Data Analysis*, 3rd ed., CRC Press, Boca Raton, 2013, section 3.5 (the multivariate normal prior).
+    """
     cov = scale_sd**2 * np.ones((states, states)) + ratio_sd**2 * np.eye(states)
     return KbPosterior(np.zeros(states), cov, 0)
 
 
 def log_variance(sd_db: float) -> float:
-    """Variance of ln Z [-] of a level known to sd_db [dB] (one standard deviation)."""
+    """Variance of ln Z of a level known to sd_db (one standard deviation).
+
+    A level of 20 lg Z known to sd_db has ln Z known to sd_db ln(10) / 20.
+
+    Parameters
+    ----------
+    sd_db : float
+        Standard deviation of the level [dB].
+
+    Returns
+    -------
+    float
+        Variance of ln Z [-], (sd_db ln 10 / 20)^2: a level is 20 lg Z, so ln Z moves by
+        ln 10 / 20 per dB.
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.1 (the roughness level 20 lg Z).
+    """
     return (sd_db * LN_PER_DB) ** 2
 
 
 def band_level_jacobian(log_components: np.ndarray, growth: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A band's ln r.m.s. (B,) from ln Z of its components (B, P), its derivative with respect to
-    scaling the growth of each friction state, d ln Z_b / d delta_f = sum_p w_bp G_f,bp (B, 4), for
-    growth G (4, B, P) already in the components, and the components' energy shares w (B, P)."""
+    """A band's ln r.m.s. and its derivative with respect to scaling each friction state's growth.
+
+    d ln Z_b / d delta_f = sum_p w_bp G_f,bp, for growth G already in the components and the
+    components' energy shares w.
+
+    Parameters
+    ----------
+    log_components : ndarray
+        ln Z of the components [ln m] (B, P).
+    growth : ndarray
+        Their log growth per friction state [-] (4, B, P).
+
+    Returns
+    -------
+    tuple of ndarray
+        ln r.m.s. per band [ln m] (B,), the derivative [-] (B, 4) and the energy shares w [-] (B, P).
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.1, eqs. 1-2 (the growth scaled).
+    """
     level = cg.band_log_amplitude(log_components)
     weight = np.exp(2.0 * (log_components - level[:, None]))
     return level, np.einsum("bp,fbp->bf", weight, growth), weight
@@ -89,12 +147,36 @@ def _curvature(scaled: np.ndarray, weight: np.ndarray, jac: np.ndarray) -> np.nd
 
 def update(post: KbPosterior, start: np.ndarray, growth: np.ndarray, measured: np.ndarray,
            sigma: np.ndarray | float) -> tuple[KbPosterior, np.ndarray]:
-    """The posterior after one survey, and delta = its change of u (4,).
+    """The posterior after one survey, by Gauss-Newton on the log posterior, and its change of u.
 
-    post: the posterior so far, whose median K_b the growth was computed with; start: ln Z of the
-    components of the surveyed bands at t1 (B, P) [ln m]; growth: their log growth since then per
-    friction state (4, B, P); measured: their surveyed ln Z (B,) [ln m]; sigma: standard deviation
-    of each band's measured minus predicted ln Z (B,) or scalar [-].
+    The survey's band levels against the model's (the module's yhat_b(delta)); the mode's Laplace
+    covariance is the inverse Hessian of the negative log posterior there.
+
+    Parameters
+    ----------
+    post : KbPosterior
+        The posterior of u so far [-], whose median K_b the growth was computed with.
+    start : ndarray
+        ln Z of the components of the surveyed bands at the last survey or grinding [ln m] (B, P).
+    growth : ndarray
+        Their log growth since then per friction state [-] (4, B, P).
+    measured : ndarray
+        Their surveyed ln Z [ln m] (B,).
+    sigma : ndarray or float
+        Standard deviation of each band's measured minus predicted ln Z [-] (B,) or scalar.
+
+    Returns
+    -------
+    tuple
+        The posterior (KbPosterior) and delta, its change of u [-] (4,).
+
+    References
+    ----------
+    .. [1] A. Gelman, J. B. Carlin, H. S. Stern, D. B. Dunson, A. Vehtari and D. B. Rubin, *Bayesian
+       Data Analysis*, 3rd ed., CRC Press, Boca Raton, 2013, sections 4.1 and 13.3 (the normal
+       approximation at the mode).
+    .. [2] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.1, eqs. 1-2.
     """
     p_inv = np.linalg.inv(post.cov)
     w = np.broadcast_to(1.0 / np.asarray(sigma, float) ** 2, np.shape(measured))

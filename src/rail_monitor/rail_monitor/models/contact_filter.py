@@ -31,10 +31,29 @@ from scipy.special import j1
 
 
 def hertzian_line_filter(wavelength: ArrayLike, semi_length: ArrayLike) -> NDArray[np.float64]:
-    """F = 2 J1(k a) / (k a) [-] for wavelength [m] and patch semi-length a [m] along the rail.
+    """The contact filter of a Hertzian patch, F = 2 J1(k a) / (k a), k = 2 pi / wavelength.
 
-    Signed: F < 0 between its first and second zeros (k a = 3.83 to 7.02), where the patch
-    sees the harmonic in antiphase.
+    Signed: F < 0 between its first and second zeros (k a = 3.83 to 7.02), where the patch sees
+    the harmonic in antiphase.
+
+    Parameters
+    ----------
+    wavelength : array_like
+        Roughness wavelength [m].
+    semi_length : array_like
+        Patch semi-length a along the rail [m].
+
+    Returns
+    -------
+    ndarray
+        F [-].
+
+    References
+    ----------
+    .. [1] P. J. Remington, "Wheel/rail rolling noise, I: Theoretical analysis", *Journal of the
+       Acoustical Society of America* 81(6) (1987) 1805-1823.
+    .. [2] R. A. J. Ford and D. J. Thompson, "Simplified contact filters in wheel/rail noise
+       prediction", *Journal of Sound and Vibration* 293(3-5) (2006) 807-818.
     """
     ka = 2.0 * np.pi * np.asarray(semi_length, float) / np.asarray(wavelength, float)
     small = np.abs(ka) < 1e-6

@@ -34,21 +34,84 @@ ComplexArray = NDArray[np.complex128]
 
 
 def delany_bazley_impedance(frequency_hz: ArrayLike, flow_resistivity_pa_s_m2: float) -> ComplexArray:
-    """Normalised characteristic impedance Z [-] of a porous ground (module docstring)."""
+    """Normalised characteristic impedance of a porous ground, Z = 1 + 0.0571 X^-0.754 + i 0.087 X^-0.732.
+
+    X = rho0 f / s; taken as the surface impedance of a locally reacting, semi-infinite ground.
+
+    Parameters
+    ----------
+    frequency_hz : array_like
+        Frequency f [Hz].
+    flow_resistivity_pa_s_m2 : float
+        Flow resistivity s [Pa s/m2].
+
+    Returns
+    -------
+    ndarray of complex
+        Z [-] (time convention exp(-i w t)).
+
+    References
+    ----------
+    .. [1] M. E. Delany and E. N. Bazley, "Acoustical properties of fibrous absorbent materials",
+       *Applied Acoustics* 3 (1970) 105-116.
+    """
     x = AIR_DENSITY * np.asarray(frequency_hz, float) / flow_resistivity_pa_s_m2
     return 1.0 + 0.0571 * x**-0.754 + 1j * 0.087 * x**-0.732
 
 
 def ground_wave_function(w: ArrayLike) -> ComplexArray:
-    """F(w) = 1 + i sqrt(pi) w e^(-w^2) erfc(-i w) [-]."""
+    """The ground wave's boundary loss function F(w) = 1 + i sqrt(pi) w e^(-w^2) erfc(-i w).
+
+    Evaluated through the Faddeeva function e^(-w^2) erfc(-i w) (scipy.special.wofz).
+
+    Parameters
+    ----------
+    w : array_like
+        Numerical distance [-] (complex).
+
+    Returns
+    -------
+    ndarray of complex
+        F [-].
+
+    References
+    ----------
+    .. [1] K. Attenborough, K. M. Li and K. Horoshenkov, *Predicting Outdoor Sound*, Taylor &
+       Francis, London, 2007, chapter 2 (the spherical-wave reflection coefficient).
+    """
     w = np.asarray(w, complex)
     return 1.0 + 1j * np.sqrt(np.pi) * w * wofz(w)
 
 
 def spherical_reflection(frequency_hz: ArrayLike, flow_resistivity_pa_s_m2: float, image_path_m: float,
                          grazing_rad: float) -> ComplexArray:
-    """Spherical-wave reflection coefficient Q [-] of the ground for an image path of this length
-    [m] and grazing angle [rad] (module docstring)."""
+    """Spherical-wave reflection coefficient Q of a porous ground for one image path.
+
+    Q = R_p + (1 - R_p) F(w), R_p the plane-wave coefficient at the grazing angle (module docstring).
+
+    Parameters
+    ----------
+    frequency_hz : array_like
+        Frequency [Hz].
+    flow_resistivity_pa_s_m2 : float
+        Flow resistivity [Pa s/m2].
+    image_path_m : float
+        Length of the image path r2 [m].
+    grazing_rad : float
+        Grazing angle psi [rad].
+
+    Returns
+    -------
+    ndarray of complex
+        Q [-]: the image source's pressure relative to that of a perfect reflector
+        (|Q| = 1) over the same path.
+
+    References
+    ----------
+    .. [1] K. Attenborough, K. M. Li and K. Horoshenkov, *Predicting Outdoor Sound*, Taylor &
+       Francis, London, 2007, chapter 2.
+    .. [2] M. E. Delany and E. N. Bazley, *Applied Acoustics* 3 (1970) 105-116 (the impedance).
+    """
     z = delany_bazley_impedance(frequency_hz, flow_resistivity_pa_s_m2)
     s = np.sin(grazing_rad)
     rp = (z * s - 1.0) / (z * s + 1.0)

@@ -37,7 +37,22 @@ TAU_SLOW_S = 1.0    # time constant of time weighting S [s]
 
 
 def a_weighting_db(frequency: ArrayLike) -> NDArray[np.float64]:
-    """A-weighting [dB] at frequency [Hz] (IEC 61672-1:2013, eq. E.6); -inf at 0 Hz."""
+    """The A weighting at a frequency, IEC 61672-1's analytic form (Annex E, eq. E.6).
+
+    Parameters
+    ----------
+    frequency : array_like
+        Frequency [Hz].
+
+    Returns
+    -------
+    ndarray
+        A(f) [dB]; -inf at 0 Hz.
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, Annex E.
+    """
     f2 = np.asarray(frequency, float) ** 2
     with np.errstate(divide="ignore"):
         ratio = (F4_HZ**2 * f2**2) / (
@@ -47,10 +62,28 @@ def a_weighting_db(frequency: ArrayLike) -> NDArray[np.float64]:
 
 
 def a_weighted_pressure(pressure_pa: ArrayLike, fs_hz: float) -> NDArray[np.float64]:
-    """A-weighted sound pressure [Pa] of a sampled pressure [Pa] at fs_hz [Hz]: the spectrum times
-    10^(A(f)/20) (a_weighting_db), zero phase. The record is padded with a second of silence, so
-    the weighting's response (its slowest pole, 20.6 Hz, decays in about 0.1 s) does not wrap
-    around."""
+    """A-weighted sound pressure of a sampled pressure: its spectrum times 10^(A(f)/20), zero phase.
+
+    The record is padded with a second of silence, so the weighting's response (its slowest pole,
+    20.6 Hz, decays in about 0.1 s) does not wrap around.
+
+    Parameters
+    ----------
+    pressure_pa : array_like
+        Sound pressure [Pa].
+    fs_hz : float
+        Sampling rate [Hz].
+
+    Returns
+    -------
+    ndarray
+        A-weighted pressure [Pa].
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*,
+       5.5 and Annex E (the magnitude response; the phase is not specified).
+    """
     p = np.asarray(pressure_pa, float)
     n = fft.next_fast_len(len(p) + int(np.ceil(fs_hz)), real=True)
     spectrum = fft.rfft(p, n)
@@ -61,8 +94,27 @@ def a_weighted_pressure(pressure_pa: ArrayLike, fs_hz: float) -> NDArray[np.floa
 
 
 def time_weighted_square(square_pa2: ArrayLike, fs_hz: float, tau_s: float = TAU_FAST_S) -> NDArray[np.float64]:
-    """Exponentially time-weighted mean square [Pa^2] of a squared pressure [Pa^2] sampled at fs_hz
-    [Hz], time constant tau_s [s] (IEC 61672-1:2013, 3.8): starts from rest (0 before the record)."""
+    """Exponentially time-weighted mean square of a squared pressure, from rest.
+
+    Parameters
+    ----------
+    square_pa2 : array_like
+        Squared (weighted) sound pressure [Pa^2].
+    fs_hz : float
+        Sampling rate [Hz].
+    tau_s : float
+        Time constant [s] (F: 0.125 s).
+
+    Returns
+    -------
+    ndarray
+        Time-weighted mean square [Pa^2] (0 before the record).
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*,
+       3.8 (exponential time weighting).
+    """
     from scipy import signal  # here: importing it costs a node's start-up half a second
 
     a = np.exp(-1.0 / (fs_hz * tau_s))

@@ -56,8 +56,27 @@ class PassbyLevels:
 
 
 def sensitivity_pa_per_unit(calibration: ArrayLike, level_db: float = 94.0) -> float:
-    """Pascals per unit of a recording channel, from a record of a calibrator of level_db [dB re
-    20 uPa] on it (its r.m.s. about its mean: a DC offset of the channel is not sound)."""
+    """Pascals per unit of a recording channel, from a record of a calibrator on it.
+
+    The calibrator's r.m.s. is taken about its mean: a DC offset of the channel is not sound.
+
+    Parameters
+    ----------
+    calibration : array_like
+        The channel's record of the calibrator [unit].
+    level_db : float
+        The calibrator's level [dB re 20 uPa].
+
+    Returns
+    -------
+    float
+        Sensitivity [Pa per unit].
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles* (the measuring chain calibrated with a sound calibrator).
+    """
     c = np.asarray(calibration, float)
     rms = float(np.sqrt(np.mean((c - c.mean()) ** 2))) if len(c) else 0.0
     if not np.isfinite(rms) or rms <= 0.0:
@@ -69,9 +88,28 @@ SKIRT = 4.0  # beyond f_m / SKIRT and f_m SKIRT a band's filter attenuates more 
 
 
 def band_mean_squares(pressure_pa: ArrayLike, fs_hz: float, bands: ArrayLike = BANDS) -> NDArray[np.float64]:
-    """Mean square [Pa^2] of a record [Pa] through each band's filter (iec61260.band_power_response;
-    its response beyond a factor SKIRT from the band centre, more than 72 dB down where class 1 asks
-    70, is taken as zero)."""
+    """Mean square of a record through each 1/3-octave band's filter.
+
+    Each band's response is IEC 61260-1's (models.iec61260.band_power_response); beyond a factor
+    SKIRT from the band centre, more than 72 dB down where class 1 asks 70, it is taken as zero.
+
+    Parameters
+    ----------
+    pressure_pa, fs_hz : array_like, float
+        A record of sound pressure [Pa] and its sampling rate [Hz].
+    bands : array_like
+        Band numbers [-] (default BANDS).
+
+    Returns
+    -------
+    ndarray
+        Mean square per band [Pa^2].
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*.
+    """
     p = np.asarray(pressure_pa, float)
     n = len(p)
     power = np.abs(fft.rfft(p)) ** 2
@@ -92,9 +130,34 @@ def _db(mean_square: ArrayLike) -> NDArray[np.float64]:
 
 def passby_levels(pressure_pa: ArrayLike, fs_hz: float, start_s: float | None = None,
                   end_s: float | None = None) -> PassbyLevels:
-    """The ISO 3095 levels of a calibrated record [Pa] sampled at fs_hz [Hz], the pass between
-    start_s and end_s [s] from the record's start (default: the whole record is the pass).
-    ValueError for a window outside the record or shorter than one sample."""
+    """The ISO 3095 levels of a calibrated pass-by record.
+
+    LpAeq,Tp over the pass, LpAFmax over the record, TEL and SEL, the pass's 1/3-octave spectrum and
+    its tones (module docstring). ValueError for a window outside the record or shorter than one
+    sample.
+
+    Parameters
+    ----------
+    pressure_pa : array_like
+        The calibrated record of the pass-by [Pa].
+    fs_hz : float
+        Its sampling rate [Hz].
+    start_s, end_s : float, optional
+        The train's front and rear at the microphone's plane, from the record's start [s]
+        (default: the record's start and end).
+
+    Returns
+    -------
+    PassbyLevels
+        Levels [dB re 20 uPa], Tp and the record's length [s], band levels and tones.
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.7 and 3.9.
+    .. [2] ISO 3095:2005, *Railway applications - Acoustics - Measurement of noise emitted by
+       railbound vehicles* (transit exposure level).
+    """
     p = np.asarray(pressure_pa, float)
     if p.ndim != 1 or not len(p) or not np.all(np.isfinite(p)):
         raise ValueError("the record must be one channel of finite samples")

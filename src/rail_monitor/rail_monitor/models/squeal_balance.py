@@ -20,18 +20,65 @@ FloatArray = NDArray[np.float64]
 
 
 def critical_slip_velocity(speed: ArrayLike, load: ArrayLike, k3: ArrayLike) -> FloatArray:
-    """u_s = zeta_c V0 = W V0 / k3 [m/s] for rolling speed V0 [m/s], load W [N], k3 [N]."""
+    """The critical slip velocity u_s = zeta_c V0 = W V0 / k3, where the creep curve saturates.
+
+    Parameters
+    ----------
+    speed : array_like
+        Rolling speed V0 [m/s].
+    load : array_like
+        Normal load W [N].
+    k3 : array_like
+        Lateral creep stiffness [N].
+
+    Returns
+    -------
+    ndarray
+        u_s [m/s]: the slip velocity past which the contact slides on the curve's falling
+        branch.
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eq. 4.
+    """
     return np.asarray(load, float) * np.asarray(speed, float) / np.asarray(k3, float)
 
 
 def creep_force(slip_velocity: ArrayLike, speed: ArrayLike, load: ArrayLike,
                 k1: ArrayLike, k2: ArrayLike, k3: ArrayLike) -> FloatArray:
-    """Lateral friction force mu(xi') W [N] at slip velocity Vc + y' [m/s].
+    """Lateral friction force mu(xi') W at a slip velocity.
 
     The UQ paper's piecewise-linear curve, extended as an odd function of the creepage (reverse
-    slip saturates at -k1 and falls with the same slope) and floored at mu = 0 (a falling
-    branch never turns friction into propulsion), so that it stays physical where the closed
-    form's assumptions fail.
+    slip saturates at -k1 and falls with the same slope) and floored at mu = 0 (a falling branch
+    never turns friction into propulsion), so that it stays physical where the closed form's
+    assumptions fail.
+
+    Parameters
+    ----------
+    slip_velocity : array_like
+        Vc + y' [m/s].
+    speed : array_like
+        Rolling speed V0 [m/s].
+    load : array_like
+        Normal load W [N].
+    k1 : array_like
+        Friction peak [-].
+    k2 : array_like
+        Slope of the sliding branch [-].
+    k3 : array_like
+        Lateral creep stiffness [N].
+
+    Returns
+    -------
+    ndarray
+        Force [N], of the sign of the slip velocity (the curve is odd), 0 where the falling
+        branch would cross mu = 0.
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eqs. 3-4.
     """
     u, v0, w = (np.asarray(x, float) for x in (slip_velocity, speed, load))
     xi = u * np.asarray(k3, float) / (v0 * w)
@@ -77,15 +124,32 @@ def _cycle_work(amplitude: FloatArray, speed: FloatArray, crabbing: FloatArray, 
 def harmonic_balance_amplitude(speed: ArrayLike, crabbing: ArrayLike, load: ArrayLike, damping: ArrayLike,
                                k1: ArrayLike, k2: ArrayLike, k3: ArrayLike,
                                resolution: BalanceResolution = FULL_BALANCE) -> FloatArray:
-    """Limit-cycle velocity amplitude A w [m/s] by energy balance over the whole creep curve.
+    """Limit-cycle velocity amplitude by energy balance over the whole creep curve.
 
-    With y' = A cos(theta), the friction force f = mu(xi') W of :func:`creep_force` (adhesion,
-    falling branch, the zero-friction floor and reverse slip, as an odd function) and the damper
-    do no net work over a cycle:  (1/pi) integral_0^2pi f(Vc + A cos theta) cos theta d theta
-    + c A = 0.  The stable limit cycle is the smallest A > 0 at which the work per cycle turns from
+    With y' = A cos(theta), the friction force f = mu(xi') W of :func:`creep_force` and the damper
+    do no net work over a cycle: (1/pi) integral_0^2pi f(Vc + A cos theta) cos theta d theta
+    + c A = 0. The stable limit cycle is the smallest A > 0 at which the work per cycle turns from
     feeding the mode to draining it; found on a log grid of A (1e-3 to 1e3 times Vc + u_s) and
-    refined by bisection. Units and inputs as :func:`limit_cycle_amplitude`; 0 where the mode
-    is not fed at small amplitude (no squeal), NaN where no balance exists on the grid.
+    refined by bisection.
+
+    Parameters
+    ----------
+    speed, crabbing, load, damping, k1, k2, k3 : array_like
+        V0 [m/s], Vc [m/s], W [N], c [N s/m], k1 [-], k2 [-] and k3 [N], as for
+        :func:`rail_monitor.models.squeal.limit_cycle_amplitude`.
+    resolution : BalanceResolution
+        Midpoints, bracket points and halvings of the solution [-].
+
+    Returns
+    -------
+    ndarray
+        A [m/s]: 0 where the mode is not fed at small amplitude (no squeal), NaN where no balance
+        exists on the grid.
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eqs. 3-7 (eq. 7 is the closed form this extends).
     """
     arrays = np.broadcast_arrays(*(np.asarray(x, float) for x in (speed, crabbing, load, damping, k1, k2, k3)))
     shape = arrays[0].shape

@@ -51,8 +51,31 @@ class SquealDetection:
 
 def detect_squeal(pressure_pa: ArrayLike, fs_hz: float, start_s: float | None = None, end_s: float | None = None,
                   min_duration_s: float = 0.5, min_audibility_db: float = 6.0) -> SquealDetection:
-    """Squeal and flanging in the pass between start_s and end_s [s] of a calibrated record [Pa]
-    sampled at fs_hz [Hz] (default: the whole record); see the module's docstring."""
+    """Squeal and flanging noise in a pass of a calibrated record (module docstring).
+
+    Parameters
+    ----------
+    pressure_pa, fs_hz, start_s, end_s : array_like, float, float, float
+        As for :func:`rail_monitor.models.iso3095.passby_levels`: the record [Pa], its sampling
+        rate [Hz] and the pass within it [s] (default: the whole record).
+    min_duration_s : float
+        Shortest squeal counted [s].
+    min_audibility_db : float
+        A frame squeals when its strongest tone's audibility reaches this [dB].
+
+    Returns
+    -------
+    SquealDetection
+        Squeal or not, its tone's frequency [Hz], level [dB re 20 uPa], duration [s] and share [-];
+        flanging or not and its time [s].
+
+    References
+    ----------
+    .. [1] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+       Elsevier, Oxford, 2009, chapter 9 (squeal tonal, at the wheel's axial modes; flanging broadband).
+    .. [2] ISO/PAS 20065:2016, *Acoustics - Objective method for assessing the audibility of tones
+       in noise - Engineering method*.
+    """
     p = np.asarray(pressure_pa, float)
     i1 = 0 if start_s is None else round(start_s * fs_hz)
     i2 = len(p) if end_s is None else round(end_s * fs_hz)

@@ -48,13 +48,42 @@ def simulate_limit_cycle(
     settle_tol: float = 1e-5,
     rtol: float = 1e-8,
 ) -> TimeDomainResult:
-    """Integrate the full nonlinear ODE (module docstring) with scipy's DOP853, no events.
+    """The squeal ODE integrated in time with scipy's DOP853, no events (module docstring).
 
     Starts at the static equilibrium with a small velocity disturbance (default 1 % of Vc),
-    integrates in chunks of ``chunk_cycles`` natural periods and stops when the velocity
-    amplitude of successive chunks changes by less than ``settle_tol`` (relative), or after
-    ``max_cycles``. Independent of the closed form: used by the tests to check it, and
-    available to users. Units as in :func:`limit_cycle_amplitude`; mass [kg], stiffness [N/m].
+    integrates in chunks of ``chunk_cycles`` natural periods and stops when the velocity amplitude
+    of successive chunks changes by less than ``settle_tol`` (relative), or after ``max_cycles``.
+    Independent of the closed form: used by the tests to check it, and available to users.
+
+    Parameters
+    ----------
+    speed, crabbing, load, damping, k1, k2, k3 : float
+        One case in the units of :func:`rail_monitor.models.squeal.limit_cycle_amplitude`:
+        V0 [m/s], Vc [m/s], W [N], c [N s/m], k1 [-], k2 [-], k3 [N].
+    mass : float
+        Modal mass m [kg].
+    stiffness : float
+        Modal stiffness k [N/m].
+    initial_velocity : float, optional
+        The disturbance [m/s] (default 1 % of Vc).
+    max_cycles, chunk_cycles : int
+        Natural periods at most, and per chunk [-].
+    settle_tol : float
+        Relative change of the amplitude that counts as settled [-].
+    rtol : float
+        The integrator's relative tolerance [-].
+
+    Returns
+    -------
+    TimeDomainResult
+        Amplitude [m/s], the last cycles' times [s] and velocities [m/s], cycles [-], settled or not.
+
+    References
+    ----------
+    .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+       acoustic phenomena", seminar paper, section 2.3, eqs. 3-5.
+    .. [2] E. Hairer, S. P. Norsett and G. Wanner, *Solving Ordinary Differential Equations I*,
+       2nd ed., Springer, Berlin, 1993 (DOP853, Dormand and Prince's explicit method of order 8).
     """
     from scipy.integrate import solve_ivp  # lazy: only the tests and --ode integrate
 

@@ -221,10 +221,38 @@ def _exterior_integrals(n: int, r: FloatArray, z: FloatArray, solid: NDArray[np.
 def harmonic_modes(blocks: tuple[tuple[float, float, float, float], ...], material: tuple[float, float, float],
                    n: int, max_hz: float, contact: tuple[float, float], clamp_radius_m: float | None = None,
                    size_m: float = 0.02) -> WheelModes:
-    """Modes of harmonic n below max_hz [Hz] of the solid of revolution made of the blocks
-    (r0, r1, z0, z1) [m], material (E [Pa], nu [-], rho [kg/m3]), meshed with elements of at most
-    size_m [m]; contact (r, z) [m] is where the radial displacement is read; the nodes at
-    clamp_radius_m are fixed (None: a free body, whose rigid-body modes come out near 0 Hz)."""
+    """Modes of one Fourier harmonic of a solid of revolution by axisymmetric finite elements.
+
+    Parameters
+    ----------
+    blocks : tuple of (float, float, float, float)
+        Rectangular blocks (r0, r1, z0, z1) of the cross-section [m].
+    material : (float, float, float)
+        E [Pa], nu [-], rho [kg/m3].
+    n : int
+        Nodal diameters [-].
+    max_hz : float
+        Highest frequency kept [Hz].
+    contact : (float, float)
+        (r, z) where the radial displacement is read [m].
+    clamp_radius_m : float, optional
+        Radius whose nodes are fixed [m] (None: a free body, whose rigid-body modes come out near 0 Hz).
+    size_m : float
+        Largest element [m].
+
+    Returns
+    -------
+    WheelModes
+        Frequencies [Hz], nodal diameters [-], contact displacements [kg^-1/2] and surface
+        integrals [m2/kg] of the modes.
+
+    References
+    ----------
+    .. [1] D. J. Thompson, "Wheel-rail noise generation, part II: wheel vibration", *Journal of
+       Sound and Vibration* 161 (1993) 401-419.
+    .. [2] O. C. Zienkiewicz and R. L. Taylor, *The Finite Element Method*, vol. 1, 5th ed.,
+       Butterworth-Heinemann, Oxford, 2000, section 9.6.
+    """
     r, z, solid = _mesh(blocks, size_m)
     from scipy.sparse.linalg import eigsh
 
@@ -266,8 +294,29 @@ def harmonic_modes(blocks: tuple[tuple[float, float, float, float], ...], materi
 
 
 def wheel_modes(section: WheelSection, max_hz: float = 12000.0, size_m: float = 0.012) -> WheelModes:
-    """All flexible modes of the clamped-bore wheel below max_hz [Hz], harmonics n = 0, 1, ... up to
-    the first whose lowest mode lies above max_hz (elements of at most size_m [m])."""
+    """All flexible modes of the clamped-bore wheel below max_hz, harmonic by harmonic.
+
+    Harmonics n = 0, 1, ... up to the first whose lowest mode lies above max_hz.
+
+    Parameters
+    ----------
+    section : WheelSection
+        The wheel's cross-section [m] and material.
+    max_hz : float
+        Highest frequency kept [Hz].
+    size_m : float
+        Largest element [m].
+
+    Returns
+    -------
+    WheelModes
+        As :func:`harmonic_modes`, over every harmonic.
+
+    References
+    ----------
+    .. [1] D. J. Thompson, "Wheel-rail noise generation, part II: wheel vibration", *Journal of
+       Sound and Vibration* 161 (1993) 401-419.
+    """
     material = (section.young_pa, section.poisson, section.density)
     contact = (section.rolling_radius_m, section.contact_offset_m)
     parts: list[WheelModes] = []
