@@ -56,7 +56,23 @@ class RoughnessSpectrum:
 
 
 def remove_spikes(z_m: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:
-    """The trace [m] with its spikes replaced (see the module), and the mask of samples replaced."""
+    """A trolley's trace with its spikes replaced (module docstring), and which samples were replaced.
+
+    Parameters
+    ----------
+    z_m : array_like
+        Displacement trace [m].
+
+    Returns
+    -------
+    tuple of ndarray
+        The trace [m] and the mask of replaced samples [-].
+
+    References
+    ----------
+    .. [1] EN 15610:2019, *Railway applications - Acoustics - Rail and wheel roughness measurement
+       related to noise generation*, CEN, Brussels, 2019 (spike removal).
+    """
     z = np.asarray(z_m, float)
     h = SPIKE_HALF_WINDOW
     padded = np.pad(z, h, mode="edge")
@@ -75,8 +91,31 @@ def remove_spikes(z_m: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.bool_
 
 def wheel_trace(z_m: ArrayLike, dx_m: float, wheel_radius_m: float = WHEEL_RADIUS_M,
                 reach_m: float = REACH_M) -> NDArray[np.float64]:
-    """The trace [m] a wheel of radius wheel_radius_m [m] sees resting on a rail of trace z_m sampled
-    every dx_m [m] (curvature processing; see the module)."""
+    """The trace a wheel resting on the rail sees: the rail's trace bridged by the wheel's curvature.
+
+    Parameters
+    ----------
+    z_m : array_like
+        The rail's trace [m].
+    dx_m : float
+        Sampling interval along the rail [m].
+    wheel_radius_m : float
+        Wheel radius [m].
+    reach_m : float
+        How far either side of a point the wheel's contact is looked for [m].
+
+    Returns
+    -------
+    ndarray
+        The wheel's trace [m].
+
+    References
+    ----------
+    .. [1] EN 15610:2019, *Railway applications - Acoustics - Rail and wheel roughness measurement
+       related to noise generation*, CEN, Brussels, 2019 (curvature processing).
+    .. [2] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+       Elsevier, Oxford, 2009, section 5.2.
+    """
     z = np.asarray(z_m, float)
     k = int(reach_m / dx_m)
     padded = np.pad(z, k, constant_values=-np.inf)
@@ -88,8 +127,29 @@ def wheel_trace(z_m: ArrayLike, dx_m: float, wheel_radius_m: float = WHEEL_RADIU
 
 
 def band_mean_squares(z_m: ArrayLike, dx_m: float, centres_m: ArrayLike) -> NDArray[np.float64]:
-    """Mean square [m^2] of a trace [m] sampled every dx_m [m] in each wavelength band of centre
-    centres_m [m] (its mean and slope removed; Hann window, power restored)."""
+    """Mean square of a trace in each 1/3-octave wavelength band, its mean and slope removed.
+
+    A Hann window is applied and its power restored.
+
+    Parameters
+    ----------
+    z_m : array_like
+        Trace [m].
+    dx_m : float
+        Sampling interval [m].
+    centres_m : array_like
+        Wavelength band centres [m].
+
+    Returns
+    -------
+    ndarray
+        Mean square roughness per band [m^2]; its root is the band's r.m.s. roughness.
+
+    References
+    ----------
+    .. [1] EN 15610:2019, *Railway applications - Acoustics - Rail and wheel roughness measurement
+       related to noise generation*, CEN, Brussels, 2019 (the one-third-octave wavelength spectrum).
+    """
     z = np.asarray(z_m, float)
     n = len(z)
     x = np.arange(n)
@@ -103,8 +163,28 @@ def band_mean_squares(z_m: ArrayLike, dx_m: float, centres_m: ArrayLike) -> NDAr
 
 
 def roughness_spectrum(z_m: ArrayLike, dx_m: float, wheel_radius_m: float = WHEEL_RADIUS_M) -> RoughnessSpectrum:
-    """Spikes removed, the wheel's trace, the band spectrum of a trolley trace [m] sampled every dx_m
-    [m]: every band the trace resolves (see the module). ValueError for a trace too short or not finite."""
+    """The roughness spectrum of a trolley's trace: spikes removed, the wheel's trace, its band spectrum.
+
+    Every band the trace resolves (module docstring). ValueError for a trace too short or not finite.
+
+    Parameters
+    ----------
+    z_m, dx_m : array_like, float
+        The trolley's trace [m] and its sampling interval [m].
+    wheel_radius_m : float
+        Wheel radius of the curvature processing [m].
+
+    Returns
+    -------
+    RoughnessSpectrum
+        Band centres [m], r.m.s. [m] and level [dB re 1 um] per band, spikes replaced [-] and the
+        trace's length [m].
+
+    References
+    ----------
+    .. [1] EN 15610:2019, *Railway applications - Acoustics - Rail and wheel roughness measurement
+       related to noise generation*, CEN, Brussels, 2019.
+    """
     z = np.asarray(z_m, float)
     if z.ndim != 1 or len(z) < 16 or not np.all(np.isfinite(z)) or not dx_m > 0:
         raise ValueError("a trace needs at least 16 finite samples at a positive spacing")

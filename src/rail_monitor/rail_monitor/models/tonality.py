@@ -47,20 +47,75 @@ class Tone:
 
 
 def critical_bandwidth_hz(frequency_hz: ArrayLike) -> NDArray[np.float64]:
-    """Width of the critical band around frequency_hz [Hz] (Zwicker; ISO/PAS 20065, eq. 3) [Hz]."""
+    """Width of the critical band around a frequency (Zwicker's), 25 + 75 (1 + 1.4 (f / 1 kHz)^2)^0.69.
+
+    Parameters
+    ----------
+    frequency_hz : array_like
+        Frequency f [Hz].
+
+    Returns
+    -------
+    ndarray
+        Critical bandwidth [Hz].
+
+    References
+    ----------
+    .. [1] ISO/PAS 20065:2016, *Acoustics - Objective method for assessing the audibility of tones in
+       noise - Engineering method*, eq. 3.
+    .. [2] E. Zwicker and H. Fastl, *Psychoacoustics: Facts and Models*, 2nd ed., Springer, 1999,
+       section 6.2.
+    """
     f = np.asarray(frequency_hz, float)
     return 25.0 + 75.0 * (1.0 + 1.4 * (f / 1000.0) ** 2) ** 0.69
 
 
 def masking_index_db(frequency_hz: ArrayLike) -> NDArray[np.float64]:
-    """Masking index a_v [dB] at frequency_hz [Hz] (ISO/PAS 20065, eq. 9)."""
+    """The masking index a_v of a tone at a frequency.
+
+    Parameters
+    ----------
+    frequency_hz : array_like
+        Frequency [Hz].
+
+    Returns
+    -------
+    ndarray
+        a_v [dB].
+
+    References
+    ----------
+    .. [1] ISO/PAS 20065:2016, *Acoustics - Objective method for assessing the audibility of tones in
+       noise - Engineering method*, eq. 9.
+    """
     return -2.0 - np.log10(1.0 + (np.asarray(frequency_hz, float) / 502.0) ** 2.5)
 
 
 def density(pressure_pa: ArrayLike, fs_hz: float, resolution_hz: float = 2.0) -> tuple[NDArray, NDArray]:
-    """Frequencies [Hz] and power spectral density [Pa^2/Hz] of a pressure record [Pa] sampled at
-    fs_hz [Hz]: Welch's average of Hann-windowed segments of 1/resolution_hz seconds, half overlapping
-    (one segment, zero-padded, when the record is shorter)."""
+    """Power spectral density of a pressure record by Welch's method.
+
+    Hann-windowed segments of 1 / resolution_hz seconds, half overlapping, averaged (one segment,
+    zero-padded, when the record is shorter).
+
+    Parameters
+    ----------
+    pressure_pa, fs_hz : array_like, float
+        The record [Pa], sampled at fs_hz [Hz].
+    resolution_hz : float
+        Line spacing [Hz].
+
+    Returns
+    -------
+    tuple of ndarray
+        Frequencies [Hz] and the density [Pa^2/Hz].
+
+    References
+    ----------
+    .. [1] ISO/PAS 20065:2016, *Acoustics - Objective method for assessing the audibility of tones in
+       noise - Engineering method* (the narrow-band spectrum).
+    .. [2] P. D. Welch, "The use of fast Fourier transform for the estimation of power spectra",
+       *IEEE Transactions on Audio and Electroacoustics* 15(2) (1967) 70-73.
+    """
     p = np.asarray(pressure_pa, float)
     n = round(fs_hz / resolution_hz)
     return signal.welch(p, fs_hz, window="hann", nperseg=min(n, len(p)), nfft=n, noverlap=None,
@@ -69,8 +124,31 @@ def density(pressure_pa: ArrayLike, fs_hz: float, resolution_hz: float = 2.0) ->
 
 def tones(pressure_pa: ArrayLike, fs_hz: float, low_hz: float = 50.0, high_hz: float = 10_000.0,
           resolution_hz: float = 2.0) -> list[Tone]:
-    """The tonal components between low_hz and high_hz [Hz] of a pressure record [Pa], strongest
-    audibility first (see the module's docstring); only those with a positive audibility."""
+    """The audible tonal components of a pressure record, strongest audibility first (module docstring).
+
+    Only those with a positive audibility.
+
+    Parameters
+    ----------
+    pressure_pa : array_like
+        A calibrated record [Pa].
+    fs_hz : float
+        Its sampling rate [Hz].
+    low_hz, high_hz : float
+        The range searched [Hz].
+    resolution_hz : float
+        The spectrum's line spacing [Hz].
+
+    Returns
+    -------
+    list of Tone
+        Frequency [Hz], tone level L_T and masking level L_G [dB re 20 uPa], audibility [dB].
+
+    References
+    ----------
+    .. [1] ISO/PAS 20065:2016, *Acoustics - Objective method for assessing the audibility of tones in
+       noise - Engineering method*.
+    """
     f, psd = density(pressure_pa, fs_hz, resolution_hz)
     df = f[1] - f[0]
     with np.errstate(divide="ignore"):

@@ -89,7 +89,25 @@ class Track:
 
 
 def support_stiffness(frequency: ArrayLike, track: Track) -> ComplexArray:
-    """Dynamic stiffness K [N/m] of one rail seat (pad, half-sleeper mass, ballast) at frequency [Hz]."""
+    """Dynamic stiffness of one rail seat: K = k_p* (k_b* - m_s w^2) / (k_p* + k_b* - m_s w^2).
+
+    Parameters
+    ----------
+    frequency : array_like
+        Frequency [Hz].
+    track : Track
+        Rail, pad, half-sleeper and ballast parameters (SI: [m], [kg], [N/m], [Pa], loss factors [-]).
+
+    Returns
+    -------
+    ndarray of complex
+        K [N/m]; the pad's and the ballast's loss factors give its imaginary part.
+
+    References
+    ----------
+    .. [1] K. Knothe and S. L. Grassie, "Modelling of railway track and vehicle/track interaction at
+       high frequencies", *Vehicle System Dynamics* 22(3-4) (1993) 209-262.
+    """
     kp, lower = _seat(frequency, track)
     return kp * lower / (kp + lower)
 
@@ -138,7 +156,29 @@ def _green(x: ArrayLike, poles: tuple[ComplexArray, ...]) -> ComplexArray:
 
 def continuous_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko",
                           distance: ArrayLike = 0.0) -> ComplexArray:
-    """Rail receptance [m/N] on the smeared support s = K / d, at distance [m] from the force."""
+    """Rail receptance on the smeared support s = K / d, at a distance from the force.
+
+    Parameters
+    ----------
+    frequency, track : array_like, Track
+        As for :func:`support_stiffness`: frequency [Hz] and the track (SI) [-].
+    beam : str
+        'timoshenko' or 'euler' [-].
+    distance : array_like
+        From the force along the rail [m].
+
+    Returns
+    -------
+    ndarray of complex
+        Receptance [m/N]: the rail's displacement over the force, in magnitude and phase.
+
+    References
+    ----------
+    .. [1] K. Knothe and S. L. Grassie, "Modelling of railway track and vehicle/track interaction at
+       high frequencies", *Vehicle System Dynamics* 22(3-4) (1993) 209-262.
+    .. [2] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+       Elsevier, Oxford, 2009, chapter 3.
+    """
     f = np.asarray(frequency, float)
     w = 2 * np.pi * f
     s = support_stiffness(f, track) / track.sleeper_spacing_m
@@ -146,13 +186,27 @@ def continuous_receptance(frequency: ArrayLike, track: Track, beam: str = "timos
 
 
 def decay_rate(frequency: ArrayLike, track: Track, beam: str = "timoshenko") -> NDArray[np.float64]:
-    """Track decay rate [dB/m] of the continuous model: 20 lg(e) Im(k) of its propagating wave.
+    """Track decay rate of the continuous model, 20 lg(e) Im(k) of its propagating wave.
 
     Of the two wavenumbers, the propagating one has the smaller Im(k) (the other is the near field
-    or, above the cut-on, the second wave). The squared vibration of a rail excited at x = 0
-    falls as exp(-2 Im(k) |x|), so its integral along the rail is |v0|^2 / Im(k) (Thompson,
-    Railway Noise and Vibration, Elsevier 2009, section 5.6: the effective radiating length of
-    the rail, 2 x 4.343 / decay rate).
+    or, above the cut-on, the second wave). The squared vibration of a rail excited at x = 0 falls
+    as exp(-2 Im(k) |x|), so its integral along the rail is |v0|^2 / Im(k): the rail's effective
+    radiating length is 2 x 4.343 / decay rate.
+
+    Parameters
+    ----------
+    frequency, track, beam : array_like, Track, str
+        As for :func:`continuous_receptance`: frequency [Hz], the track (SI), the beam theory [-].
+
+    Returns
+    -------
+    ndarray
+        Decay rate [dB/m].
+
+    References
+    ----------
+    .. [1] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+       Elsevier, Oxford, 2009, section 5.6.
     """
     f = np.asarray(frequency, float)
     s = support_stiffness(f, track) / track.sleeper_spacing_m
@@ -161,7 +215,23 @@ def decay_rate(frequency: ArrayLike, track: Track, beam: str = "timoshenko") -> 
 
 
 def sleeper_transmissibility(frequency: ArrayLike, track: Track) -> ComplexArray:
-    """Half-sleeper over rail displacement [-] at a rail seat: k_p* / (k_p* + k_b* - m_s w^2)."""
+    """Half-sleeper displacement over rail displacement at a seat, k_p* / (k_p* + k_b* - m_s w^2).
+
+    Parameters
+    ----------
+    frequency, track : array_like, Track
+        As for :func:`support_stiffness`: frequency [Hz] and the track (SI) [-].
+
+    Returns
+    -------
+    ndarray of complex
+        The ratio [-].
+
+    References
+    ----------
+    .. [1] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+       Elsevier, Oxford, 2009, chapter 3 (the two-layer support).
+    """
     kp, lower = _seat(frequency, track)
     return kp / (kp + lower)
 
@@ -171,11 +241,28 @@ _FREQUENCIES_AT_ONCE = 50  # 50 x 121 x 121 complex: 12 MB per array
 
 def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", position: ArrayLike = 0.5,
                         supports: int = 121) -> ComplexArray:
-    """Rail point receptance [m/N] on discrete supports, the force at ``position`` of a bay.
+    """Rail point receptance on discrete supports, the force at a position within a bay.
 
-    position: fraction of the sleeper spacing from a support (0 above a sleeper, 0.5 mid-span);
-    several positions share one factorisation per frequency. supports: number of rail seats
-    (odd, at least 3). Returns shape frequency.shape + position.shape.
+    Several positions share one factorisation per frequency.
+
+    Parameters
+    ----------
+    frequency, track, beam : array_like, Track, str
+        As for :func:`continuous_receptance`: frequency [Hz], the track (SI), the beam theory [-].
+    position : array_like
+        Fraction of the sleeper spacing from a support [-] (0 above a sleeper, 0.5 mid-span).
+    supports : int
+        Rail seats modelled (odd, at least 3) [-].
+
+    Returns
+    -------
+    ndarray of complex
+        Receptance [m/N], shape frequency.shape + position.shape.
+
+    References
+    ----------
+    .. [1] K. Knothe and S. L. Grassie, "Modelling of railway track and vehicle/track interaction at
+       high frequencies", *Vehicle System Dynamics* 22(3-4) (1993) 209-262 (periodically supported track).
     """
     if supports < 3 or supports % 2 == 0:
         raise ValueError("supports must be odd and at least 3")
@@ -206,13 +293,48 @@ def discrete_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshe
 
 def bay_averaged_receptance(frequency: ArrayLike, track: Track, beam: str = "timoshenko", positions: int = 8,
                             supports: int = 121) -> ComplexArray:
-    """Discrete-support receptance [m/N] averaged over ``positions`` equally spaced points of a bay."""
+    """Discrete-support receptance averaged over equally spaced points of a bay.
+
+    Parameters
+    ----------
+    frequency, track, beam : array_like, Track, str
+        As for :func:`continuous_receptance`: frequency [Hz], the track (SI), the beam theory [-].
+    positions : int
+        Points of the bay averaged [-].
+    supports : int
+        Rail seats modelled [-].
+
+    Returns
+    -------
+    ndarray of complex
+        Mean receptance over the bay [m/N].
+
+    References
+    ----------
+    .. [1] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+       Elsevier, Oxford, 2009, chapter 3 (the receptance over a bay).
+    """
     xs = (np.arange(positions) + 0.5) / positions
     return discrete_receptance(frequency, track, beam, xs, supports).mean(axis=-1)
 
 
 def static_stiffness(track: Track) -> float:
-    """Winkler static stiffness 2 s / beta [N/m] of the continuous model (Hetenyi 1946), s = K(0) / d."""
+    """Winkler static stiffness of the continuous model, 2 s / beta, s = K(0) / d.
+
+    Parameters
+    ----------
+    track : Track
+        The track; its support at 0 Hz and the rail's bending stiffness [N/m, N m2] matter.
+
+    Returns
+    -------
+    float
+        Stiffness [N/m].
+
+    References
+    ----------
+    .. [1] M. Hetenyi, *Beams on Elastic Foundation*, University of Michigan Press, Ann Arbor, 1946.
+    """
     s = 1.0 / (1.0 / track.pad_stiffness_npm + 1.0 / track.ballast_stiffness_npm) / track.sleeper_spacing_m
     beta = (s / (4.0 * track.young_modulus_pa * track.second_moment_m4)) ** 0.25
     return 2.0 * s / beta
@@ -220,10 +342,28 @@ def static_stiffness(track: Track) -> float:
 
 def wheel_receptance(frequency: ArrayLike, unsprung_mass: float = 600.0,
                      modes: tuple[tuple[float, float, float], ...] = ()) -> ComplexArray:
-    """Vertical wheel receptance [m/N] at the contact: rigid unsprung mass [kg] plus modes.
+    """Vertical wheel receptance at the contact: the rigid unsprung mass plus the wheel's modes.
 
-    modes: (natural frequency [Hz], modal mass [kg], damping ratio [-]) of each wheel mode
-    seen at the contact, added as 1 / (m_n (w_n^2 - w^2 + 2 i zeta_n w_n w)).
+    Each mode adds 1 / (m_n (w_n^2 - w^2 + 2 i zeta_n w_n w)).
+
+    Parameters
+    ----------
+    frequency : array_like
+        Frequency [Hz].
+    unsprung_mass : float
+        Unsprung mass per wheel [kg].
+    modes : tuple of (float, float, float)
+        (natural frequency [Hz], modal mass [kg], damping ratio [-]) of each mode seen at the contact.
+
+    Returns
+    -------
+    ndarray of complex
+        Receptance [m/N].
+
+    References
+    ----------
+    .. [1] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
+       Elsevier, Oxford, 2009, the chapter on wheel vibration.
     """
     w = 2 * np.pi * np.asarray(frequency, float)
     out = -1.0 / (unsprung_mass * w**2) + 0j
