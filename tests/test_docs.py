@@ -72,7 +72,8 @@ def test_one_version_everywhere():
 
 # The model modules whose public functions are documented as pvlib documents its own (issue 53):
 # numpydoc Parameters (each with its unit in brackets), Returns and References. Grows module by module.
-NUMPYDOC_MODULES = ("axle_layout", "calibration", "contact_filter", "corrugation", "ground", "hertz", "iec61672",
+NUMPYDOC_MODULES = ("axle_layout", "calibration", "cnossos", "cnossos_bands", "cnossos_tables", "contact_filter",
+                    "corrugation", "ground", "hertz", "iec61672",
                     "iso3095", "kalker", "levels", "radiation", "rail_roughness", "squeal", "squeal_balance",
                     "squeal_detection", "squeal_ode", "tonality", "track", "wheel_modes")
 
@@ -92,8 +93,9 @@ def _numpydoc_sections(doc: str) -> dict[str, list[str]]:
 def _numpydoc_faults(fn: ast.FunctionDef) -> list[str]:
     doc = ast.get_docstring(fn) or ""
     sections = _numpydoc_sections(doc)
-    faults = [f"no {s}" for s in ("Parameters", "Returns", "References") if s not in sections]
     names = [a.arg for a in (*fn.args.posonlyargs, *fn.args.args, *fn.args.kwonlyargs)]
+    wanted = ("Parameters", "Returns", "References") if names else ("Returns", "References")
+    faults = [f"no {s}" for s in wanted if s not in sections]
     entries: dict[str, str] = {}
     current: list[str] = []
     for line in sections.get("Parameters", []):
@@ -118,4 +120,4 @@ def test_public_model_functions_are_documented_with_units_and_references():
             if isinstance(fn, ast.FunctionDef) and not fn.name.startswith("_"):
                 assert not _numpydoc_faults(fn), f"models/{name}.py: {fn.name}: {_numpydoc_faults(fn)}"
                 checked += 1
-    assert checked >= 79
+    assert checked >= 111

@@ -53,6 +53,25 @@ NOISEMODELLING_WAVELENGTH_M = 10.0 ** (np.arange(-1, 34) / 10.0) / 1e3
 
 
 def check_rule(rule: str, edition: str = DEFAULT_EDITION) -> str:
+    """The interpolation rule, or a ValueError naming the known ones (or the edition it lacks).
+
+    Parameters
+    ----------
+    rule : str
+        'reference' or 'noisemodelling' [-].
+    edition : str
+        '2021' or '2015' [-]: its tables the rule's implementation must hold.
+
+    Returns
+    -------
+    str
+        The rule, checked [-].
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, section 2.3.2 (the spectra
+       "averaged energetically and proportionally").
+    """
     if rule not in INTERPOLATION_RULES:
         raise ValueError(f"unknown interpolation rule {rule!r}; use one of {INTERPOLATION_RULES}")
     return check_rule_edition(rule, edition)
@@ -61,10 +80,38 @@ def check_rule(rule: str, edition: str = DEFAULT_EDITION) -> str:
 def band_roughness(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter_db: ArrayLike, speed_mps: ArrayLike,
                    band_hz: ArrayLike | None = None, rule: str = "reference",
                    impact_db: ArrayLike | None = None, edition: str = DEFAULT_EDITION) -> FloatArray:
-    """L_R,TOT per band [dB re 1 um] (eqs. 2.3.6 and 2.3.10) at lambda = v / f_i: shape
-    speed.shape + (bands,). The tables are on the tables' grid (the rail roughness may carry a
-    leading axis per pass); band_hz: nominal band centres (default the tables'). The order of
-    operations is the rule's (module docstring); the grid is the edition's."""
+    """L_R,TOT per band at lambda = v / f_i, in the rule's order of operations (module docstring).
+
+    The tables are on the edition's grid (the rail roughness may carry a leading axis per pass).
+
+    Parameters
+    ----------
+    rail_db, wheel_db : array_like
+        Rail and wheel roughness [dB re 1 um] on the grid.
+    contact_filter_db : array_like
+        A_3 [dB] on the grid.
+    speed_mps : array_like
+        Speed v [m/s].
+    band_hz : array_like, optional
+        Nominal band centres [Hz] (default the tables').
+    rule : str
+        'reference' or 'noisemodelling' [-].
+    impact_db : array_like, optional
+        Impact roughness [dB re 1 um] on the grid.
+    edition : str
+        '2021' or '2015' [-]: its wavelength grid.
+
+    Returns
+    -------
+    ndarray
+        L_R,TOT [dB re 1 um], shape speed.shape + (bands,).
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, section 2.3.2, eqs. 2.3.6 and
+       2.3.10; corrigendum, OJ L 5, 10.1.2018.
+    .. [2] NoiseModelling (Universite Gustave Eiffel, CNRS), noisemodelling-emission, railway/cnossos.
+    """
     if check_rule(rule, edition) == "noisemodelling":
         rough = power(rail_db) + power(wheel_db)
         if impact_db is not None:
@@ -79,9 +126,26 @@ def band_roughness_power(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter
                          speed_mps: ArrayLike, band_hz: ArrayLike | None = None, rule: str = "reference",
                          impact_db: ArrayLike | None = None, edition: str = DEFAULT_EDITION,
                          rail_power: FloatArray | None = None) -> FloatArray:
-    """band_roughness as a power ratio re (1 um)^2, summed in energy without a round trip through
-    decibels (the ``reference`` rule; the ``noisemodelling`` rule's is 10^(L/10) of its level).
-    rail_power: the rail's power_at_bands, where the caller has it (the reference rule)."""
+    """:func:`band_roughness` as a power ratio re (1 um)^2, summed in energy without decibels between.
+
+    The ``noisemodelling`` rule's is 10^(L/10) of its level.
+
+    Parameters
+    ----------
+    rail_db, wheel_db, contact_filter_db, speed_mps, band_hz, rule, impact_db, edition : various
+        As for :func:`band_roughness` ([dB], [m/s], [Hz], [-]).
+    rail_power : ndarray, optional
+        The rail's :func:`power_at_bands` where the caller has it [-] (the reference rule).
+
+    Returns
+    -------
+    ndarray
+        Power ratio [-], shape speed.shape + (bands,).
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, section 2.3.2, eq. 2.3.6.
+    """
     if check_rule(rule, edition) == "noisemodelling":
         return power(band_roughness(rail_db, wheel_db, contact_filter_db, speed_mps, band_hz, rule, impact_db,
                                     edition))
@@ -97,9 +161,31 @@ def band_roughness_power(rail_db: ArrayLike, wheel_db: ArrayLike, contact_filter
 
 def power_at_bands(table: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
                    edition: str = DEFAULT_EDITION) -> FloatArray:
-    """10^(L/10) of a spectrum on the edition's grid [dB] read at lambda = v / f_i by the reference
-    rule: shape speed.shape + (bands,). One spectrum (a class's or the site's) is cached, being read
-    at the same passes' speeds by every model and the baseline; one per pass is not."""
+    """10^(L/10) of a spectrum on the edition's grid, read at lambda = v / f_i by the reference rule.
+
+    One spectrum (a class's or the site's) is cached, being read at the same passes' speeds by every
+    model and the baseline; one per pass is not.
+
+    Parameters
+    ----------
+    table : array_like
+        Spectrum [dB] on the grid.
+    speed_mps : array_like
+        Speed [m/s].
+    band_hz : array_like, optional
+        Nominal band centres [Hz].
+    edition : str
+        '2021' or '2015' [-]: its wavelength grid.
+
+    Returns
+    -------
+    ndarray
+        The spectrum's power ratio 10^(L/10) at the bands [-], shape speed.shape + (bands,).
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, section 2.3.2.
+    """
     if np.ndim(table) == 1:
         speed, f = np.asarray(speed_mps, float), tables(edition).band_hz if band_hz is None else band_hz
         return _power_at(np.asarray(table, float).tobytes(), speed.tobytes(), speed.shape,
@@ -110,21 +196,76 @@ def power_at_bands(table: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | 
 def contact_filter_at_patch(filter_db: ArrayLike, speed_mps: ArrayLike, table_patch_m: float,
                             patch_m: ArrayLike, band_hz: ArrayLike | None = None, rule: str = "reference",
                             edition: str = DEFAULT_EDITION) -> FloatArray:
-    """A contact filter tabulated for one contact (A3 of Table G-2, for a patch of semi-length a_0
-    along the rail = table_patch_m [m]) at another contact of semi-length a (patch_m [m], per
-    pass): a contact filter is a function of the wavenumber times the contact length (Remington,
-    JASA 81, 1987; Ford & Thompson, JSV 293, 2006), H(k a), so the table is read at
-    lambda a_0 / a, that is at the speed v a_0 / a: shape speed.shape + (bands,) [dB]. Patches of
-    one shape (aspect ratio) assumed."""
+    """A contact filter tabulated for one contact read for another of different length.
+
+    A contact filter is a function of the wavenumber times the contact length, H(k a), so the table
+    (for a patch of semi-length a_0) is read at lambda a_0 / a, that is at the speed v a_0 / a.
+    Patches of one shape (aspect ratio) assumed.
+
+    Parameters
+    ----------
+    filter_db : array_like
+        A_3 [dB] on the grid (Table G-2).
+    speed_mps : array_like
+        Speed [m/s].
+    table_patch_m : float
+        a_0, the table's patch semi-length along the rail [m].
+    patch_m : array_like
+        a, the pass's [m].
+    band_hz : array_like, optional
+        Nominal band centres [Hz].
+    rule : str
+        'reference' or 'noisemodelling' [-].
+    edition : str
+        '2021' or '2015' [-]: its wavelength grid of the filter.
+
+    Returns
+    -------
+    ndarray
+        A_3 at the bands [dB], shape speed.shape + (bands,).
+
+    References
+    ----------
+    .. [1] P. J. Remington, "Wheel/rail rolling noise, I: Theoretical analysis", *Journal of the
+       Acoustical Society of America* 81(6) (1987) 1805-1823 (a filter of the wavenumber times the
+       contact length).
+    .. [2] R. A. J. Ford and D. J. Thompson, *Journal of Sound and Vibration* 293(3-5) (2006) 807-818.
+    .. [3] Commission Delegated Directive (EU) 2021/1226 (OJ L 269, 28.7.2021), Annex, Table G-2.
+    """
     speed = np.asarray(speed_mps, float) * table_patch_m / np.asarray(patch_m, float)
     return at_band_frequencies(filter_db, speed, band_hz, rule, edition)
 
 
 def at_band_frequencies(level_db: ArrayLike, speed_mps: ArrayLike, band_hz: ArrayLike | None = None,
                         rule: str = "reference", edition: str = DEFAULT_EDITION) -> FloatArray:
-    """A spectrum on the tables' wavelength grid [dB], last axis (it may carry leading axes
-    matching speed, one spectrum per pass), read at lambda = v / f_i by the rule: shape
-    speed.shape + (bands,). band_hz: nominal band centres [Hz] (default the tables')."""
+    """A spectrum on the tables' wavelength grid read at lambda = v / f_i by the rule.
+
+    The spectrum's last axis is the grid; it may carry leading axes matching speed (one spectrum per
+    pass).
+
+    Parameters
+    ----------
+    level_db : array_like
+        Spectrum [dB].
+    speed_mps : array_like
+        Speed [m/s].
+    band_hz : array_like, optional
+        Nominal band centres [Hz] (default the tables').
+    rule : str
+        'reference' or 'noisemodelling' [-].
+    edition : str
+        '2021' or '2015' [-]: its wavelength grid of the spectrum.
+
+    Returns
+    -------
+    ndarray
+        Levels [dB], shape speed.shape + (bands,).
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, section 2.3.2; corrigendum, OJ L 5,
+       10.1.2018 (f = v / lambda, v in m/s).
+    """
     t = tables(edition)
     f = t.band_hz if band_hz is None else np.asarray(band_hz, float)
     speed = np.asarray(speed_mps, float)

@@ -32,7 +32,22 @@ DEFAULT_EDITION = "2021"
 
 
 def table_rows(text: str) -> list[list[str]]:
-    """The rows of a table file's text: CSV, lines starting with # are comments."""
+    """The rows of a table file's text: CSV, lines starting with # are comments.
+
+    Parameters
+    ----------
+    text : str
+        The file's text [-].
+
+    Returns
+    -------
+    list of list of str
+        Rows of cells.
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, Appendix G (the tables the files hold).
+    """
     return [[cell.strip() for cell in r] for r in csv.reader(io.StringIO(text)) if r and not r[0].startswith("#")]
 
 
@@ -84,19 +99,70 @@ class Tables:
 
 
 def as_tables(edition: str | Tables) -> Tables:
-    """The tables themselves, or an edition's (a site's own catalogue: models.cnossos_catalogue)."""
+    """The tables themselves, or an edition's.
+
+    Parameters
+    ----------
+    edition : str or Tables
+        '2021' (in force) or '2015', or a site's own tables (models.cnossos_catalogue) [-]: its tables.
+
+    Returns
+    -------
+    Tables
+        Appendix G of the edition (wavelength grid [m], band centres [Hz], levels [dB]).
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, Appendix G.
+    """
     return edition if isinstance(edition, Tables) else tables(edition)
 
 
 def check_edition(edition: str) -> str:
-    """The edition, or a ValueError naming the known ones."""
+    """The edition, or a ValueError naming the known ones.
+
+    An edition is one text of Appendix G: 2015's, or 2021's as amended.
+
+    Parameters
+    ----------
+    edition : str
+        '2021' or '2015' [-]: its name, to be checked.
+
+    Returns
+    -------
+    str
+        The edition [-], '2021' or '2015' (a ValueError names them for any other).
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, Appendix G (edition 2015).
+    .. [2] Commission Delegated Directive (EU) 2021/1226 (OJ L 269, 28.7.2021), Annex (edition 2021).
+    """
     if edition not in EDITIONS:
         raise ValueError(f"unknown CNOSSOS-EU edition {edition!r}; use one of {EDITIONS}")
     return edition
 
 
 def check_rule_edition(rule: str, edition: str) -> str:
-    """The interpolation rule, refused where its implementation has no tables of the edition."""
+    """The interpolation rule, refused where its implementation has no tables of the edition.
+
+    Parameters
+    ----------
+    rule : str
+        'reference' or 'noisemodelling' [-].
+    edition : str
+        '2021' or '2015' [-]: its tables the rule needs.
+
+    Returns
+    -------
+    str
+        The rule [-].
+
+    References
+    ----------
+    .. [1] NoiseModelling (Universite Gustave Eiffel, CNRS), noisemodelling-emission, railway/cnossos
+       (its tables' edition).
+    """
     if rule == "noisemodelling" and check_edition(edition) != "2021":
         raise ValueError("the noisemodelling interpolation rule reads the 2021 edition's tables only")
     return rule
@@ -104,7 +170,25 @@ def check_rule_edition(rule: str, edition: str) -> str:
 
 @lru_cache(maxsize=len(EDITIONS))
 def tables(edition: str = DEFAULT_EDITION) -> Tables:
-    """The Appendix G tables of an edition (read once)."""
+    """The Appendix G tables of an edition, read once from the package's data files.
+
+    Parameters
+    ----------
+    edition : str
+        '2021' or '2015' [-]: its tables to read.
+
+    Returns
+    -------
+    Tables
+        Wavelength tables on an ascending grid [m], frequency tables on the 24 nominal bands [Hz],
+        levels [dB].
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, Appendix G.
+    .. [2] Commission Delegated Directive (EU) 2021/1226 (OJ L 269, 28.7.2021), Annex, Tables G-1b, G-2, G-3a, G-4
+       and G-7.
+    """
     check_edition(edition)
     head, data = _read(f"cnossos_eu_{edition}_wavelength.csv")
     order = np.argsort(data[:, 0])
@@ -116,15 +200,36 @@ def tables(edition: str = DEFAULT_EDITION) -> Tables:
 
 
 def printed_wheel_roughness() -> tuple[FloatArray, dict[str, FloatArray]]:
-    """Table G-1a as printed (rounded): wavelength labels [m] and levels by column [dB re 1 um]."""
+    """Table G-1a as printed (rounded): its wavelength labels and its levels by column.
+
+    Returns
+    -------
+    tuple
+        Wavelength labels [m] and {brake type: levels [dB re 1 um]}.
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, Table G-1a.
+    """
     head, data = _read("cnossos_eu_2021_g1a_printed.csv")
     return data[:, 0] / 1e3, {h: data[:, j] for j, h in enumerate(head) if j}
 
 
 @lru_cache(maxsize=1)
 def noisemodelling_wheel_roughness() -> dict[str, FloatArray]:
-    """Table G-1a's wheel roughness [dB re 1 um] at the full precision of NoiseModelling's data, by
-    brake type, on the tables' grid (data/noisemodelling_wheel_roughness.csv)."""
+    """Table G-1a's wheel roughness at the full precision of NoiseModelling's data, on the tables' grid.
+
+    From data/noisemodelling_wheel_roughness.csv.
+
+    Returns
+    -------
+    dict
+        {brake type: levels [dB re 1 um]}.
+
+    References
+    ----------
+    .. [1] NoiseModelling (Universite Gustave Eiffel, CNRS), noisemodelling-emission, railway/cnossos.
+    """
     head, data = _read("noisemodelling_wheel_roughness.csv")
     order = np.argsort(data[:, 0])
     if not np.array_equal(data[order, 0] / 1e3, tables().wavelength_m):
