@@ -32,30 +32,110 @@ _NOMINAL_DECADE = (10.0, 12.5, 16.0, 20.0, 25.0, 31.5, 40.0, 50.0, 63.0, 80.0)
 
 
 def band_index(nominal_hz: ArrayLike) -> NDArray[np.int64]:
-    """Band number x (1 kHz is 0) of nominal mid-band frequencies [Hz]."""
+    """Band numbers x of nominal mid-band frequencies (1 kHz is band 0).
+
+    Parameters
+    ----------
+    nominal_hz : array_like
+        Nominal mid-band frequencies [Hz].
+
+    Returns
+    -------
+    ndarray of int
+        x [-].
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*, Annex E (the nominal labels).
+    """
     return np.rint(10.0 * np.log10(np.asarray(nominal_hz, float) / REFERENCE_HZ)).astype(np.int64)
 
 
 def exact_centre(x: ArrayLike) -> FloatArray:
-    """Exact mid-band frequency [Hz] of band number x (IEC 61260-1 eq. 2, base ten, b = 3)."""
+    """Exact mid-band frequency of band x, f_m = 1000 G^(x/3) Hz, G = 10^(3/10).
+
+    Parameters
+    ----------
+    x : array_like
+        Band number [-] (1 kHz is 0; any integer).
+
+    Returns
+    -------
+    ndarray
+        f_m [Hz].
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*, eq. 2 (base ten, b = 3).
+    """
     return REFERENCE_HZ * G ** (np.asarray(x, float) / 3.0)
 
 
 def nominal_centre(x: ArrayLike) -> FloatArray:
-    """Nominal mid-band frequency [Hz] of band number x (Annex E labels)."""
+    """Nominal mid-band frequency (the band's label) of band x.
+
+    Parameters
+    ----------
+    x : array_like
+        Band number [-] within Annex E's labelled range.
+
+    Returns
+    -------
+    ndarray
+        Nominal frequency [Hz], as Annex E prints it.
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*, Annex E.
+    """
     x = np.asarray(x, np.int64)
     decade, step = np.divmod(x + 30, 10)
     return np.asarray(_NOMINAL_DECADE, float)[step] * 10.0 ** (decade - 1)
 
 
 def band_edges(x: ArrayLike) -> tuple[FloatArray, FloatArray]:
-    """Lower and upper band-edge frequencies [Hz] of band number x (eqs. 4-5)."""
+    """Lower and upper band-edge frequencies of band x, f_m G^(-1/6) and f_m G^(1/6).
+
+    Parameters
+    ----------
+    x : array_like
+        Band number [-]; the edges follow from its exact centre.
+
+    Returns
+    -------
+    tuple of ndarray
+        The lower and upper edges [Hz].
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*, eqs. 4-5.
+    """
     fm = exact_centre(x)
     return fm * G ** (-1.0 / 6.0), fm * G ** (1.0 / 6.0)
 
 
 def third_octave_bands(lowest_hz: float, highest_hz: float) -> NDArray[np.int64]:
-    """Band numbers from the band named lowest_hz to the band named highest_hz (nominal) inclusive."""
+    """Band numbers from the band named lowest_hz to the band named highest_hz, inclusive.
+
+    Parameters
+    ----------
+    lowest_hz, highest_hz : float
+        Nominal frequencies of the first and last band [Hz].
+
+    Returns
+    -------
+    ndarray of int
+        x [-], ascending.
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*, Annex E.
+    """
     return np.arange(int(band_index(lowest_hz)), int(band_index(highest_hz)) + 1)
 
 
@@ -63,8 +143,27 @@ ORDER = 3  # Butterworth order of the band filters
 
 
 def band_power_response(frequency_hz: ArrayLike, x: ArrayLike) -> FloatArray:
-    """|H(f)|^2 of the filters of band numbers x at frequency_hz [Hz]: shape x.shape + f.shape (a
-    Butterworth band-pass of order ORDER, -3 dB at the band edges; 0 at 0 Hz)."""
+    """|H(f)|^2 of the filters of bands x: Butterworth band-passes of order ORDER, -3 dB at the edges.
+
+    0 at 0 Hz. Class 1 attenuation limits are met (tests).
+
+    Parameters
+    ----------
+    frequency_hz : array_like
+        Frequency f [Hz].
+    x : array_like
+        Band numbers [-].
+
+    Returns
+    -------
+    ndarray
+        |H|^2 [-], shape x.shape + f.shape.
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*, 5.10 (the relative attenuation limits it meets).
+    """
     f = np.asarray(frequency_hz, float)
     fm = exact_centre(np.asarray(x))[..., None] if np.ndim(x) else exact_centre(x)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -82,10 +181,27 @@ _CLASS1_OCTAVE = ((0.0, -0.3, 0.3), (1 / 8, -0.3, 0.4), (1 / 4, -0.3, 0.6), (3 /
 
 
 def class1_attenuation_limits(b: int = 3) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Normalised frequencies f/f_m of the class 1 breakpoints of a 1/b-octave filter (both sides of
-    the band) and the minimum and maximum relative attenuation [dB] there. The octave breakpoints
-    G^k map to 1 + (G^(1/(2b)) - 1) / (G^(1/2) - 1) (G^k - 1) above the band centre, and to their
-    reciprocals below (IEC 61260-1:2014, 5.10)."""
+    """The class 1 breakpoints of a 1/b-octave filter and the relative attenuation allowed there.
+
+    The octave breakpoints G^k map to 1 + (G^(1/(2b)) - 1) / (G^(1/2) - 1) (G^k - 1) above the band
+    centre, and to their reciprocals below.
+
+    Parameters
+    ----------
+    b : int
+        Bandwidth designator (3: one-third octave) [-].
+
+    Returns
+    -------
+    tuple of ndarray
+        Normalised frequencies f / f_m [-] (both sides of the band) and the minimum and maximum
+        relative attenuation [dB] there.
+
+    References
+    ----------
+    .. [1] IEC 61260-1:2014, *Electroacoustics - Octave-band and fractional-octave-band filters -
+       Part 1: Specifications*, 5.10 and Table 1.
+    """
     k, lo, hi = (np.array(c, float) for c in zip(*_CLASS1_OCTAVE, strict=True))
     above = 1.0 + (G ** (1.0 / (2 * b)) - 1.0) / (G ** 0.5 - 1.0) * (G ** k - 1.0)
     omega = np.concatenate([1.0 / above[:0:-1], above])
