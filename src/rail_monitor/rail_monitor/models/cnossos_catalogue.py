@@ -24,14 +24,33 @@ CATALOGUE_MAX_CHARS = 1_000_000   # far above any real catalogue; a larger text 
 
 
 def with_catalogue(base: Tables, text: str) -> Tables:
-    """The edition's tables with a user's own added: ``text`` holds one or more tables in the
-    package's format (lines starting with # are comments; each table starts with its header, a
-    first column ``frequency_hz`` on the 24 nominal bands 50 Hz - 10 kHz or ``wavelength_mm`` on
-    the edition's grid), whose columns are named as the package's are: track transfers
-    ``track_<name>`` [dB per axle], vehicle transfers ``vehicle_wheel_<d>mm`` [dB per axle],
-    traction ``traction_<type>_<constant|idling>_<A|B>`` [dB re 1 pW per vehicle; constant at both
-    heights required], contact filters ``contact_filter_<load>kN_<d>mm`` [dB]. A column may not
-    replace one the edition has. ValueError, one line, for the first fault."""
+    """An edition's tables with a user's own added, in the package's CSV format.
+
+    ``text`` holds one or more tables (lines starting with # are comments; each table starts with its
+    header, a first column ``frequency_hz`` on the 24 nominal bands 50 Hz - 10 kHz or
+    ``wavelength_mm`` on the edition's grid), whose columns are named as the package's are: track
+    transfers ``track_<name>`` [dB per axle], vehicle transfers ``vehicle_wheel_<d>mm`` [dB per
+    axle], traction ``traction_<type>_<constant|idling>_<A|B>`` [dB re 1 pW per vehicle; constant at
+    both heights required], contact filters ``contact_filter_<load>kN_<d>mm`` [dB]. A column may not
+    replace one the edition has. ValueError, one line, for the first fault.
+
+    Parameters
+    ----------
+    base : Tables
+        The edition's tables [-].
+    text : str
+        The user's tables [-].
+
+    Returns
+    -------
+    Tables
+        Both, the user's columns added.
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, Appendix G
+       (the tables' meaning and units).
+    """
     if not text.strip():
         return base
     if len(text) > CATALOGUE_MAX_CHARS:

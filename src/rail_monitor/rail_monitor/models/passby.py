@@ -132,9 +132,38 @@ class PassGeometry:
 
 def pass_geometry(band: ArrayLike, length_m: ArrayLike, speed_mps: ArrayLike, receiver: Receiver,
                   axles: AxleLayout | None = None, engine: str = "numpy") -> PassGeometry:
-    """The PassGeometry of passes of these lengths [m] and speeds [m/s] (IEC 61260-1 band numbers):
-    a moving point source per axle of the layout (its kernels by engine, models.passby_axles), or
-    without one the uniform line source."""
+    """What pass-by levels need of the passes, bands and receiver, whatever the spectrum.
+
+    A moving point source per axle of the layout (its kernels by engine, models.passby_axles), or
+    without one the uniform line source.
+
+    Parameters
+    ----------
+    band : array_like
+        IEC 61260-1 band numbers [-].
+    length_m : array_like
+        Train length per pass [m].
+    speed_mps : array_like
+        Speed per pass [m/s].
+    receiver : Receiver
+        Receiver and source geometry [m].
+    axles : AxleLayout, optional
+        The trains' axles (None: a line source) [m].
+    engine : str
+        'numpy' or 'numba' [-].
+
+    Returns
+    -------
+    PassGeometry
+        Lengths [m], speeds [m/s], distances [m] and the kernels' window means [1/m], shared by every
+        spectrum radiated on these passes.
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, sections 2.3 and 2.5.
+    .. [2] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*.
+    """
     length = np.atleast_1d(np.asarray(length_m, float))
     d = receiver.distance_m
     (r1, _), (r2, _) = receiver.paths()
@@ -151,16 +180,46 @@ def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, sp
             receiver: Receiver, direct_correction_db: ArrayLike = 0.0, time_weighted: bool = True,
             geometry: PassGeometry | None = None,
             elevated: tuple[ArrayLike, PassGeometry] | None = None, engine: str = "numpy") -> PassBy:
-    """Pass-by levels of trains with band sound power per metre [dB re 1 pW/m] (passes x bands).
+    """Pass-by levels of trains from their band sound power per metre.
 
-    length_m, speed_mps: per pass [m], [m/s]. band: IEC 61260-1 band numbers. direct_correction_db:
-    per band, added to the direct path only (CNOSSOS-EU's vertical directivity of source A).
-    time_weighted: compute LpAFmax (the costly part; NaN without it, see f_weighted_peaks for
-    several spectra on the same trains at once). geometry: pass_geometry of the same bands, passes
-    and receiver, when it is already at hand. elevated: a second source line of the same trains at
-    another height (CNOSSOS-EU's source B, 4 m): its power per metre and its pass_geometry (the same
-    passes, bands and axles), without directivity correction; its paths join the time history, so
-    LpAFmax is that of both lines together. engine: of the per-axle time history (numpy or numba).
+    direct_correction_db is added to the direct path only (CNOSSOS-EU's vertical directivity of
+    source A). time_weighted computes LpAFmax, the costly part (NaN without it; see
+    :func:`f_weighted_peaks` for several spectra on the same trains at once). elevated is a second
+    source line of the same trains at another height (CNOSSOS-EU's source B, 4 m), without
+    directivity correction; its paths join the time history, so LpAFmax is that of both lines
+    together.
+
+    Parameters
+    ----------
+    lw_per_metre_db : array_like
+        Sound power per metre [dB re 1 pW/m], passes x bands.
+    band : array_like
+        IEC 61260-1 band numbers [-].
+    length_m, speed_mps : array_like
+        Per pass: train length [m] and speed [m/s].
+    receiver : Receiver
+        Receiver and source geometry [m].
+    direct_correction_db : array_like
+        Per band, added to the direct path [dB].
+    time_weighted : bool
+        Whether LpAFmax is computed [-].
+    geometry : PassGeometry, optional
+        :func:`pass_geometry` of the same bands, passes and receiver, when at hand [-].
+    elevated : (array_like, PassGeometry), optional
+        The elevated line's power per metre [dB re 1 pW/m] and its geometry.
+    engine : str
+        Of the per-axle time history, 'numpy' or 'numba' [-].
+
+    Returns
+    -------
+    PassBy
+        LpAeq,Tp per band [dB re 20 uPa], LpAeq,Tp, TEL and LpAFmax [dB(A)] and Tp [s] per pass.
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, sections 2.3 and 2.5.
+    .. [2] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.6-3.9.
     """
     g = geometry or pass_geometry(band, length_m, speed_mps, receiver)
     paths = band_paths(lw_per_metre_db, g, direct_correction_db, elevated)
@@ -169,8 +228,29 @@ def pass_by(lw_per_metre_db: ArrayLike, band: ArrayLike, length_m: ArrayLike, sp
 
 
 def pass_by_levels(g: PassGeometry, paths: BandPaths, lpafmax_dba: FloatArray | None = None) -> PassBy:
-    """pass_by of the band paths (band_paths) on their geometry, given LpAFmax (None: NaN); the
-    A-weighted totals summed in energy, without a round trip through decibels."""
+    """:func:`pass_by` of the band paths on their geometry, given LpAFmax.
+
+    The A-weighted totals are summed in energy, without a round trip through decibels.
+
+    Parameters
+    ----------
+    g : PassGeometry
+        The passes' geometry [-].
+    paths : BandPaths
+        :func:`band_paths` (power per metre per band [W/m-like], kernels [1/m], distances [m]).
+    lpafmax_dba : ndarray, optional
+        LpAFmax per pass [dB(A)] (None: NaN).
+
+    Returns
+    -------
+    PassBy
+        The levels per band and per pass [dB re 20 uPa, dB(A)] and Tp [s].
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.6-3.9.
+    """
     mean = _per_line(w * k for w, k, _, _ in paths)   # mean squared pressure over the pass-by time
     exposure = _per_line(w * total for w, _, total, _ in paths)
     a = g.a_weight
@@ -184,10 +264,29 @@ def pass_by_levels(g: PassGeometry, paths: BandPaths, lpafmax_dba: FloatArray | 
 
 
 def lpaeq_weights(g: PassGeometry, direct_gain: ArrayLike = 1.0) -> FloatArray:
-    """Per pass and band, the A-weighted window mean of a unit power per metre on the source line
-    of g (its direct path times direct_gain, and its image path): a spectrum W of power per metre
-    on that line gives LpAeq,Tp = 10 lg(sum over bands of W Q) (passes x bands) [1/m]. Being linear
-    in W, one Q serves every component and every model on the line."""
+    """Per pass and band, the A-weighted window mean of a unit power per metre on the source line.
+
+    Its direct path times direct_gain, and its image path: a spectrum W of power per metre on that
+    line gives LpAeq,Tp = 10 lg(sum over bands of W Q). Being linear in W, one Q serves every
+    component and every model on the line.
+
+    Parameters
+    ----------
+    g : PassGeometry
+        The passes' geometry [-].
+    direct_gain : array_like
+        The direct path's power ratio per band [-].
+
+    Returns
+    -------
+    ndarray
+        Q [1/m], passes x bands.
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.9 (LpAeq,Tp).
+    """
     return (direct_gain * g.k1 + g.ground_reflection * g.k2) * g.a_weight
 
 
@@ -205,16 +304,58 @@ BandPaths = list[tuple[FloatArray, FloatArray, float, float]]
 
 def band_paths(lw_per_metre_db: ArrayLike, g: PassGeometry, direct_correction_db: ArrayLike = 0.0,
                elevated: tuple[ArrayLike, PassGeometry] | None = None) -> BandPaths:
-    """The direct and image paths of the source line (and of the elevated one) with their power
-    per metre per band (pass_by's arguments)."""
+    """The direct and image paths of the source line, and of the elevated one, with their band power.
+
+    Parameters
+    ----------
+    lw_per_metre_db : array_like
+        Sound power per metre [dB re 1 pW/m], passes x bands.
+    g : PassGeometry
+        The passes' geometry [-].
+    direct_correction_db : array_like
+        Per band, added to the direct path [dB].
+    elevated : (array_like, PassGeometry), optional
+        The elevated line's power per metre [dB re 1 pW/m] and geometry.
+
+    Returns
+    -------
+    BandPaths
+        Per path: power per metre per pass and band [W/m-like], its kernel window mean [1/m], its
+        kernel total [1/m] and its perpendicular distance [m].
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, section 2.5
+       (the direct and the ground-reflected path).
+    """
     high = None if elevated is None else (power(np.atleast_2d(np.asarray(elevated[0], float))), elevated[1])
     return power_paths(power(np.atleast_2d(np.asarray(lw_per_metre_db, float))), g, power(direct_correction_db), high)
 
 
 def power_paths(w: FloatArray, g: PassGeometry, direct_gain: ArrayLike = 1.0,
                 elevated: tuple[FloatArray, PassGeometry] | None = None) -> BandPaths:
-    """band_paths of power per metre w (power ratio re 1 pW/m per pass and band; direct_gain:
-    the direct path's power ratio per band, and the elevated line's power per metre)."""
+    """:func:`band_paths` of a power per metre already a ratio, without decibels.
+
+    Parameters
+    ----------
+    w : ndarray
+        Power per metre, ratio re 1 pW/m [-], passes x bands.
+    g : PassGeometry
+        The passes' geometry [-].
+    direct_gain : array_like
+        The direct path's power ratio per band [-].
+    elevated : (ndarray, PassGeometry), optional
+        The elevated line's power per metre (ratio re 1 pW/m) [-] and geometry.
+
+    Returns
+    -------
+    BandPaths
+        As :func:`band_paths` gives them [W/m-like, 1/m, m].
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, section 2.5.
+    """
     out = [(w * direct_gain, g.k1, g.total1, g.r1), (g.ground_reflection * w, g.k2, g.total2, g.r2)]
     if elevated is not None:
         w_b, gb = elevated
@@ -223,14 +364,54 @@ def power_paths(w: FloatArray, g: PassGeometry, direct_gain: ArrayLike = 1.0,
 
 
 def a_weighted_paths(g: PassGeometry, paths: BandPaths) -> Paths:
-    """The A-weighted power per metre of each path (summed over bands), for the time history."""
+    """The A-weighted power per metre of each path, summed over bands, for the time history.
+
+    Parameters
+    ----------
+    g : PassGeometry
+        The passes' geometry (its bands) [-].
+    paths : BandPaths
+        The band paths [W/m-like, 1/m, m].
+
+    Returns
+    -------
+    Paths
+        Per path: A-weighted power per metre per pass [W/m-like] and perpendicular distance [m].
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*,
+       Annex E (the A weighting).
+    """
     return [(np.sum(w * g.a_weight, axis=-1), r) for w, _, _, r in paths]
 
 
 def f_weighted_peaks(g: PassGeometry, paths_of: list[Paths], engine: str = "numpy") -> FloatArray:
-    """The F-time-weighted peak of the squared pressure (sets x passes) of each set of paths on the
-    same trains (line or axles; several spectra share the axles' time histories, over windows set
-    by the source line's paths, g's, whatever other lines the sets hold)."""
+    """The peak F-time-weighted squared pressure of several sets of paths on the same trains.
+
+    Line or axles; several spectra share the axles' time histories, over windows set by the source
+    line's paths, g's, whatever other lines the sets hold.
+
+    Parameters
+    ----------
+    g : PassGeometry
+        The passes' geometry [-].
+    paths_of : list of Paths
+        Each set's A-weighted power per metre [W/m-like] and distances [m].
+    engine : str
+        'numpy' or 'numba' [-].
+
+    Returns
+    -------
+    ndarray
+        Peak squared pressure [W/m-like per m, the paths' unit over m], sets x passes.
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, 5.8 (time weighting F).
+    .. [2] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.7 (LpAFmax).
+    """
     if g.axles is None:
         return np.stack([line_f_weighted_peak(paths, g.length, g.speed, g.d) for paths in paths_of])
     return passby_axles.f_weighted_peaks(paths_of, g.axles, g.length, g.speed, g.d, engine, max(g.r1, g.r2))

@@ -98,15 +98,60 @@ def _sum_over_axles(layout: AxleLayout, first: NDArray[np.int64], count: NDArray
 
 
 def window_kernel(layout: AxleLayout, length_m: ArrayLike, d: float, r: float, engine: str = "numpy") -> FloatArray:
-    """Mean over the pass-by time of the kernel of the axles [1/m] (passes,): exact, every axle."""
+    """Mean over the pass-by time of the kernel of every axle, exactly.
+
+    Parameters
+    ----------
+    layout : AxleLayout
+        The trains' axles [m].
+    length_m : array_like
+        Train length per pass [m].
+    d : float
+        Horizontal distance [m].
+    r : float
+        Path distance R [m].
+    engine : str
+        'numpy' or 'numba' [-].
+
+    Returns
+    -------
+    ndarray
+        Window mean [1/m] per pass.
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.6 and 3.8 (the pass-by time, LpAeq,Tp and TEL).
+    """
     return window_kernels(layout, length_m, d, [r], engine)[0]
 
 
 def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Sequence[float],
                    engine: str = "numpy") -> FloatArray:
-    """window_kernel for each path distance R [m] (radii x passes); engine as f_weighted_peaks's.
+    """:func:`window_kernel` for each path distance, once per distinct train geometry.
+
     A pass's kernel depends on its train's geometry only, so it is computed once per distinct train
-    (a history holds few: consists of whole vehicles) and copied to the passes alike."""
+    (a history holds few: consists of whole vehicles) and copied to the passes alike.
+
+    Parameters
+    ----------
+    layout, length_m, d : AxleLayout, array_like, float
+        As for :func:`window_kernel`: the axles, train lengths and horizontal distance [m].
+    radii : sequence of float
+        Path distances R [m].
+    engine : str
+        'numpy' or 'numba' [-].
+
+    Returns
+    -------
+    ndarray
+        Window means [1/m], radii x passes.
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.6 and 3.8.
+    """
     length = np.atleast_1d(np.asarray(length_m, float))
     check_engine(engine)
     if len(length) > 1:
@@ -117,8 +162,27 @@ def window_kernels(layout: AxleLayout, length_m: ArrayLike, d: float, radii: Seq
 
 
 def distinct_trains(layout: AxleLayout, length: FloatArray) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """The first pass of each distinct train geometry (length, vehicles, pitch, axle offsets: alike
-    bit for bit) and the index of each pass's among them."""
+    """The first pass of each distinct train geometry, and each pass's index among them.
+
+    Trains are alike when their length, vehicles, pitch and axle offsets are equal bit for bit.
+
+    Parameters
+    ----------
+    layout : AxleLayout
+        The trains' vehicles and axle offsets [m].
+    length : ndarray
+        Train length per pass [m].
+
+    Returns
+    -------
+    tuple of ndarray
+        The first pass of each distinct geometry [-] and each pass's geometry [-].
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, clause 3 (the pass-by time depends on the train's length).
+    """
     vehicles = np.asarray(layout.vehicles, np.int64).view(np.float64)  # its bits, as a float column of the key
     rows = np.column_stack([length, vehicles, layout.pitch_m, layout.offsets_m])
     keys = np.ascontiguousarray(rows).view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1])))[:, 0]
@@ -152,21 +216,67 @@ def _take(layout: AxleLayout, rows: NDArray[np.int64]) -> AxleLayout:
 
 def f_weighted_peak(paths: Paths, layout: AxleLayout, length_m: ArrayLike, speed_mps: ArrayLike,
                     d: float, engine: str = "numpy", window_r: float | None = None) -> FloatArray:
-    """Peak of the F-time-weighted squared pressure of the axles (passes,) along the paths (c, R): c
-    the A-weighted power per metre [W/m-like, any unit] of a path (per pass), R its perpendicular
-    distance [m]: the direct and image paths of each source line (module docstring)."""
+    """Peak of the F-time-weighted squared pressure of the axles along the paths (c, R).
+
+    c is the A-weighted power per metre of a path (per pass), R its perpendicular distance: the
+    direct and image paths of each source line (module docstring).
+
+    Parameters
+    ----------
+    paths : Paths
+        (c [W/m-like, any unit], R [m]) per path.
+    layout : AxleLayout
+        The trains' axles [m].
+    length_m, speed_mps : array_like
+        Train length [m] and speed [m/s] per pass.
+    d : float
+        Horizontal distance [m].
+    engine : str
+        'numpy' or 'numba' [-].
+    window_r : float, optional
+        The path distance that sets each pass's window [m] (default the largest of the paths').
+
+    Returns
+    -------
+    ndarray
+        Peak squared pressure per pass [the paths' unit over m], every axle's time history summed.
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, 5.8.
+    """
     return f_weighted_peaks([paths], layout, length_m, speed_mps, d, engine, window_r)[0]
 
 
 def f_weighted_peaks(paths_of: Sequence[Paths], layout: AxleLayout, length_m: ArrayLike, speed_mps: ArrayLike,
                      d: float, engine: str = "numpy", window_r: float | None = None) -> FloatArray:
-    """f_weighted_peak of several sets of paths on the same trains (models x passes): the time
-    history of each distinct path distance R is computed once and shared, each set's squared
-    pressure being sum_i c_i X_R_i(t). Each pass's time step, window and near vehicles are its own
-    (from the path distance window_r [m], default the largest of the paths': a set's peak depends
-    on the sets computed with it only through it), so the result is the same bits in a batch as
-    alone. engine: ``numpy``, or ``numba`` (the same arithmetic compiled, models.passby_axles_jit;
-    equal but for the arctangent's last bit)."""
+    """:func:`f_weighted_peak` of several sets of paths on the same trains, sharing time histories.
+
+    The time history of each distinct path distance R is computed once and shared, each set's
+    squared pressure being sum_i c_i X_R_i(t). Each pass's time step, window and near vehicles are
+    its own (from window_r: a set's peak depends on the sets computed with it only through it), so
+    the result is the same bits in a batch as alone. The numba engine (models.passby_axles_jit) is
+    equal but for the arctangent's last bit.
+
+    Parameters
+    ----------
+    paths_of : sequence of Paths
+        Each set's (c [W/m-like], R [m]) per path.
+    layout, length_m, speed_mps, d, engine, window_r : as for f_weighted_peak
+        The axles [m], train lengths [m], speeds [m/s], horizontal distance [m], engine [-] and
+        the window's path distance [m], as for :func:`f_weighted_peak`.
+
+    Returns
+    -------
+    ndarray
+        Peak squared pressure [the paths' unit over m], sets x passes.
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, 5.8.
+    .. [2] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.7.
+    """
     length = np.atleast_1d(np.asarray(length_m, float))
     speed = np.atleast_1d(np.asarray(speed_mps, float))
     radii = list(dict.fromkeys(r for paths in paths_of for _, r in paths))
@@ -232,16 +342,36 @@ def _reach(layout: AxleLayout, r: float, speed: FloatArray, duration: FloatArray
 
 
 def near_axle_terms(x2: FloatArray, d: float, r2: Sequence[float], broad: float) -> list[FloatArray]:
-    """An axle's squared-pressure kernel per path distance, directivity / (x^2 + R_k^2) with
-    directivity = broad / (x^2 + d^2) + omni, for x^2 (any shape) and each R_k^2 of r2.
+    """An axle's squared-pressure kernel per path distance, directivity / (x^2 + R_k^2).
 
-    The path distances in pairs, as the callers give them (a source line's direct and image
-    paths; an odd last one alone), each pair over one common denominator: with D = x^2 + d^2 and
-    D_a, D_b its pair's, q = (broad + omni D) / (D D_a D_b), the terms are q D_b and q D_a. One
-    division per pair instead of three, the same numbers to a few ulps (the divisions were most of
-    the time history's cost). A term depends on its own pair only, so a set of whole source lines
-    gives the same bits alone as with others. models.passby_axles_jit does these operations in
-    this order."""
+    directivity = broad / (x^2 + d^2) + omni. The path distances come in pairs, as the callers give
+    them (a source line's direct and image paths; an odd last one alone), each pair over one common
+    denominator: with D = x^2 + d^2 and D_a, D_b its pair's, q = (broad + omni D) / (D D_a D_b), the
+    terms are q D_b and q D_a. One division per pair instead of three, the same numbers to a few
+    ulps. A term depends on its own pair only, so a set of whole source lines gives the same bits
+    alone as with others. models.passby_axles_jit does these operations in this order.
+
+    Parameters
+    ----------
+    x2 : ndarray
+        Squared distance along the track to the axle [m2] (any shape).
+    d : float
+        Horizontal distance [m].
+    r2 : sequence of float
+        Squared path distances R_k^2 [m2].
+    broad : float
+        The directivity's broadside weight times d^2 [m2].
+
+    Returns
+    -------
+    list of ndarray
+        One kernel [1/m2] per path distance.
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, eq. 2.3.15 (the directivity) and
+       section 2.5 (spherical spreading).
+    """
     d0 = x2 + d * d
     num = OMNI * d0
     num += broad

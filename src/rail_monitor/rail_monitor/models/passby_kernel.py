@@ -48,19 +48,72 @@ def _atan_over_integral(x: FloatArray, c: float) -> FloatArray:
 
 
 def same_path(d: float, r: float) -> bool:
-    """Whether R = d to within 1e-6 d^2 (no height difference: the broadside term's limit form)."""
+    """Whether R = d to within 1e-6 d^2: no height difference, the broadside term's limit form.
+
+    Parameters
+    ----------
+    d, r : float
+        Horizontal distance and path distance [m].
+
+    Returns
+    -------
+    bool
+        [-]
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, eq. 2.3.15.
+    """
     return r * r - d * d < 1e-6 * d * d
 
 
 def point_kernel(x: ArrayLike, d: float, r: float) -> FloatArray:
-    """g(x) [1/m^2]: the squared pressure re rho c of a unit point source at x along the track."""
+    """g(x), the squared pressure re rho c of a unit point source at x along the track.
+
+    g(x) = [OMNI / (R^2 + x^2) + BROADSIDE d^2 / ((d^2 + x^2)(R^2 + x^2))] / (4 pi).
+
+    Parameters
+    ----------
+    x : array_like
+        Position along the track from the receiver's perpendicular [m].
+    d : float
+        Horizontal distance [m].
+    r : float
+        Path distance R [m].
+
+    Returns
+    -------
+    ndarray
+        g [1/m^2].
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, eq. 2.3.15 and 2.5.6.
+    """
     x2 = np.asarray(x, float) ** 2
     q = d * d + x2
     return (OMNI * q + BROADSIDE * d * d) / (q * (r * r + x2) * (4.0 * np.pi))
 
 
 def kernel_antiderivative(x: ArrayLike, d: float, r: float) -> FloatArray:
-    """G(x) = integral of g from 0 to x [1/m] for horizontal distance d and path distance R [m]."""
+    """G(x), the integral of g from 0 to x.
+
+    Parameters
+    ----------
+    x, d, r : array_like, float, float
+        As for :func:`point_kernel`: position along the track, horizontal distance and path
+        distance R [m].
+
+    Returns
+    -------
+    ndarray
+        G [1/m].
+
+    References
+    ----------
+    .. [1] Commission Directive (EU) 2015/996 (OJ L 168, 1.7.2015), Annex II, eqs. 2.3.15 and 2.5.6
+       (the kernel integrated).
+    """
     x = np.asarray(x, float)
     return _antiderivative_with(x, d, r, _atan_over(x, d))
 
@@ -76,7 +129,23 @@ def _antiderivative_with(x: FloatArray, d: float, r: float, at_d: FloatArray) ->
 
 
 def kernel_second_antiderivative(x: ArrayLike, d: float, r: float) -> FloatArray:
-    """GG(x), an antiderivative of G(x) [-] (even in x)."""
+    """GG(x), an antiderivative of G(x) (even in x), for window means of G.
+
+    Parameters
+    ----------
+    x, d, r : array_like, float, float
+        Position along the track [m], horizontal distance [m] and path distance R [m].
+
+    Returns
+    -------
+    ndarray
+        GG [-].
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.9 (the mean over the pass-by time it gives).
+    """
     x = np.asarray(x, float)
     if same_path(d, r):
         broad = 0.25 * np.log(d * d + x * x) + 0.5 * _atan_over_integral(x, d)
@@ -86,24 +155,73 @@ def kernel_second_antiderivative(x: ArrayLike, d: float, r: float) -> FloatArray
 
 
 def kernel_total(d: float, r: float) -> float:
-    """Integral of g over all x [1/m]: [0.01 / R + 0.99 d / (R (d + R))] / 4."""
+    """The integral of g over all x: [0.01 / R + 0.99 d / (R (d + R))] / 4.
+
+    Parameters
+    ----------
+    d, r : float
+        Horizontal distance and path distance R [m], as for :func:`point_kernel`.
+
+    Returns
+    -------
+    float
+        Total [1/m].
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.8 (TEL takes the whole pass's energy).
+    """
     return (OMNI / r + BROADSIDE * d / (r * (d + r))) / 4.0
 
 
 def kernel_window_mean(length_m: ArrayLike, d: float, r: float) -> FloatArray:
-    """Mean over the pass-by time of the kernel of a line of length L [m] [1/m]."""
+    """Mean over the pass-by time of the kernel of a line of length L.
+
+    Parameters
+    ----------
+    length_m : array_like
+        Train length L [m].
+    d, r : float
+        The receiver's horizontal distance and the path's distance R [m].
+
+    Returns
+    -------
+    ndarray
+        Window mean [1/m].
+
+    References
+    ----------
+    .. [1] ISO 3095:2013, *Acoustics - Railway applications - Measurement of noise emitted by
+       railbound vehicles*, 3.9 (LpAeq,Tp over Tp = L / v).
+    """
     length = np.asarray(length_m, float)
     gg = kernel_second_antiderivative
     return (gg(length, d, r) - 2.0 * gg(0.0, d, r) + gg(-length, d, r)) / length
 
 
 def exponential_average(x: FloatArray, a: float | FloatArray) -> FloatArray:
-    """y_n = (1 - a) x_n + a y_(n-1) along the last axis, started in steady state (y_(-1) = x_0):
-    the sampled exponential time weighting of IEC 61672-1 eq. 7 with a = exp(-dt / tau), one a
-    for all series or one per series (x's leading shape).
+    """The sampled exponential time weighting y_n = (1 - a) x_n + a y_(n-1), started in steady state.
 
-    The arithmetic of scipy.signal.lfilter([1 - a], [1, -a], x, zi=a x_0), step for step (the tests
-    compare the bits), without importing scipy.signal (44 MB and 0.4 s at a node's start-up).
+    Along the last axis, y_(-1) = x_0; a = exp(-dt / tau), one for all series or one per series
+    (x's leading shape). The arithmetic of scipy.signal.lfilter([1 - a], [1, -a], x, zi=a x_0),
+    step for step (the tests compare the bits), without importing scipy.signal at a node's start-up.
+
+    Parameters
+    ----------
+    x : ndarray
+        The series [any unit].
+    a : float or ndarray
+        exp(-dt / tau) [-].
+
+    Returns
+    -------
+    ndarray
+        The weighted series [x's unit].
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, eq. 7.
     """
     rows = np.asarray(x, float).reshape(-1, np.shape(x)[-1])
     a_rows = np.broadcast_to(np.asarray(a, float), np.shape(x)[:-1]).reshape(-1)
@@ -130,12 +248,31 @@ def exponential_average(x: FloatArray, a: float | FloatArray) -> FloatArray:
 
 def line_f_weighted_peak(paths: Paths, length: FloatArray, speed: FloatArray, d: float,
                      steps_per_tau: int = 8) -> FloatArray:
-    """Peak of the F-time-weighted squared pressure sum_i c_i x_i(t), x_i(t) = G_i(vt) - G_i(vt - L),
-    over the paths (c_i, R_i).
+    """Peak of the F-time-weighted squared pressure of a moving line over its paths.
 
-    Exponential averaging (IEC 61672-1 eq. 7, tau = 0.125 s) from 6 tau before to 3 tau after the
-    unweighted peak (the train's middle at the perpendicular), started in steady state: the
-    truncated history weighs e^-6 of a level no higher than the peak's.
+    sum_i c_i x_i(t), x_i(t) = G_i(vt) - G_i(vt - L); exponential averaging (tau = 0.125 s) from 6 tau
+    before to 3 tau after the unweighted peak (the train's middle at the perpendicular), started in
+    steady state: the truncated history weighs e^-6 of a level no higher than the peak's.
+
+    Parameters
+    ----------
+    paths : Paths
+        (c [W/m-like], R [m]) per path.
+    length, speed : ndarray
+        Train length [m] and speed [m/s] per pass.
+    d : float
+        Horizontal distance [m].
+    steps_per_tau : int
+        Time steps per time constant [-].
+
+    Returns
+    -------
+    ndarray
+        Peak squared pressure per pass [the paths' unit over m].
+
+    References
+    ----------
+    .. [1] IEC 61672-1:2013, *Electroacoustics - Sound level meters - Part 1: Specifications*, 5.8 and eq. 7.
     """
     tau = F_TIME_CONSTANT_S
     t = (np.arange(-6 * steps_per_tau, 3 * steps_per_tau + 1) / steps_per_tau) * tau
