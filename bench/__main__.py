@@ -8,7 +8,8 @@ bench.bare_graph); the live graph's start-up, idle CPU, CPU and latency (bench.l
 1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
 per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes
 (the graph, the recorder, the streamed batch, and export in parts against read whole);
-many sites on a local Dask cluster of 1 and 2 workers.
+many sites on a local Dask cluster of 1 and 2 workers; where a live pass's time goes in the site
+engine (bench.engine_pass).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ import numpy as np
 from bench import audio as baudio
 from bench import batch as bb
 from bench import corrugation as bc
+from bench import engine_pass as bep
 from bench import graph as bg
 from bench import live as blive
 from bench import noise as bn
@@ -207,6 +209,8 @@ def main() -> None:
         sections.append(("live graph as a site runs it", blive.rows(ns.site, ns.source, [1.0, 20.0] if ns.quick
                                                                      else [1.0, 100.0], 2.0 if ns.quick else 10.0,
                                                                      2.0 if ns.quick else 10.0)))
+        sections.append(("a live pass through the site engine", bep.rows(ns.site, ns.source, 2.0 if ns.quick else 28.0,
+                                                                           60 if ns.quick else 300)))
         eq = bb.live_equality(str(live_bag), values)
         sections.append(("batch", [*batch_rows(values, ns.site, sizes), (
             "batch against the live graph (same passes)", f"{eq['corrugation_rel']:.1e}",

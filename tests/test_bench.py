@@ -20,10 +20,15 @@ def test_the_benchmark_harness_runs_and_batch_equals_the_live_graph(tmp_path):
                           capture_output=True, text=True, timeout=600, check=False)
     assert done.returncode == 0, done.stderr[-3000:]
     text = out.read_text()
-    for section in ("graph against its rclpy ceiling", "live graph as a site runs it", "batch", "a busy site's year",
+    for section in ("graph against its rclpy ceiling", "live graph as a site runs it",
+                    "a live pass through the site engine", "batch", "a busy site's year",
                     "models, per pass", "noise station", "recorder", "memory against passes"):
         assert f"| **{section}** |" in text
     assert re.search(r"\| wayside_monitor start-up to first output \| [0-9.]+ s \|", text), text
+    assert re.search(r"\| wayside_monitor start-up to first output, listening \| [0-9.]+ s \|", text), text
+    assert re.search(r"\| site engine, one pass fed alone \(feed \+ settle\) \| [0-9.]+ ms \| mean over 60 "
+                     r"passes", text), text
+    assert re.search(r"\|   of which the engine's own bookkeeping \| -?[0-9.]+ ms \|", text), text
     assert re.search(r"\| live graph, 20 passes/s arriving one at a time \| [0-9]+ % of a core \| latency pass to "
                      r"last output p50 [0-9]+ ms, p95 [0-9]+ ms over 40 passes; by process: "
                      r"corrugation_estimator [0-9]+ %", text), text
