@@ -29,7 +29,7 @@ from rail_monitor.batch.run import run_models
 from rail_monitor.core.passes import PassTable
 from rail_monitor.messages import fields
 from rail_monitor.nodes.base import Diagnostics, Sent, subscribe_batched
-from rail_monitor.nodes.convert import to_cdr
+from rail_monitor.nodes.convert import output_publishers, to_cdr
 from rail_monitor.nodes.hosted_models import OneEngine
 from rail_monitor.nodes.mcap_recorder import McapRecorder
 from rail_monitor.nodes.qos import (
@@ -41,7 +41,7 @@ from rail_monitor.nodes.qos import (
     STREAM_QOS,
     STREAM_SUB_QOS,
 )
-from rail_monitor.nodes.site_engine import output_publishers
+from rail_monitor.nodes.site_engine import PUBLISHED
 from rail_monitor.nodes.topic_tap import TAKE_AT_ONCE
 from rail_msgs.msg import (
     CorrugationState,
@@ -130,7 +130,7 @@ class _Engine(_StandIn):
         super().__init__("site_engine", max_batch)
         self.counts: Counter[str] = Counter()
         self.engine = SimpleNamespace(model=_Models(tuple(noise)))
-        self.pubs = output_publishers(self)
+        self.pubs = output_publishers(self, PUBLISHED)
         self.create_publisher(SpeedAdvisory, "speed_advisory", LATEST_QOS)
         self.outputs = [(self.pubs["noise/squeal"], squeal), (self.pubs["corrugation/state"], state),
                         *((self.pubs["noise/rolling"], m) for m in noise.values())]

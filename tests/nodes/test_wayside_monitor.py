@@ -52,6 +52,9 @@ DAYS = 3.0
 ALERTS = {"alerts.squeal_window_passes": 20, "alerts.squeal_raise_share": 0.25, "alerts.squeal_clear_share": 0.05}
 # Day-long windows of indirect roughness, taken by the state: the 3-day slice closes three of them.
 INDIRECT = {"residual.indirect_days": 1.0}
+# Day-long windows of the squeal model's fit to the measured squeal: every layout predicts the
+# passes after each on its curves.
+FIT = {"squeal.fit_days": 1.0}
 REL = 1e-9  # live equals batch to this (issue 6)
 
 
@@ -62,6 +65,7 @@ def _site_file(folder: Path, checkpoint: Path | None = None) -> Path:
     alerts = doc["/**"]["ros__parameters"]["alerts"]
     alerts.update({k.split(".", 1)[1]: v for k, v in ALERTS.items()})
     doc["/**"]["ros__parameters"].setdefault("residual", {}).update(indirect_days=INDIRECT["residual.indirect_days"])
+    doc["/**"]["ros__parameters"].setdefault("squeal", {}).update(fit_days=FIT["squeal.fit_days"])
     if checkpoint is not None:  # the state's holder in either layout
         for node in ("corrugation_estimator", "site_engine"):
             doc[f"/**/{node}"]["ros__parameters"].update(checkpoint_path=str(checkpoint), checkpoint_every_passes=10)
@@ -71,7 +75,7 @@ def _site_file(folder: Path, checkpoint: Path | None = None) -> Path:
 
 
 def _values() -> dict:
-    return {**load_parameter_file(SITE_FILE), **ALERTS, **INDIRECT}
+    return {**load_parameter_file(SITE_FILE), **ALERTS, **INDIRECT, **FIT}
 
 
 def _slice():
@@ -150,7 +154,8 @@ def _assert_equal_runs(live, batch) -> None:
 # (published on a wall-clock period live, once on the final state in batch).
 COMPARED = ("rail_msgs/msg/TrainPass", "rail_msgs/msg/SquealPrediction", "rail_msgs/msg/RollingNoise",
             "rail_msgs/msg/CorrugationState", "rail_msgs/msg/WaysideAlert", "rail_msgs/msg/NoiseResidual",
-            "rail_msgs/msg/RoughnessSurvey", "rail_msgs/msg/MeasuredPassNoise", "rail_msgs/msg/IndirectRoughness")
+            "rail_msgs/msg/RoughnessSurvey", "rail_msgs/msg/MeasuredPassNoise", "rail_msgs/msg/IndirectRoughness",
+            "rail_msgs/msg/SquealCalibration")
 
 
 FORECAST_TIME_NS = 1_000_000  # a forecast time is float arithmetic over ~1e17 ns: equal within 1 ms

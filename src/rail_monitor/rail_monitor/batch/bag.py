@@ -83,7 +83,7 @@ class BatchBag:
         self._alerts(result.alerts)
         self.events(result.events)
         self.measured(result.measurements, result.residuals)
-        for msgs in outputs.measured((), result.observations, self.frame):
+        for msgs in outputs.measured((), result.observations, self.frame, result.calibrations):
             self._write(msgs)
 
     def _alerts(self, events: list[Alert]) -> None:

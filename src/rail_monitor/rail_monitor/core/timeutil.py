@@ -17,6 +17,12 @@ INT64_MAX = 2**63 - 1
 _ISO = re.compile(r"^(\d{4}-\d\d-\d\d[T ]\d\d:\d\d:\d\d)(?:\.(\d{1,9}))?(Z|[+-]\d\d:?\d\d)?$")
 
 
+def window_end_ns(stamp_ns: int, interval_ns: int) -> int:
+    """The end of the window (k w, (k + 1) w] holding stamp_ns [ns], windows of w = interval_ns
+    counted from the Unix epoch (UTC): the same in every process."""
+    return -(-int(stamp_ns) // interval_ns) * interval_ns
+
+
 def parse_iso_ns(text: str) -> int:
     """ISO 8601 time with up to 9 fractional digits (Z, an offset, or naive = UTC) -> ns."""
     m = _ISO.match(text.strip())

@@ -6,7 +6,9 @@ times), the band centres, ln Z of every component, K_b, the last survey and the 
 amplitudes, the calibration (growth since the last survey per friction state, the covariance of
 ln K_b, each band's level variance), the last year's growth per day and the kept passes' columns;
 with an indirect roughness observer (rail_monitor.measured.observer), its open window's fit too
-(optional arrays ``indirect_*``: a file without them resumes with the window empty).
+(optional arrays ``indirect_*``: a file without them resumes with the window empty); with the
+squeal model's fit (rail_monitor.engine.squeal_site), its grids, posteriors and passes (optional
+arrays ``squeal_fit_*``: a file without them resumes on the configured curves).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
 
 if TYPE_CHECKING:  # the observer's module imports the noise model: not needed to read a checkpoint
+    from rail_monitor.engine.squeal_site import SquealSite
     from rail_monitor.measured.observer import IndirectObserver
 
 VERSION = 5
@@ -56,12 +59,14 @@ def previous_checkpoint(path: str | Path) -> Path:
     return path.with_name(path.name + ".prev")
 
 
-def save(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None) -> None:
+def save(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None,
+         squeal: SquealSite | None = None) -> None:
     """Write the state atomically (snapshot, encode, write_atomically)."""
-    write_atomically(encode(snapshot(est, observer)), path)
+    write_atomically(encode(snapshot(est, observer, squeal)), path)
 
 
-def snapshot(est: CorrugationEstimator, observer: IndirectObserver | None = None) -> dict[str, np.ndarray]:
+def snapshot(est: CorrugationEstimator, observer: IndirectObserver | None = None,
+             squeal: SquealSite | None = None) -> dict[str, np.ndarray]:
     """The state's arrays now, copied and not yet converted (the cheap part: the state may move on
     while another thread encodes them)."""
     meta = {"version": VERSION, "site_id": est.site.site_id, **{k: getattr(est, k) for k in _COUNTS},
@@ -73,7 +78,8 @@ def snapshot(est: CorrugationEstimator, observer: IndirectObserver | None = None
                   calibration_mean=est.calibration.mean, season_growth=est.season.growth,
                   season_passes=est.season.passes, season_first_day=np.array(est.season.first_day),
                   **{f"recent_{n}": getattr(est.kept, n) for n in COLUMNS},
-                  **(observer.to_arrays() if observer is not None else {}))
+                  **(observer.to_arrays() if observer is not None else {}),
+                  **(squeal.to_arrays() if squeal is not None else {}))
     return {name: np.array(a, copy=True) for name, a in arrays.items()}
 
 
@@ -194,10 +200,12 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
     return meta, data
 
 
-def load(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None) -> None:
-    """Resume est (and observer's window, where the file has one) from a checkpoint of its site with
-    the same bands (ConfigError otherwise; a file that does not hold a whole, consistent state is
-    CorruptCheckpoint). Both are changed only once the whole file has been read and checked."""
+def load(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None,
+         squeal: SquealSite | None = None) -> None:
+    """Resume est (and observer's window and squeal's fit, where the file has them) from a
+    checkpoint of its site with the same bands (ConfigError otherwise; a file that does not hold a
+    whole, consistent state is CorruptCheckpoint). All are changed only once the whole file has
+    been read and checked."""
     meta, data = _read(path)
     if not isinstance(meta, dict):
         raise CorruptCheckpoint(f"{path}: not a readable corrugation checkpoint: its meta record is not a mapping")
@@ -211,13 +219,16 @@ def load(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver
                                 f"{(str(exc).splitlines() or [''])[0]}") from None
     if state is None:
         raise ConfigError(f"{path}: checkpoint bands differ from the configured ones")
-    if observer is not None and "indirect_pairs" in data:
-        trial = copy.copy(observer)
+    trials = []
+    for part in (p for p in (observer, squeal) if p is not None):
+        trial = copy.copy(part)
         try:
             trial.restore(data)
         except (TypeError, ValueError, KeyError) as exc:
             raise CorruptCheckpoint(f"{path}: not a readable corrugation checkpoint: {exc}") from None
-        observer.__dict__.update(trial.__dict__)
+        trials.append((part, trial))
+    for part, trial in trials:
+        part.__dict__.update(trial.__dict__)
     k_b = state.pop("_k_b")
     for key, value in state.items():
         setattr(est, key, value)
@@ -299,8 +310,8 @@ def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarr
             "calibration": calibration.KbPosterior(mean, cov, fits)}
 
 
-def resume(est: CorrugationEstimator, path: str | Path,
-           observer: IndirectObserver | None = None) -> tuple[Path | None, list[str]]:
+def resume(est: CorrugationEstimator, path: str | Path, observer: IndirectObserver | None = None,
+           squeal: SquealSite | None = None) -> tuple[Path | None, list[str]]:
     """Load the newest readable checkpoint: path, else previous_checkpoint(path).
 
     Returns the file loaded (None: neither exists, the state stays as it is) and one line per
@@ -316,7 +327,7 @@ def resume(est: CorrugationEstimator, path: str | Path,
         if not candidate.exists():
             continue
         try:
-            load(est, candidate, observer)
+            load(est, candidate, observer, squeal)
         except CorruptCheckpoint as exc:
             skipped.append(str(exc))
             continue

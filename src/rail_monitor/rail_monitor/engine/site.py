@@ -26,6 +26,7 @@ import numpy as np
 
 from rail_monitor.advice.consequences import Consequences
 from rail_monitor.advice.plan import SpeedAdvice, advise_or_none
+from rail_monitor.alerts.config import RISK_NAMES
 from rail_monitor.alerts.manager import Alert, AlertManager
 from rail_monitor.core.errors import PassOrderError
 from rail_monitor.core.passes import PassTable, publishable, reject_ahead, rejection_reasons, with_class_defaults
@@ -38,6 +39,7 @@ from rail_monitor.engine.corrugation_site import CorrugationSite
 from rail_monitor.engine.noise_chunks import noise_on_states, pool_of
 from rail_monitor.engine.result import SiteOutputs
 from rail_monitor.engine.site_config import SiteConfig
+from rail_monitor.engine.squeal_site import SquealSite
 from rail_monitor.measured.observer import IndirectObserver, Observation
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual, ResidualTracker, predictions_of
@@ -128,6 +130,9 @@ class SiteEngine:
         self.tracker = ResidualTracker(rcfg, self.model.band_hz, (receiver.distance_m, receiver.height_m),
                                        self.model.models)
         observer = IndirectObserver(self.model, rcfg, self.estimator.bands) if rcfg.indirect_days > 0 else None
+        self.squeal = SquealSite(self.site, self.cfg.squeal, RISK_NAMES.index(self.cfg.alerts.squeal_min_risk),
+                                 rcfg.held_predictions)
+        self.squeal.take(self._measurements)
         # Events are checked against the passes taken when they fall due, as the node checks them on arrival.
         self.corrugation = CorrugationSite(self.estimator, observer, self._event_ahead)
         self.corrugation.pending = in_time_order(events)
@@ -138,7 +143,7 @@ class SiteEngine:
     def resume(self, path: str) -> tuple[Any, list[str]]:
         """Continue from the newest readable checkpoint at path (engine.checkpoint.resume): the file
         loaded (None: none there, a fresh history) and one line per unreadable file passed over."""
-        used, skipped = checkpoint.resume(self.estimator, path, self.observer)
+        used, skipped = checkpoint.resume(self.estimator, path, self.observer, self.squeal)
         self.newest_taken_ns = self.estimator.newest_ns
         self.alerts = AlertManager(replace(self.cfg.alerts, lead_time_days=self.estimator.cfg.lead_time_days))
         return used, skipped
@@ -177,6 +182,7 @@ class SiteEngine:
         residual.held_predictions at most): taken with the passes up to their stamps (or settle())."""
         for m in measurements:
             bisect.insort(self._measurements, m, key=lambda x: x.key)
+        self.squeal.take(measurements)
 
     def settle(self) -> tuple[list[Measurement], list[Residual], list[Alert]]:
         """What the inputs so far give without a later pass (live, when the stream is idle): the
@@ -213,7 +219,7 @@ class SiteEngine:
         accepted = with_class_defaults(table.take(reasons == ""), self.site)
         self._newest_accepted_ns = int(accepted.stamp_ns.max(initial=self._newest_accepted_ns))
         with pool_of(self.threads) as pool:
-            squeal_job = pool.submit(predict_squeal, self.cfg.squeal, self.site, accepted)
+            squeal_job = pool.submit(self._squeal, accepted)
             # The corrugation history in chunks on this thread, each chunk's noise on the pool while
             # the next is advanced (the estimator carries the kept passes, _Tail the states a later
             # pass may be predicted on: the chunks give one call's states and predictions).
@@ -244,7 +250,15 @@ class SiteEngine:
                            trajectory=traj, noise=noise, alerts=[a for a in events if a.stamp_ns < later],
                            standing=self.standing(), advice=None, estimator=self.estimator,
                            receiver=self.model.receiver, left_out=dict(left_out), measurements=measured,
-                           residuals=residuals)
+                           residuals=residuals, calibrations=self.squeal.take_calibrations())
+
+    def _squeal(self, accepted: PassTable) -> dict[str, np.ndarray]:
+        """The squeal of the passes, each on the curves fitted before it (engine.squeal_site)."""
+        parts = []
+        for part in self.squeal.segments(accepted):
+            parts.append(predict_squeal(self.cfg.squeal, self.squeal.site, part))
+            self.squeal.hold(part)
+        return parts[0] if len(parts) == 1 else {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
     def _measured(self, table: PassTable, accepted: PassTable, noise: dict[str, NoisePrediction],
                   squeal_risk: np.ndarray) -> tuple[list[Measurement], list[Residual]]:

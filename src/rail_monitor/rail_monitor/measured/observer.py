@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rail_monitor.core.passes import PassTable
-from rail_monitor.core.timeutil import NS_PER_DAY
+from rail_monitor.core.timeutil import NS_PER_DAY, window_end_ns
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_INDIRECT, KIND_SURVEY, MaintenanceEvent, split_before
@@ -88,7 +88,7 @@ class IndirectObserver:
 
     def boundary(self, stamp_ns: int) -> int:
         """The end of the window holding stamp_ns [ns]."""
-        return -(-int(stamp_ns) // self.interval_ns) * self.interval_ns
+        return window_end_ns(stamp_ns, self.interval_ns)
 
     def add_measurements(self, measurements: list[Measurement]) -> None:
         for m in measurements:
@@ -192,7 +192,10 @@ class IndirectObserver:
                 "indirect_pass_post": np.array([v[3] for _, v in awaiting], float).reshape(-1, nb)}
 
     def restore(self, arrays: dict[str, np.ndarray]) -> None:
-        """Resume from to_arrays's records (ValueError, the observer untouched, if they are not usable)."""
+        """Resume from to_arrays's records (ValueError, the observer untouched, if they are not usable;
+        without them, the window stays empty)."""
+        if "indirect_pairs" not in arrays:
+            return
         pairs = IndirectPairs.from_array(arrays["indirect_pairs"], len(self.bands))
         window = np.asarray(arrays["indirect_baseline"], float)
         scalars = np.asarray(arrays["indirect_scalars"]).astype(np.int64, casting="same_kind")

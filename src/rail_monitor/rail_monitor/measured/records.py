@@ -20,6 +20,7 @@ INSTRUMENT_CLASSES = (1, 2)
 MAX_VEHICLES = 1000  # segments of one train: more is no train (and would cost memory to check)
 SQUEAL_BAND_HZ = (20.0, 20_000.0)  # a squeal's tone is audible sound (measured ones lie in 0.4-10 kHz)
 MAX_PASS_S = 3600.0  # no pass-by lasts an hour
+MAX_SQUEAL_DISTANCE_M = 1000.0  # squeal.receiver_distance_m's range: no one wheel is heard further
 # The squeal measures a measurement may carry, each with its value when not measured.
 SQUEAL_MEASURES: dict[str, float | bool] = {"squeal_frequency_hz": float("nan"), "squeal_level_db": float("nan"),
                                             "squeal_duration_s": float("nan"), "flanging_detected": False}
@@ -99,6 +100,16 @@ def measurement_refusal(m: Measurement, model_band_hz: np.ndarray, receiver_m: t
     seg = np.asarray(m.vehicle_lpaeq_dba, float)
     if len(m.vehicle_id) != len(seg) or not np.all(np.isfinite(seg) & (seg >= lo) & (seg <= hi)):
         return "vehicle_id and vehicle_lpaeq_dba differ in length, or a vehicle level is not a level"
+    return squeal_refusal(m)
+
+
+def squeal_observation_refusal(m: Measurement) -> str:
+    """Why a measurement cannot tell whether its pass squealed, and how loud ('' when it can): its
+    stamp, its microphone's distance and its squeal measures (its band levels are not needed)."""
+    if m.stamp_ns <= 0:
+        return "stamp not set, or before 1970"
+    if not (np.isfinite(m.receiver_distance_m) and 0.0 < m.receiver_distance_m <= MAX_SQUEAL_DISTANCE_M):
+        return f"receiver distance not within 0-{MAX_SQUEAL_DISTANCE_M:g} m"
     return squeal_refusal(m)
 
 

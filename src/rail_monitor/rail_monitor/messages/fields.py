@@ -22,6 +22,7 @@ import numpy as np
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.codec.typestore import CORRUGATION_STATE, ROLLING_NOISE
+from rail_monitor.core.friction import FRICTION_NAMES
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot, Trajectory
@@ -32,6 +33,7 @@ from rail_monitor.noise.records import NoisePrediction
 
 if TYPE_CHECKING:
     from rail_monitor.advice.plan import SpeedAdvice
+    from rail_monitor.engine.squeal_site import Calibration
     from rail_monitor.measured.observer import Observation
 
 Fields = dict[str, Any]
@@ -270,6 +272,19 @@ def indirect_roughness_fields(obs: Observation, frame_id: str) -> Fields:
             "level_db": ind.level_db.tolist(), "sd_db": ind.sd_db.tolist(), "model_db": ind.model_db.tolist(),
             "pass_bands": ind.passes.astype(int).tolist(), "rail_share": ind.rail_share.tolist(),
             "observed_amplitude_m": obs.observed_amplitude_m.tolist()}
+
+
+def squeal_calibration_fields(c: Calibration, frame_id: str) -> Fields:
+    """One fit of the squeal model: per friction state fitted, its configured curve and quantiles."""
+    out: Fields = {"header": header_fields(c.stamp_ns, frame_id),
+                   "friction_state": [FRICTION_NAMES[code] for code, _, _ in c.states],
+                   "k1_configured": [k[0] for _, k, _ in c.states], "k2_configured": [k[1] for _, k, _ in c.states],
+                   "measured_passes": [q.passes for _, _, q in c.states],
+                   "squealing_passes": [q.squealed for _, _, q in c.states]}
+    for i, p in enumerate(("p10", "p50", "p90")):
+        out[f"k1_{p}"] = [q.k1[i] for _, _, q in c.states]
+        out[f"k2_{p}"] = [q.k2[i] for _, _, q in c.states]
+    return out
 
 
 def measured_pass_noise_fields(m: Measurement, frame_id: str) -> Fields:

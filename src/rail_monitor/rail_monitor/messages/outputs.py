@@ -18,6 +18,7 @@ from rail_monitor.alerts.manager import Alert
 from rail_monitor.codec.cdr import serialize
 from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.engine.result import SiteOutputs
+from rail_monitor.engine.squeal_site import Calibration
 from rail_monitor.measured.observer import Observation
 from rail_monitor.measured.residuals import Residual
 from rail_monitor.messages import fields
@@ -56,11 +57,15 @@ def per_pass(result: SiteOutputs, frame: str) -> list[Messages]:
                      np.repeat(accepted.stamp_ns, len(result.noise)).tolist())]
 
 
-def measured(residuals: Iterable[Residual], observations: Iterable[Observation], frame: str) -> list[Messages]:
-    """Residuals of measured pass-bys, and the indirect roughness of each closed window."""
+def measured(residuals: Iterable[Residual], observations: Iterable[Observation], frame: str,
+             calibrations: Iterable[Calibration] = ()) -> list[Messages]:
+    """Residuals of measured pass-bys, the indirect roughness of each closed window, and each fit
+    of the squeal model."""
     return [*(one("noise/residual", fields.noise_residual_fields(r, frame), r.stamp_ns) for r in residuals),
             *(one("corrugation/indirect_roughness", fields.indirect_roughness_fields(o, frame), o.stamp_ns)
-              for o in observations)]
+              for o in observations),
+            *(one("noise/squeal_calibration", fields.squeal_calibration_fields(c, frame), c.stamp_ns)
+              for c in calibrations)]
 
 
 def advice(advised: SpeedAdvice, newest_ns: int, frame: str) -> Messages:

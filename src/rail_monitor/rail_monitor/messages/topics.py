@@ -82,4 +82,6 @@ OPTIONAL_TOPICS: dict[str, tuple[str, Qos]] = {
     "noise/measured": ("rail_msgs/msg/MeasuredPassNoise", STREAM),
     "noise/residual": ("rail_msgs/msg/NoiseResidual", STREAM),
     # A model output like the others (latched): a recorder that matched a moment late lost one.
-    "corrugation/indirect_roughness": ("rail_msgs/msg/IndirectRoughness", STREAM)}
+    "corrugation/indirect_roughness": ("rail_msgs/msg/IndirectRoughness", STREAM),
+    # Each fit of the squeal model to the measured squeal (latched, as every model output).
+    "noise/squeal_calibration": ("rail_msgs/msg/SquealCalibration", STREAM)}

@@ -15,7 +15,7 @@ from rail_monitor.codec.cdr import serialize
 from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.messages import fields as messages
-from rail_monitor.messages.topics import GRAPH_TOPICS
+from rail_monitor.messages.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
 from rail_monitor.nodes.qos import profile
 
 _SCALARS = {"boolean": bool, "float": float, "double": float, "string": str}
@@ -32,6 +32,15 @@ def message_class(typename: str) -> type:
 
 # The recorded topics with their rclpy message class and publisher profile.
 TOPICS: dict[str, tuple[type, Any]] = {name: (message_class(t), profile(q)) for name, (t, q) in GRAPH_TOPICS.items()}
+
+
+def output_publishers(node: Any, topics: tuple[str, ...]) -> dict[str, Any]:
+    """Publishers of graph topics (relative names), by topic, with the graph's QoS."""
+    pubs = {}
+    for topic in topics:
+        typename, qos = GRAPH_TOPICS.get(topic) or OPTIONAL_TOPICS[topic]
+        pubs[topic] = node.create_publisher(message_class(typename), topic, profile(qos))
+    return pubs
 
 
 @functools.cache

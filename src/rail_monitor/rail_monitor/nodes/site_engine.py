@@ -26,7 +26,6 @@ from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from rail_monitor.advice.consequences import Consequences
@@ -49,13 +48,12 @@ from rail_monitor.messages.fields import (
     passes_from_columns,
     wayside_alert_array_fields,
 )
-from rail_monitor.messages.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
 from rail_monitor.nodes.alert_manager import retune_alerts
 from rail_monitor.nodes.base import declare, declare_site_values, subscribe_batched, take_queued, wall_timer
-from rail_monitor.nodes.convert import message_class
+from rail_monitor.nodes.convert import output_publishers
 from rail_monitor.nodes.pass_consumer import PassConsumerNode
 from rail_monitor.nodes.process import run_node
-from rail_monitor.nodes.qos import EVENT_QOS, STREAM_SUB_QOS, profile
+from rail_monitor.nodes.qos import EVENT_QOS, STREAM_SUB_QOS
 from rail_monitor.nodes.state_services import StateServices
 from rail_monitor.noise.config import NOISE_SPECS
 from rail_monitor.squeal.config import SQUEAL_SPECS
@@ -64,16 +62,7 @@ from rail_msgs.msg import MeasuredPassNoise, RoughnessSurvey
 MODEL_SECTIONS = (("corrugation.", CORRUGATION_SPECS), ("noise.", NOISE_SPECS), ("squeal.", SQUEAL_SPECS),
                   ("residual.", RESIDUAL_SPECS), ("alerts.", ALERT_SPECS))
 PUBLISHED = ("noise/squeal", "corrugation/state", "noise/rolling", "alerts", "alerts/standing", "noise/residual",
-             "corrugation/indirect_roughness")
-
-
-def output_publishers(node: Node, topics: tuple[str, ...] = PUBLISHED) -> dict[str, Any]:
-    """The publishers of the model outputs (PUBLISHED), by topic, with the graph's QoS."""
-    pubs = {}
-    for topic in topics:
-        typename, qos = GRAPH_TOPICS.get(topic) or OPTIONAL_TOPICS[topic]
-        pubs[topic] = node.create_publisher(message_class(typename), topic, profile(qos))
-    return pubs
+             "corrugation/indirect_roughness", "noise/squeal_calibration")
 
 
 class SiteEngineNode(PassConsumerNode):
@@ -91,11 +80,13 @@ class SiteEngineNode(PassConsumerNode):
         self.engine = SiteEngine(values, threads=1, engine="numpy")
         self.engine.measured_live = True  # a station's measurement comes after its pass
         self._consequences: Consequences | None = None
-        # The indirect roughness only where its windows are kept (as corrugation_estimator offers it).
-        self.pubs = output_publishers(self, tuple(t for t in PUBLISHED if self.engine.observer is not None
-                                                  or t != "corrugation/indirect_roughness"))
+        # The indirect roughness only where its windows are kept (as corrugation_estimator offers it),
+        # the squeal model's fits where it is fitted.
+        offered = {"corrugation/indirect_roughness": self.engine.observer is not None,
+                   "noise/squeal_calibration": self.engine.squeal.enabled}
+        self.pubs = output_publishers(self, tuple(t for t in PUBLISHED if offered.get(t, True)))
         self.state_services = StateServices(self, self.engine.estimator, self.params, self.consequences, self.sent,
-                                            self.pubs["corrugation/state"], self.engine.observer)
+                                            self.pubs["corrugation/state"], self.engine.observer, self.engine.squeal)
         self.state_services.resume(self.engine.resume)
         self.stream_ns = self.engine.estimator.newest_ns
         self.add_on_set_parameters_callback(self._on_set_parameters)
@@ -162,7 +153,7 @@ class SiteEngineNode(PassConsumerNode):
             elif msgs.datas:
                 self.state_services.publish_state_if_due()
         self._events()
-        self._publish(result.alerts, result.residuals, result.observations)
+        self._publish(result.alerts, result.residuals, result.observations, result.calibrations)
         self._settle()
 
     def _send(self, msgs: outputs.Messages) -> None:
@@ -170,8 +161,9 @@ class SiteEngineNode(PassConsumerNode):
         for data in msgs.datas:
             self.sent.send(pub, data)
 
-    def _publish(self, alerts: list[Alert], residuals: list[Residual], observations: list[Any]) -> None:
-        for msgs in outputs.measured(residuals, observations, self.site.site_id):
+    def _publish(self, alerts: list[Alert], residuals: list[Residual], observations: list[Any],
+                 calibrations: list[Any] = ()) -> None:
+        for msgs in outputs.measured(residuals, observations, self.site.site_id, calibrations):
             self._send(msgs)
         for msgs in self.alert_stream.messages(alerts):
             self._send(msgs)
@@ -236,7 +228,8 @@ class SiteEngineNode(PassConsumerNode):
                   "days_to_threshold": f"{fc.days_to_threshold:.4g}", "grinding_due": fc.grinding_due,
                   "surveys pending": len(e.corrugation.pending), "standing": len(e.alerts.standing),
                   "raised": e.alerts.raised, "cleared": e.alerts.cleared,
-                  "measurements scored late": e.tracker.late, **self.state_services.diagnostic_values()}
+                  "measurements scored late": e.tracker.late, **self.state_services.diagnostic_values(),
+                  **{f"squeal fit {k}": v for k, v in sorted(e.squeal.counts.items())}}
         values.update({f"survey rejected: {why}": n for why, n in sorted(e.corrugation.refused.items())})
         values.update({f"noise/measured refused: {why}": n for why, n in sorted(e.tracker.refused.items())})
         if e.observer is not None:

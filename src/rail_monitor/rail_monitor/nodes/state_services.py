@@ -16,6 +16,7 @@ from rail_monitor.advice.consequences import Consequences
 from rail_monitor.core.node_params import EstimatorParams
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.engine import checkpoint
+from rail_monitor.engine.squeal_site import SquealSite
 from rail_monitor.measured.observer import IndirectObserver
 from rail_monitor.messages.fields import corrugation_state_fields, speed_advisory_fields
 from rail_monitor.nodes.base import RailNode, Sent, wall_timer
@@ -30,16 +31,16 @@ class StateServices:
     """The whole state, the advisory, the service and the checkpoint of the state ``est`` held by ``node``.
 
     consequences: the noise model and squeal parameters the advice weighs (built at first use);
-    state_pub: the node's corrugation/state publisher; observer: the indirect roughness windows
-    checkpointed with the state (None: none).
+    state_pub: the node's corrugation/state publisher; observer, squeal: the indirect roughness
+    windows and the squeal model's fit checkpointed with the state (None: none).
     """
 
     def __init__(self, node: RailNode, est: CorrugationEstimator, params: EstimatorParams,
                  consequences: Callable[[], Consequences], sent: Sent, state_pub: Any,
-                 observer: IndirectObserver | None = None) -> None:
+                 observer: IndirectObserver | None = None, squeal: SquealSite | None = None) -> None:
         self.node, self.est, self.params, self.sent, self.state_pub = node, est, params, sent, state_pub
         self._last_state_t = float("-inf")  # time.monotonic() of the last periodic state [s]
-        self.observer = observer
+        self.observer, self.squeal = observer, squeal
         self._consequences = consequences
         self.path = params.checkpoint_path
         self.skipped: list[str] = []
@@ -84,7 +85,7 @@ class StateServices:
         only for the copy)."""
         if self.writer is None:
             return
-        self.writer.submit(checkpoint.snapshot(self.est, self.observer))
+        self.writer.submit(checkpoint.snapshot(self.est, self.observer, self.squeal))
         self.since_checkpoint = 0
 
     def _failed(self, exc: OSError) -> None:  # on the writer's thread

@@ -74,6 +74,12 @@ class FitConfig:
     min_risk: int = 2               # the risk that counts as squealing (RISK_MEDIUM)
 
 
+def fit_config(cfg: SquealConfig, min_risk: int) -> FitConfig:
+    """The fit of a site's squeal parameters (its ``squeal.fit_prior_*``), squealing counted from
+    min_risk (the alerts' ``squeal_min_risk``, as a RISK_* value)."""
+    return FitConfig(prior_sd_peak=cfg.fit_prior_sd_peak, prior_sd_slope=cfg.fit_prior_sd_slope, min_risk=min_risk)
+
+
 @dataclass(frozen=True)
 class CurveQuantiles:
     """A friction state's fitted creep curve: quantiles (P10, P50, P90) of k1 and of k2 [-], and
@@ -188,6 +194,56 @@ class SquealFit:
             self.log_post[code] += self._log_likelihood(code, *part)
             self.seen[code][0] += len(rows)
             self.seen[code][1] += int(squealed[rows].sum())
+
+    def _merged(self, code: int) -> tuple[PassTable, np.ndarray, np.ndarray] | None:
+        """The state's kept passes as one part (None: none)."""
+        parts = self.kept[code]
+        if len(parts) > 1:
+            parts[:] = [(PassTable.concat([p[0] for p in parts]), *(np.concatenate([p[i] for p in parts])
+                                                                     for i in (1, 2)))]
+        return parts[0] if parts else None
+
+    def keep_newest(self, code: int, n: int) -> None:
+        """Keep the state's newest n measured passes: the older ones' likelihood is taken out of the
+        posterior, which is then that of the newest n (a site's friction changes with the seasons)."""
+        kept = self._merged(code)
+        if kept is None or len(kept[0]) <= n:
+            return
+        drop = len(kept[0]) - n
+        old = (kept[0].take(slice(0, drop)), kept[1][:drop], kept[2][:drop])
+        self.log_post[code] -= self._log_likelihood(code, *old)
+        self.kept[code] = [(kept[0].take(slice(drop, None)), kept[1][drop:], kept[2][drop:])]
+        self.seen[code] = [self.seen[code][0] - drop, self.seen[code][1] - int(old[1].sum())]
+
+    def to_arrays(self, prefix: str) -> dict[str, np.ndarray]:
+        """Every state's grid, log-posterior and kept passes, for a checkpoint (keys under prefix)."""
+        out: dict[str, np.ndarray] = {}
+        for code in FRICTION_NAMES:
+            kept = self._merged(code) or (PassTable.empty(), np.zeros(0, bool), np.zeros(0))
+            p = f"{prefix}{code}_"
+            out.update({f"{p}a": self.grids[code][0], f"{p}s": self.grids[code][1], f"{p}log_post": self.log_post[code],
+                        f"{p}seen": np.array(self.seen[code], np.int64), f"{p}squealed": kept[1],
+                        f"{p}level": kept[2],
+                        **{f"{p}pass_{c}": getattr(kept[0], c) for c in PassTable.columns()}})
+        return out
+
+    def restore(self, arrays: dict[str, np.ndarray], prefix: str) -> None:
+        """Resume from to_arrays's records (ValueError, the fit untouched, if they are not usable)."""
+        grids, log_post, kept, seen = {}, {}, {}, {}
+        for code in FRICTION_NAMES:
+            p = f"{prefix}{code}_"
+            a, s, lp = (np.asarray(arrays[f"{p}{k}"], float) for k in ("a", "s", "log_post"))
+            table = PassTable(**{c: np.asarray(arrays[f"{p}pass_{c}"]).astype(PassTable.DTYPES[c])
+                                 for c in PassTable.columns()})
+            squealed, level = np.asarray(arrays[f"{p}squealed"]).astype(bool), np.asarray(arrays[f"{p}level"], float)
+            counts = np.asarray(arrays[f"{p}seen"]).astype(np.int64, casting="same_kind")
+            if a.shape != (GRID,) or s.shape != (GRID,) or lp.shape != (GRID, GRID) or not np.all(np.isfinite(lp)) \
+                    or squealed.shape != (len(table),) or level.shape != (len(table),) or counts.shape != (2,) \
+                    or counts[0] != len(table) or not 0 <= counts[1] <= counts[0]:
+                raise ValueError(f"squeal fit records of friction state {code} have the wrong shape or counts")
+            grids[code], log_post[code], seen[code] = (a, s), lp, counts.tolist()
+            kept[code] = [(table, squealed, level)] if len(table) else []
+        self.grids, self.log_post, self.kept, self.seen = grids, log_post, kept, seen
 
     def refine(self, code: int, rounds: int = 8) -> None:
         """Zoom the state's grid onto its posterior and evaluate every kept pass on it.

@@ -27,6 +27,14 @@ SQUEAL_SPECS: tuple[ParamSpec, ...] = (
               "which a friction modifier's benefit is judged [dB(A)].", 0.0, 200.0),
     ParamSpec("risk_medium_dba", 85.0, "Squeal level from which the risk is medium [dB(A)].", 0.0, 200.0),
     ParamSpec("risk_high_dba", 95.0, "Squeal level from which the risk is high [dB(A)].", 0.0, 200.0),
+    ParamSpec("fit_days", 7.0, "Windows of measured squeal (from the Unix epoch, UTC) at whose end each friction "
+              "state's creep curve is re-fitted from the measured pass-bys and the passes after it predicted on "
+              "the posterior's P50 [day]; 0: the configured curves always.", 0.0, 3650.0),
+    ParamSpec("fit_window_passes", 2000, "Measured passes per friction state the fit keeps, the newest [-].",
+              10, 1_000_000),
+    ParamSpec("fit_prior_sd_peak", 0.4, "Prior standard deviation of ln(k1 / the configured k1) [-].", 0.01, 3.0),
+    ParamSpec("fit_prior_sd_slope", 0.05, "Prior standard deviation of k2 / k1 about the configured ratio [-].",
+              0.001, 1.0),
 )
 
 
@@ -41,6 +49,10 @@ class SquealConfig:
     background_level_dba: float
     risk_medium_dba: float
     risk_high_dba: float
+    fit_days: float
+    fit_window_passes: int
+    fit_prior_sd_peak: float
+    fit_prior_sd_slope: float
 
 
 def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealConfig:

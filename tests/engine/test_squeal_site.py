@@ -1,0 +1,143 @@
+"""The squeal model calibrated live in the site engine (engine.squeal_site, issue 55): each window's
+fit made before the first pass after its end, the passes after it predicted on its P50 curves, the
+same bits however the passes come (one chunk, one at a time with the measurements after each pass
+as a station sends them, across a checkpoint), and the posterior closing on a true curve the fit
+never saw."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from rail_monitor.batch.run import run_models
+from rail_monitor.core.friction import FRICTION_BY_NAME, FRICTION_NAMES
+from rail_monitor.core.simulator_params import simulator_config
+from rail_monitor.core.site import site_from_values
+from rail_monitor.core.timeutil import NS_PER_DAY
+from rail_monitor.engine import checkpoint
+from rail_monitor.engine.site import SiteEngine
+from rail_monitor.simulation.measurements import station_on_true_rail
+from rail_monitor.simulation.simulator import simulate
+from rail_monitor.site_file import load_parameter_file
+from rail_monitor.squeal.config import squeal_config
+from rail_monitor.squeal.predict import predict
+
+from conftest import SITE_FILE
+
+# The true curves of tests/squeal/test_calibration.py, off the configured ones (dry 0.30/-0.020,
+# wet 0.20/-0.0133, contaminated 0.10/-0.0067), kept out of the fit's reach.
+TRUTH = {"dry": (0.36, -0.030), "wet": (0.16, -0.016), "contaminated": (0.12, -0.006)}
+DAYS = 28.0
+FIT_DAYS = 7.0
+
+
+@pytest.fixture(scope="module")
+def month():
+    values = load_parameter_file(SITE_FILE)
+    values.update({"simulator.days": DAYS, "squeal.fit_days": FIT_DAYS})
+    table = simulate(site_from_values(values), simulator_config(values)).sorted()
+    station = station_on_true_rail(table, values, 1.0, int(values["simulator.seed"]), TRUTH)
+    return values, table, sorted(station.measurements, key=lambda m: m.key)
+
+
+@pytest.fixture(scope="module")
+def batch(month):
+    values, table, measurements = month
+    return run_models(table, values, threads=1, measurements=measurements)
+
+
+def _same_outputs(a, b) -> None:
+    for k in a.squeal:
+        np.testing.assert_array_equal(a.squeal[k], b.squeal[k], err_msg=k)
+    assert [c.stamp_ns for c in a.calibrations] == [c.stamp_ns for c in b.calibrations]
+    for x, y in zip(a.calibrations, b.calibrations, strict=True):
+        assert x.states == y.states
+
+
+def test_each_window_is_fitted_and_the_passes_after_it_are_predicted_on_its_median(month, batch):
+    """A fit at each 7-day window's end that has passes after it (stamps multiples of 7 days from
+    the epoch); the squeal of the passes before the first fit is the configured model's, and that
+    of the passes after the last fit is the model's on that fit's P50 curves, recomputed here
+    (squeal.predict, bit for bit)."""
+    values = month[0]
+    cals = batch.calibrations
+    t = batch.accepted.stamp_ns
+    ends = sorted({-(-int(s) // int(FIT_DAYS * NS_PER_DAY)) * int(FIT_DAYS * NS_PER_DAY) for s in t})[:-1]
+    assert [c.stamp_ns for c in cals] == ends and len(cals) >= 3
+    cfg, site = squeal_config(values), batch.site
+    before = t <= cals[0].stamp_ns
+    np.testing.assert_array_equal(batch.squeal["level_dba"][before],
+                                  predict(cfg, site, batch.accepted.take(before))["level_dba"])
+    last = cals[-1]
+    curves = {}
+    for code, _, q in last.states:
+        curves.update({f"creep_{FRICTION_NAMES[code]}_k1": q.k1[1], f"creep_{FRICTION_NAMES[code]}_k2": q.k2[1]})
+    fitted = replace(site, contact=replace(site.contact, **curves))
+    after = t > last.stamp_ns
+    for k in ("level_dba", "risk", "velocity_amplitude_mps"):
+        np.testing.assert_array_equal(batch.squeal[k][after], predict(cfg, fitted, batch.accepted.take(after))[k])
+    assert {FRICTION_NAMES[code] for code, _, _ in last.states} == {"dry", "wet"}  # the month's states
+
+
+def test_four_weeks_of_measured_squeal_close_on_the_true_curves(batch):
+    """After four weeks (every pass measured, 2 % of the flags wrong, tone levels to 1.5 dB) each
+    state run (dry and wet: a month without leaves) has its true peak within its P10-P90 of k1, and
+    that interval spans at most 6 % of its median (measured: dry 0.355-0.366 over 1,895 passes, 3.1 %;
+    wet 0.153-0.161 over 358, 4.5 %; the prior's P10-P90 spans 107 %); the configured peaks miss
+    the truth by 17-20 %."""
+    last = {FRICTION_NAMES[code]: (k0, q) for code, k0, q in batch.calibrations[-1].states}
+    for name in last:
+        k1 = TRUTH[name][0]
+        (k1_0, _), q = last[name]
+        assert q.k1[0] <= k1 <= q.k1[2], (name, q.k1)
+        assert (q.k1[2] - q.k1[0]) / q.k1[1] <= 0.06, (name, q.k1)
+        assert abs(k1_0 - k1) / k1 > 0.15
+
+
+def test_one_pass_at_a_time_with_measurements_after_their_passes_gives_the_same_bits(month, batch):
+    """Live: each pass fed alone, then its measurement taken as a station sends it after the pass,
+    then settled (as site_engine does): the same squeal and fits as the history in one chunk."""
+    values, table, measurements = month
+    by_key = {m.key: m for m in measurements}
+    engine = SiteEngine(values, threads=1)
+    engine.measured_live = True
+    parts = []
+    for i in range(len(table)):
+        parts.append(engine.feed(table.take(slice(i, i + 1)), late=True))
+        m = by_key.get((int(table.stamp_ns[i]), str(table.train_id[i])))
+        if m is not None:
+            engine.take_measurements([m])
+        engine.settle()
+    live = type(batch).merged(parts, [], None)
+    _same_outputs(live, batch)
+
+
+def test_a_checkpoint_mid_history_resumes_the_fit(month, batch, tmp_path):
+    """The engine checkpointed after 12 days (the fit, the open window, the passes paired since
+    the last fit and those awaiting their measurement) and resumed in a new engine gives the
+    uninterrupted run's squeal and fits; the fit's arrays are in the file."""
+    values, table, measurements = month
+    cut = int(np.searchsorted(table.stamp_ns, table.stamp_ns[0] + int(12 * NS_PER_DAY)))
+    first = SiteEngine(values, threads=1, measurements=measurements)
+    a = first.feed(table.take(slice(0, cut)))
+    path = tmp_path / "state.npz"
+    checkpoint.save(first.estimator, path, first.observer, first.squeal)
+    with np.load(path) as data:
+        assert {"squeal_fit_1_log_post", "squeal_fit_scalars", "squeal_fit_paired_measures"} <= set(data.files)
+    later = [m for m in measurements if m.stamp_ns > table.stamp_ns[cut - 1]]
+    second = SiteEngine(values, threads=1, measurements=later)
+    second.resume(str(path))
+    b = second.feed(table.take(slice(cut, None)))
+    _same_outputs(type(batch).merged([a, b], [], None), batch)
+
+
+def test_fit_days_zero_keeps_the_configured_curves(month):
+    values, table, measurements = month
+    off = run_models(table.take(slice(0, 600)), {**values, "squeal.fit_days": 0.0}, threads=1,
+                     measurements=measurements)
+    assert off.calibrations == []
+    np.testing.assert_array_equal(off.squeal["level_dba"],
+                                  predict(squeal_config(values), off.site, off.accepted)["level_dba"])
+    assert FRICTION_BY_NAME["dry"] in FRICTION_NAMES
