@@ -79,7 +79,10 @@ def test_a_node_states_its_topics_and_key_parameters_at_start():
     r = run_cmd("timeout", "-s", "INT", "3", "squeal_risk_model", "--ros-args", "-r", "__ns:=/curve_250",
                 "--params-file", str(TOP / "src/rail_monitor/config/curve_250.yaml"), timeout=60)
     line = next(x for x in r.stderr.splitlines() if "started:" in x)
-    assert "subscribes /curve_250/train_pass" in line and "publishes /curve_250/noise/squeal" in line
+    subscribed, published = (line.split(f"{verb} ", 1)[1].split(";", 1)[0].split(", ")
+                             for verb in ("subscribes", "publishes"))
+    assert {"/curve_250/train_pass", "/curve_250/noise/measured"} <= set(subscribed)  # the squeal fit's input
+    assert {"/curve_250/noise/squeal", "/curve_250/noise/squeal_calibration"} <= set(published)
     assert "site=curve_250" in line and "classes=emu/dmu/freight" in line and "k3=" in line
 
 

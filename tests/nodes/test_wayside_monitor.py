@@ -249,7 +249,9 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
 def test_report_folder_has_images_and_a_page(runs):
     files = sorted(runs["report"].iterdir())
     pngs = [f for f in files if f.suffix == ".png"]
-    assert {f.stem for f in pngs} == {"timeline", "corrugation", "noise", "squeal", "speeds", "measured"}
+    # squeal_fits: the day-long squeal fits of the measured squeal (FIT)
+    assert {f.stem for f in pngs} == {"timeline", "corrugation", "noise", "squeal", "speeds", "measured",
+                                      "squeal_fits"}
     for f in pngs:
         assert f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f.stat().st_size > 10_000
     page = (runs["report"] / "index.html").read_text()

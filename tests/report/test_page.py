@@ -257,3 +257,31 @@ def test_measured_squeal_by_angle_of_attack_and_the_repeat_squealers_named():
                   10**18, 10**18, 0)
     cleared = Alert(KIND_SQUEAL_OFFENDER, "vehicle V9", 0, False, "cleared", 0.5, 0.01, "-", 10**18, 10**18, 0)
     assert [r["vehicle or train"] for r in report_tables.repeat_squealers([named, cleared], "UTC")] == ["vehicle V7"]
+
+
+def test_the_squeal_models_fits_are_reported_from_the_bag(tmp_path):
+    """A run whose measured squeal re-fits the squeal model (two weeks, weekly fits): the report's
+    table gives each friction state's latest fit as the bag recorded it, and its figure plots every
+    fit's P50 with the P10-P90 band and the configured curve (issue 55)."""
+    from rail_monitor.core.simulator_params import simulator_config
+    from rail_monitor.core.site import site_from_values
+    from rail_monitor.simulation.measurements import station_on_true_rail
+    from rail_monitor.simulation.simulator import simulate
+    from rail_monitor.site_file import load_parameter_file
+
+    values = {**load_parameter_file(SITE_FILE), "simulator.days": 15.0}
+    table = simulate(site_from_values(values), simulator_config(values)).sorted()
+    station = station_on_true_rail(table, values, 1.0, 5, {"dry": (0.36, -0.030)})
+    result = run_models(table, values, threads=1, measurements=station.measurements)
+    assert len(result.calibrations) >= 2
+    run = load_run(write_bag(result, tmp_path / "bag", "curve_250"))
+    last = {code: q for code, _, q in result.calibrations[-1].states}
+    rows = {r["friction state"]: r for r in report_tables.squeal_fits(run.squeal_fits, "UTC")}
+    assert rows["dry"]["k1 P10 / P50 / P90"] == " / ".join(f"{v:.4g}" for v in last[1].k1)
+    assert rows["dry"]["measured passes"] == last[1].passes and rows["dry"]["k1 configured"] == 0.3
+    assert len(run.squeal_fits["dry"]["stamp_ns"]) == len(result.calibrations)
+    fig = report_plots.squeal_fits(run.squeal_fits, "UTC")
+    assert [ax.get_ylabel() for ax in fig.axes] == ["friction peak k1 [-]", "falling slope k2 [-]"]
+    files = build_report(run, SiteConfig.from_values(values), tmp_path / "report", "curve_250.yaml")
+    page = next(f for f in files if f.name == "index.html").read_text()
+    assert "The squeal model fitted to the measured squeal" in page and "squeal_fits" in page

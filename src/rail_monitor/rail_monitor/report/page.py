@@ -169,7 +169,8 @@ def write_report(run: RunData, cfg: SiteConfig, out: Path, figures_extra: Mappin
               "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run),
               "offenders": report_tables.repeat_offenders(t, cfg, zone),
               "squeal_angles": report_tables.squeal_by_angle(t, lim),
-              "repeat_squealers": report_tables.repeat_squealers(run.alerts, zone)}
+              "repeat_squealers": report_tables.repeat_squealers(run.alerts, zone),
+              "squeal_fits": report_tables.squeal_fits(run.squeal_fits, zone)}
     head = headline(run, t, lim, tables, zone)
     figures = [("timeline", "Passes and squealing passes per day, and the day's highest pass-by level against "
                 "the limit.", report_plots.timeline(report_tables.daily(t, lim, models, zone), models, lim, zone))]
@@ -183,6 +184,10 @@ def write_report(run: RunData, cfg: SiteConfig, out: Path, figures_extra: Mappin
     if len(run.squeal.get("risk", ())):
         figures.append(("squeal", "Squeal amplitude against crabbing velocity: every pass and the model per "
                         "friction state.", report_plots.squeal(run.squeal, figures_extra["curves"])))
+    if run.squeal_fits:
+        figures.append(("squeal_fits", "The squeal model's creep curves as the measured squeal fitted them, per "
+                        "friction state: P50 and the P10-P90 band at each fit, the configured curve dashed.",
+                        report_plots.squeal_fits(run.squeal_fits, zone)))
     if run.residuals:
         figures.append(("measured", "Measured pass-by noise against the prediction, and the 500-2000 Hz residual "
                         "against the site's running baseline (the wheel-defect and drift alerts' reference).",
@@ -293,6 +298,10 @@ def _html(run, values, head, tables, lim, figures, meta, listen=()) -> str:
         measured += (f"<h2>Measured squeal against the model, by angle of attack</h2>"
                      f"{_html_table(tables['squeal_angles'])}<h2>Repeat squealers</h2>"
                      f"{_html_table(tables['repeat_squealers'], 25)}")
+    if tables["squeal_fits"]:
+        measured += (f"<h2>The squeal model fitted to the measured squeal</h2>{_html_table(tables['squeal_fits'])}"
+                     "<p class=\"meta\">Each friction state's latest fit (squeal.fit_days windows); the passes "
+                     "after it are predicted on its P50 curve.</p>" + fig("squeal_fits"))
     advice = (f"<h2>Speed advice per class</h2>{_html_table(tables['advice'])}<p class=\"meta\">Shares of each "
               "class's trains per speed band at its recent mean speed, cutting the peak corrugation growth "
               "without raising the mean noise by more than the limit or the squealing share.</p>"

@@ -139,6 +139,27 @@ def squeal(squeal_data: Mapping[str, np.ndarray], curves: dict) -> Figure:
     return fig
 
 
+def squeal_fits(fits: Mapping[str, Mapping[str, np.ndarray]], zone: str) -> Figure:
+    """Each friction state's creep curve as the site's measured squeal fitted it: the peak k1 and the
+    falling slope k2, P50 with the P10-P90 band at each fit, the configured value dashed."""
+    fig, axes = plt.subplots(2, 1, sharex=True, figsize=(8.0, 5.6), constrained_layout=True)
+    for j, (state, f) in enumerate(fits.items()):
+        t = _dates(f["stamp_ns"])
+        for ax, k in zip(axes, ("k1", "k2"), strict=True):
+            ax.fill_between(t, f[f"{k}_p10"], f[f"{k}_p90"], step="post", color=f"C{j}", alpha=0.25)
+            ax.step(t, f[f"{k}_p50"], where="post", color=f"C{j}", label=f"{state}, P50 (band: P10-P90)")
+            ax.axhline(f[f"{k}_configured"][-1], color=f"C{j}", ls="--", lw=1.0)
+    axes[0].set_ylabel("friction peak k1 [-]")
+    axes[1].set_ylabel("falling slope k2 [-]")
+    axes[0].legend(fontsize="small")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+    _time_axis(axes[1], zone)
+    axes[0].set_title("The squeal model's creep curves fitted to the measured squeal (dashed: configured)",
+                      fontsize="medium")
+    return fig
+
+
 def speeds(speed_mps: np.ndarray, advisory) -> Figure:
     """Speed distributions in km/h, shares of train passes: the whole history, the advisory's recent
     passes and its advised distribution (every class; the plan is per class)."""

@@ -20,7 +20,9 @@ from rail_monitor.measured.records import SQUEAL_MEASURES
 from rail_monitor.messages.fields import alert_from_msg, pass_row, time_ns
 
 _TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory",
-          "MeasuredPassNoise", "NoiseResidual")
+          "MeasuredPassNoise", "NoiseResidual", "SquealCalibration")
+_FIT = ("k1_configured", "k2_configured", "k1_p10", "k1_p50", "k1_p90", "k2_p10", "k2_p50", "k2_p90",
+        "measured_passes", "squealing_passes")
 _MEASURED = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "squeal_detected", "instrument_class", *SQUEAL_MEASURES)
 _RESIDUAL = ("residual_lpaeq_dba", "residual_lpafmax_dba", "residual_tel_dba", "residual_mid_db", "baseline_mid_db",
              "drift_db", "excess_mid_db", "loudest_vehicle_id", "loudest_vehicle_excess_db")
@@ -42,6 +44,7 @@ class RunData:
     advisory: Any = None
     measured: dict[str, np.ndarray] = field(default_factory=dict)               # MeasuredPassNoise fields
     residuals: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)   # NoiseResidual fields, by model
+    squeal_fits: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)  # SquealCalibration, by state
 
 
 def load_run(bag: str | Path) -> RunData:
@@ -132,6 +135,13 @@ def _run_of(path: Path, got: dict[str, list[Any]]) -> RunData:
     for model in sorted({m.model for m in got["rail_msgs/msg/NoiseResidual"]}):
         run.residuals[model] = _columns([m for m in got["rail_msgs/msg/NoiseResidual"] if m.model == model],
                                         _RESIDUAL)
+    for msg in got["rail_msgs/msg/SquealCalibration"]:  # one row per fit of each state
+        for i, state in enumerate(msg.friction_state):
+            fit = run.squeal_fits.setdefault(state, {"stamp_ns": [], **{k: [] for k in _FIT}})
+            fit["stamp_ns"].append(time_ns(msg.header.stamp))
+            for k in _FIT:
+                fit[k].append(getattr(msg, k)[i])
+    run.squeal_fits = {s: {k: np.array(v) for k, v in f.items()} for s, f in run.squeal_fits.items()}
     run.alerts = sorted((alert_from_msg(m) for m in al), key=lambda a: (a.stamp_ns, a.kind, a.key, a.active))
     run.advisory = advisories[-1] if advisories else None
     return run

@@ -150,6 +150,21 @@ def squeal_by_angle(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list
     return rows
 
 
+def squeal_fits(fits: Mapping[str, Mapping[str, np.ndarray]], zone: str) -> list[dict]:
+    """Each friction state's latest fit of the squeal model to the measured squeal: its configured
+    curve and the posterior's P10/P50/P90 (empty without fits)."""
+    rows = []
+    for state, f in fits.items():
+        k1, k2 = (" / ".join(f"{f[f'{k}_{p}'][-1]:.4g}" for p in ("p10", "p50", "p90")) for k in ("k1", "k2"))
+        passes = int(f["measured_passes"][-1])
+        rows.append({"friction state": state, "fitted (local)": format_local_ns(int(f["stamp_ns"][-1]), zone),
+                     "measured passes": passes,
+                     "squealing, measured [%]": 100.0 * f["squealing_passes"][-1] / max(passes, 1),
+                     "k1 configured": float(f["k1_configured"][-1]), "k1 P10 / P50 / P90": k1,
+                     "k2 configured": float(f["k2_configured"][-1]), "k2 P10 / P50 / P90": k2})
+    return rows
+
+
 def repeat_squealers(alerts: list, zone: str) -> list[dict]:
     """The vehicles (or trains) the repeat-squealer alert named, the latest first."""
     from rail_monitor.alerts.config import KIND_SQUEAL_OFFENDER
