@@ -141,3 +141,29 @@ def test_fit_days_zero_keeps_the_configured_curves(month):
     np.testing.assert_array_equal(off.squeal["level_dba"],
                                   predict(squeal_config(values), off.site, off.accepted)["level_dba"])
     assert FRICTION_BY_NAME["dry"] in FRICTION_NAMES
+
+
+def test_hostile_measurements_are_counted_by_reason_and_change_nothing(month):
+    """Measurements the fit cannot use are counted by reason and leave the squeal as without them:
+    500 far ahead of every pass (at most residual.held_predictions wait for their passes), a tone
+    of 500 dB, a microphone at -1 m, and one for a pass that never came."""
+    values, table, measurements = month
+    part = table.take(slice(0, 300))
+    clean = run_models(part, values, threads=1)
+    engine = SiteEngine({**values, "residual.held_predictions": 100}, threads=1)
+    engine.measured_live = True
+    far = [replace(measurements[0], stamp_ns=4 * 10**18, train_id=f"F{i}") for i in range(500)]
+    bad = [replace(measurements[1], squeal_level_db=500.0), replace(measurements[2], receiver_distance_m=-1.0),
+           replace(measurements[3], train_id="NO-SUCH-TRAIN")]
+    engine.take_measurements(far + bad[:2])
+    out = engine.feed(part, late=True)
+    engine.take_measurements(bad[2:])  # its pass's time has gone by
+    counts = engine.squeal.counts
+    assert len(engine.squeal.waiting) == 100
+    assert counts["refused: more measurements ahead of every accepted pass than held"] == 400
+    assert sum(n for k, n in counts.items() if "squeal measure is out of range" in k) == 1
+    assert sum(n for k, n in counts.items() if "receiver distance" in k) == 1
+    assert counts["no accepted pass (unknown, rejected, or measured twice)"] == 1
+    assert out.calibrations == [] and engine.squeal.site == clean.site
+    for k in ("level_dba", "risk"):
+        np.testing.assert_array_equal(out.squeal[k], clean.squeal[k])

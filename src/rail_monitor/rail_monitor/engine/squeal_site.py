@@ -23,7 +23,7 @@ squeal limit, which weighs the configured curves.
 from __future__ import annotations
 
 import heapq
-from collections import Counter, OrderedDict
+from collections import Counter, OrderedDict, deque
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 
@@ -60,9 +60,14 @@ class SquealSite:
         self.window = cfg.fit_window_passes
         self.fit = SquealFit(site, cfg, fit_config(cfg, min_risk)) if self.interval_ns > 0 else None
         self.held_max = held
+        self.waiting_max = held  # measurements ahead of every accepted pass (a batch's owner raises it)
         self.window_end_ns = 0                          # end of the open window (0: none yet)
-        # Accepted passes awaiting their measurement, oldest first: (stamp, train id) -> (table, row).
+        # Accepted passes awaiting their measurement, oldest first: (stamp, train id) -> (table, row);
+        # newer ones in the tables not yet indexed (indexed when a measurement is looked up: a history
+        # without measurements costs no work per pass).
         self.held: OrderedDict[tuple[int, str], tuple[PassTable, int]] = OrderedDict()
+        self._unindexed: deque[PassTable] = deque()
+        self._unindexed_rows = 0
         self.waiting: dict[tuple[int, str], Measurement] = {}  # measurements later than every accepted pass
         self._waiting_order: list[tuple[int, str]] = []  # their keys, a heap (paired ones left in it)
         # Paired since the last fit: (key, its pass, squeal flagged, tone level [dB], microphone distance [m]).
@@ -99,14 +104,27 @@ class SquealSite:
         measurements, else held for those still to come."""
         if not self.enabled or not len(accepted):
             return
-        for i, key in enumerate(zip(accepted.stamp_ns.tolist(), accepted.train_id.tolist(), strict=True)):
-            m = self.waiting.pop(key, None)
-            if m is not None:
-                self._pair(key, accepted.take(slice(i, i + 1)), m)
-            else:
-                self.held[key] = (accepted, i)
-        while len(self.held) > self.held_max:
+        if self.waiting:
+            self._index()
+            for i, key in enumerate(zip(accepted.stamp_ns.tolist(), accepted.train_id.tolist(), strict=True)):
+                m = self.waiting.pop(key, None)
+                if m is not None:
+                    self._pair(key, accepted.take(slice(i, i + 1)), m)
+                else:
+                    self.held[key] = (accepted, i)
+        else:
+            self._unindexed.append(accepted)
+            self._unindexed_rows += len(accepted)
+        excess = len(self.held) + self._unindexed_rows - self.held_max  # the oldest beyond held_max go
+        while excess > 0 and self.held:
             self.held.popitem(last=False)
+            excess -= 1
+        while excess > 0:
+            oldest = self._unindexed.popleft()
+            if len(oldest) > excess:
+                self._unindexed.appendleft(oldest.take(slice(excess, None)))
+            self._unindexed_rows -= min(len(oldest), excess)
+            excess -= len(oldest)
         self.newest_held_ns = max(self.newest_held_ns, int(accepted.stamp_ns.max()))
         while self._waiting_order and self._waiting_order[0][0] < self.newest_held_ns:  # passes that never came
             if self.waiting.pop(heapq.heappop(self._waiting_order), None) is not None:
@@ -117,6 +135,7 @@ class SquealSite:
         measures are not measures, or whose pass is neither held nor to come, is counted by reason."""
         if not self.enabled:
             return
+        self._index()
         for m in measurements:
             why = squeal_observation_refusal(m)
             held = self.held.pop(m.key, None) if not why else None
@@ -125,10 +144,21 @@ class SquealSite:
             elif held is not None:
                 self._pair(m.key, held[0].take(slice(held[1], held[1] + 1)), m)
             elif m.stamp_ns >= self.newest_held_ns and m.key not in self.waiting:
+                if len(self.waiting) >= self.waiting_max:
+                    self.counts["refused: more measurements ahead of every accepted pass than held"] += 1
+                    continue
                 self.waiting[m.key] = m
                 heapq.heappush(self._waiting_order, m.key)
             else:
                 self.counts["no accepted pass (unknown, rejected, or measured twice)"] += 1
+
+    def _index(self) -> None:
+        """The held tables not yet indexed, indexed (after the older ones)."""
+        while self._unindexed:
+            table = self._unindexed.popleft()
+            for i, key in enumerate(zip(table.stamp_ns.tolist(), table.train_id.tolist(), strict=True)):
+                self.held[key] = (table, i)
+        self._unindexed_rows = 0
 
     def _pair(self, key: tuple[int, str], row: PassTable, m: Measurement) -> None:
         self.pending.append((key, row, bool(m.squeal_detected), float(m.squeal_level_db),
@@ -175,6 +205,7 @@ class SquealSite:
         if not self.enabled:
             return {}
         rows = [table.row(i) for key, (table, i) in self.held.items() if key[0] > self.newest_taken_ns]
+        rows += [t.row(i) for t in self._unindexed for i in np.flatnonzero(t.stamp_ns > self.newest_taken_ns)]
         held = PassTable.from_rows(rows) if rows else PassTable.empty()
         paired = PassTable.concat([PassTable.empty(), *(p[1] for p in self.pending)])
         return {**self.fit.to_arrays(PREFIX),
@@ -203,5 +234,6 @@ class SquealSite:
                          bool(f), float(level), float(d)) for i, (f, level, d) in enumerate(measures)]
         self.window_end_ns, self.newest_taken_ns = int(scalars[0]), int(scalars[1])
         self.held, self.waiting, self._waiting_order = OrderedDict(), dict(self.waiting), list(self._waiting_order)
+        self._unindexed, self._unindexed_rows = deque(), 0
         self.hold(held)
         self._use([(code, (0.0, 0.0), fit.quantiles(code)) for code in FRICTION_NAMES if fit.seen[code][0]])
