@@ -15,7 +15,7 @@ from rail_monitor.core.friction import FRICTION_NAMES
 from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
 from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.measured.records import Measurement
-from rail_monitor.squeal.calibration import FitConfig, SquealFit
+from rail_monitor.squeal.calibration import FitConfig, SquealFit, fit_config
 from rail_monitor.squeal.predict import predict
 
 
@@ -38,8 +38,8 @@ def fit_squeal(values: Mapping[str, Any], passes: PassTable, measurements: Seque
     and a row per friction state measured: the configured and fitted curves, the passes and the
     squeal share measured, predicted by the configured curve and by the fit (its predictive mean)."""
     config = SiteConfig.from_values(values)
-    if cfg is None:
-        cfg = FitConfig(min_risk=RISK_NAMES.index(config.alerts.squeal_min_risk))
+    if cfg is None:  # the site's prior (squeal.fit_prior_*), squealing counted as the alerts count it
+        cfg = fit_config(config.squeal, RISK_NAMES.index(config.alerts.squeal_min_risk))
     table, flags, level, distance = measured_passes(config, passes, measurements)
     fit = SquealFit(config.site, config.squeal, cfg)
     fit.observe(table, flags, level if levels else np.full(len(table), np.nan), distance)
