@@ -12,8 +12,9 @@ recorded. The site engine and the squeal_risk_model node hold one each and cut t
 so both predict every pass on the same curves.
 
 A measurement is paired with its accepted pass whichever comes first (live, the pass; in batch,
-the measurements are known first): it waits while its stamp is later than every accepted pass, a
-pass waits among the newest ``residual.held_predictions``. One whose squeal measures are not
+the measurements are known first): it waits while its stamp is later than every accepted pass
+(``residual.held_predictions`` of them at most), a pass among the newest ``residual.held_predictions``
+(and up to an eighth more). One whose squeal measures are not
 measures (``squeal_observation_refusal``), or whose pass never came, is counted by reason. It must
 arrive before the first pass after its window's end (a replay sends each after its pass and
 before the next); one that comes later joins the next fit. The curves do not change the advice's
@@ -39,6 +40,7 @@ from rail_monitor.squeal.calibration import CurveQuantiles, SquealFit, fit_confi
 from rail_monitor.squeal.config import SquealConfig
 
 PREFIX = "squeal_fit_"  # its checkpoint records
+MERGE_TABLES = 64       # held tables not yet indexed, merged into one past this many
 
 
 @dataclass(frozen=True)
@@ -115,7 +117,11 @@ class SquealSite:
         else:
             self._unindexed.append(accepted)
             self._unindexed_rows += len(accepted)
+            if len(self._unindexed) > MERGE_TABLES:  # live: a table a pass; kept as few (cheap to copy out)
+                self._unindexed = deque([PassTable.concat(list(self._unindexed))])
         excess = len(self.held) + self._unindexed_rows - self.held_max  # the oldest beyond held_max go
+        if excess <= 0 or (not self.held and excess < self.held_max // 8):
+            excess = 0  # a merged table is cut once an eighth of it is over, not a pass at a time
         while excess > 0 and self.held:
             self.held.popitem(last=False)
             excess -= 1
@@ -204,9 +210,13 @@ class SquealSite:
         sends them again)."""
         if not self.enabled:
             return {}
-        rows = [table.row(i) for key, (table, i) in self.held.items() if key[0] > self.newest_taken_ns]
-        rows += [t.row(i) for t in self._unindexed for i in np.flatnonzero(t.stamp_ns > self.newest_taken_ns)]
-        held = PassTable.from_rows(rows) if rows else PassTable.empty()
+        # Taken table by table (a checkpoint is copied on the executor's thread: no per-pass Python).
+        by_table: dict[int, tuple[PassTable, list[int]]] = {}
+        for key, (table, i) in self.held.items():
+            if key[0] > self.newest_taken_ns:
+                by_table.setdefault(id(table), (table, []))[1].append(i)
+        held = PassTable.concat([PassTable.empty(), *(t.take(np.array(rows)) for t, rows in by_table.values()),
+                                 *(t.take(t.stamp_ns > self.newest_taken_ns) for t in self._unindexed)])
         paired = PassTable.concat([PassTable.empty(), *(p[1] for p in self.pending)])
         return {**self.fit.to_arrays(PREFIX),
                 f"{PREFIX}scalars": np.array([self.window_end_ns, self.newest_taken_ns], np.int64),
