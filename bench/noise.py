@@ -11,7 +11,7 @@ import time
 from bench.corrugation import passes
 from bench.timing import best_of, header, parser
 from rail_monitor.core.site import site_from_values
-from rail_monitor.models.corrugation import band_limits, wavelength_bands
+from rail_monitor.models.corrugation_bands import band_limits, wavelength_bands
 from rail_monitor.noise.config import MODELS, PASS_BY_SOURCES, noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation

@@ -9,7 +9,7 @@ import pytest
 from noise.test_predict import _passes
 
 from rail_monitor.cli import main
-from rail_monitor.models.corrugation import band_limits, wavelength_bands
+from rail_monitor.models.corrugation_bands import band_limits, wavelength_bands
 from rail_monitor.noise.config import noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation

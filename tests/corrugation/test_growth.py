@@ -10,7 +10,9 @@ from corrugation.conftest import _estimator, _passes
 from rail_monitor.core.contact import REGIME_FULL_SLIDING, REGIME_PARTIAL_SLIP, contact_state
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.models import corrugation as cg
+from rail_monitor.models import corrugation_bands
 from rail_monitor.models import track as tr
+from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.contact_filter import hertzian_line_filter
 
 
@@ -23,7 +25,7 @@ def test_full_sliding_reverses_k_b_and_moves_the_growing_wavelength(site_, table
     tables.set_k_b(corrugation_config({}).k_b)
     j = round(14.0 / 0.1) - 1                                  # an EMU at 14 m/s on dry rail
     assert tables.speeds[j] == pytest.approx(14.0)
-    sub = cg.band_sub_wavelengths(tables.bands, 5)
+    sub = corrugation_bands.band_sub_wavelengths(tables.bands, 5)
     slip, slide = tables.table[0, 0, REGIME_PARTIAL_SLIP, :, j, :], tables.table[0, 0, REGIME_FULL_SLIDING, :, j, :]
     peak_slip, peak_slide = np.unravel_index(slip.argmax(), slip.shape), np.unravel_index(slide.argmax(), slide.shape)
     assert slide[peak_slip] < 0 < slip[peak_slip]
@@ -61,17 +63,17 @@ def test_the_growth_is_averaged_over_the_bay_positions_not_the_receptance(site_,
     v, speed = site_.vehicle("emu"), 22.0
     j = round(speed / 0.1) - 1
     patch = site_.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
-    sub = cg.band_sub_wavelengths(tables.bands, 5)
+    sub = corrugation_bands.band_sub_wavelengths(tables.bands, 5)
     f = speed / sub.ravel()
     r = tr.discrete_receptance(f, site_.track, position=(np.arange(8) + 0.5) / 8)
-    h = cg.growth_kernel(float(patch.stiffness), r + tr.wheel_receptance(f, v.unsprung_mass_kg)[:, None])
+    h = cg.growth_kernel(float(patch.stiffness), r + wrn.wheel_receptance(f, v.unsprung_mass_kg)[:, None])
     filt = hertzian_line_filter(sub.ravel(), float(patch.a))[:, None]
     direct = np.log(np.abs(1.0 + tables.k_b[0] * filt**2 * h)).mean(axis=1).reshape(sub.shape)
     table = tables.table[0, 0, REGIME_PARTIAL_SLIP, :, j, :]
     assert np.max(np.abs(table - direct)) <= 0.01 * direct.max()
     # Averaging the receptance first (its phase varies along the bay around the pinned-pinned
     # resonance) gives a 20 mm band growing about half as fast again: the order matters there.
-    averaged = cg.growth_kernel(float(patch.stiffness), r.mean(axis=1) + tr.wheel_receptance(f, v.unsprung_mass_kg))
+    averaged = cg.growth_kernel(float(patch.stiffness), r.mean(axis=1) + wrn.wheel_receptance(f, v.unsprung_mass_kg))
     first = np.log(np.abs(1.0 + tables.k_b[0] * filt[:, 0] ** 2 * averaged)).reshape(sub.shape)
     band = int(np.argmin(np.abs(tables.bands - 0.02)))
     assert first[band].max() > 1.3 * direct[band].max()

@@ -10,7 +10,7 @@ from corrugation.conftest import _estimator, _passes
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation.forecast import _seasonal_days
 from rail_monitor.corrugation.season import SEASON_DAYS, DailyGrowth
-from rail_monitor.models import corrugation as cg
+from rail_monitor.models import corrugation_state as cstate
 
 RNG = np.random.default_rng(6)
 
@@ -24,18 +24,18 @@ def _case(draws: int = 4, bands: int = 3, points: int = 5):
 
 def test_a_season_of_equal_days_gives_the_closed_form_forecast():
     # Every day the same growth: the day-by-day path with linear interpolation within a day must
-    # equal the closed form (models.corrugation.passes_to_band_level, growth per day), to 1e-3 day.
+    # equal the closed form (models.corrugation_state.passes_to_band_level, growth per day), to 1e-3 day.
     state, per_day, thr = _case()
     season = np.zeros((SEASON_DAYS, 4, *per_day.shape))
     season[:, 0] = 0.7 * per_day
     season[:, 2] = 0.3 * per_day
     got = _seasonal_days(state, np.ones((len(state), 4)), season, thr)
-    want = cg.passes_to_band_level(state, np.broadcast_to(per_day, state.shape), thr)
+    want = cstate.passes_to_band_level(state, np.broadcast_to(per_day, state.shape), thr)
     assert np.all(want > 50) and np.any(want > SEASON_DAYS)  # crossings inside and beyond the season
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-3)
     # a friction state's draw scale multiplies its own growth only
     twice = _seasonal_days(state, np.array([[1.0, 1.0, 3.0 + 1 / 3, 1.0]] * len(state)), season, thr)
-    np.testing.assert_allclose(twice, cg.passes_to_band_level(state, np.broadcast_to(1.7 * per_day, state.shape),
+    np.testing.assert_allclose(twice, cstate.passes_to_band_level(state, np.broadcast_to(1.7 * per_day, state.shape),
                                                               thr), atol=1e-3)
 
 
@@ -45,7 +45,7 @@ def test_days_without_growth_delay_the_crossing_by_their_number():
     season = np.zeros((SEASON_DAYS, 4, *per_day.shape))
     season[100:, 1] = per_day                          # 100 quiet days first (a line closure)
     got = _seasonal_days(state, np.ones((len(state), 4)), season, thr)
-    closed = cg.passes_to_band_level(state, np.broadcast_to(per_day, state.shape), thr)
+    closed = cstate.passes_to_band_level(state, np.broadcast_to(per_day, state.shape), thr)
     inside = closed < SEASON_DAYS - 100
     assert inside.any()
     np.testing.assert_allclose(got[inside], 100 + closed[inside], atol=1e-3)

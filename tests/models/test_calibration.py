@@ -6,7 +6,7 @@ import numpy as np
 from scipy.optimize import minimize
 
 from rail_monitor.models import calibration
-from rail_monitor.models.corrugation import band_log_amplitude
+from rail_monitor.models.corrugation_state import band_log_amplitude
 
 
 def _case(seed: int):

@@ -10,7 +10,10 @@ import pytest
 
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_directivity as cdir
+from rail_monitor.models import cnossos_roughness as crough
 from rail_monitor.models import cnossos_tables as ct
+from rail_monitor.models import cnossos_transfer as xfer
 
 T = ct.tables()
 
@@ -36,7 +39,7 @@ def test_unrounded_wheel_roughness_rounds_to_printed_table_g1a():
     np.testing.assert_allclose(T.wavelength_m[idx], wl, rtol=1e-9)
     for brake, col in (("cast_iron", "cast_iron_tread_brake"), ("composite", "composite_or_sinter_tread_brake"),
                        ("disc", "non_tread_disc_brake")):
-        np.testing.assert_allclose(cn.wheel_roughness(brake)[idx], printed[col], atol=0.051)
+        np.testing.assert_allclose(crough.wheel_roughness(brake)[idx], printed[col], atol=0.051)
 
 
 def test_hand_computed_band_disc_brake_class_e_monoblock_medium_pad():
@@ -47,11 +50,11 @@ def test_hand_computed_band_disc_brake_class_e_monoblock_medium_pad():
     L_R,TOT = 10 lg(10^-0.62 + 10^-0.858) - 8.0 = -12.219 dB; G-3a (monoblock medium, 1 kHz): 104.4;
     L_W,0,TR = -12.219 + 104.4 + 10 lg 4 = 98.202 dB. G-3b (920 mm, 1 kHz): 94.9 -> L_W,0,VEH = 88.702 dB.
     """
-    _, a3 = cn.contact_filter(50e3, 0.92)
-    lr = cn.total_roughness(cn.rail_roughness("E"), cn.wheel_roughness("disc"), a3)
+    _, a3 = crough.contact_filter(50e3, 0.92)
+    lr = crough.total_roughness(crough.rail_roughness("E"), crough.wheel_roughness("disc"), a3)
     lrf = cb.at_band_frequencies(lr, 20.0)
-    _, track = cn.track_transfer("monoblock", 400e6)
-    _, veh = cn.vehicle_transfer(0.92)
+    _, track = xfer.track_transfer("monoblock", 400e6)
+    _, veh = xfer.vehicle_transfer(0.92)
     power = cn.rolling_sound_power(lrf, 4, track, veh)
     i = list(T.band_hz).index(1000)
     hand_lr = 10 * np.log10(10 ** -0.62 + 10 ** -0.858) - 8.0
@@ -63,40 +66,40 @@ def test_hand_computed_band_disc_brake_class_e_monoblock_medium_pad():
 
 
 def test_table_choices_follow_the_directive():
-    assert [cn.pad_class(k) for k in (100e6, 200e6, 250e6, 500e6, 800e6, 900e6, 2e9)] == \
+    assert [xfer.pad_class(k) for k in (100e6, 200e6, 250e6, 500e6, 800e6, 900e6, 2e9)] == \
         ["soft", "soft", "medium", "medium", "medium", "hard", "hard"]
-    assert cn.track_transfer("biblock", 900e6)[0] == "track_biblock_hard_pad"
-    assert cn.track_transfer("wooden", 900e6)[0] == "track_wooden_sleepers"
-    assert cn.contact_filter(65e3, 0.84)[0] == (50e3, 0.92)
-    assert cn.contact_filter(100e3, 0.92)[0] == (100e3, 0.92)
-    assert cn.contact_filter(40e3, 0.70)[0] == (50e3, 0.68)
-    assert cn.vehicle_transfer(0.86)[0] == 0.84
+    assert xfer.track_transfer("biblock", 900e6)[0] == "track_biblock_hard_pad"
+    assert xfer.track_transfer("wooden", 900e6)[0] == "track_wooden_sleepers"
+    assert crough.contact_filter(65e3, 0.84)[0] == (50e3, 0.92)
+    assert crough.contact_filter(100e3, 0.92)[0] == (100e3, 0.92)
+    assert crough.contact_filter(40e3, 0.70)[0] == (50e3, 0.68)
+    assert xfer.vehicle_transfer(0.86)[0] == 0.84
     assert [cn.curve_squeal_db(r) for r in (250.0, 300.0, 400.0, 500.0, 800.0)] == [8, 8, 5, 5, 0]
-    assert cn.bridge_transfer("none") is None
+    assert xfer.bridge_transfer("none") is None
     with pytest.raises(ValueError):
-        cn.track_transfer("slab", 1e8)
+        xfer.track_transfer("slab", 1e8)
 
 
 def test_impact_roughness_scales_with_joint_density():
-    one = cn.impact_roughness(0.01)
+    one = crough.impact_roughness(0.01)
     np.testing.assert_allclose(one, _col("impact_single_joint_per_100m"))
-    np.testing.assert_allclose(cn.impact_roughness(0.1) - one, 10.0)
+    np.testing.assert_allclose(crough.impact_roughness(0.1) - one, 10.0)
     # Adding the joints in energy never lowers L_R,TOT, and dominates where they are 10 dB above it.
-    base = cn.total_roughness(cn.rail_roughness("E"), cn.wheel_roughness("disc"), 0.0)
-    with_joints = cn.total_roughness(cn.rail_roughness("E"), cn.wheel_roughness("disc"), 0.0, one)
+    base = crough.total_roughness(crough.rail_roughness("E"), crough.wheel_roughness("disc"), 0.0)
+    with_joints = crough.total_roughness(crough.rail_roughness("E"), crough.wheel_roughness("disc"), 0.0, one)
     assert np.all(with_joints >= base)
 
 
 def test_directivity():
-    np.testing.assert_allclose(cn.horizontal_directivity_db([np.pi / 2, 0.0]), [0.0, -20.0], atol=1e-12)
+    np.testing.assert_allclose(cdir.horizontal_directivity_db([np.pi / 2, 0.0]), [0.0, -20.0], atol=1e-12)
     # Vertical (source A): zero at and below the source; its sign changes at cos psi = 3/4.
-    assert cn.vertical_directivity_a_db(-0.2, 1000.0) == 0.0
-    assert cn.vertical_directivity_a_db(np.arccos(0.75), 1000.0) == pytest.approx(0.0, abs=1e-12)
-    assert cn.vertical_directivity_a_db(0.3, 1000.0) > 0 > cn.vertical_directivity_a_db(1.2, 1000.0)
+    assert cdir.vertical_directivity_a_db(-0.2, 1000.0) == 0.0
+    assert cdir.vertical_directivity_a_db(np.arccos(0.75), 1000.0) == pytest.approx(0.0, abs=1e-12)
+    assert cdir.vertical_directivity_a_db(0.3, 1000.0) > 0 > cdir.vertical_directivity_a_db(1.2, 1000.0)
     # At psi = 90 deg: -40/3 lg((f + 600) / 200); 1 kHz: -12.04 dB.
-    assert cn.vertical_directivity_a_db(np.pi / 2, 1000.0) == pytest.approx(-40 / 3 * np.log10(8.0), abs=1e-9)
+    assert cdir.vertical_directivity_a_db(np.pi / 2, 1000.0) == pytest.approx(-40 / 3 * np.log10(8.0), abs=1e-9)
 
 
 def test_line_sound_power_of_a_flow():
     """eq. 2.3.1: 100 vehicles per hour at 100 km/h are one vehicle per km: -30 dB re one vehicle per metre."""
-    assert cn.line_sound_power_db(100.0, 100.0, 100.0) == pytest.approx(70.0)
+    assert cdir.line_sound_power_db(100.0, 100.0, 100.0) == pytest.approx(70.0)

@@ -15,7 +15,10 @@ import pytest
 
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_directivity as cdir
+from rail_monitor.models import cnossos_roughness as crough
 from rail_monitor.models import cnossos_tables as ct
+from rail_monitor.models import cnossos_transfer as xfer
 from rail_monitor.models.levels import level, power
 
 T = ct.tables()
@@ -28,27 +31,28 @@ def _col(name):
 
 
 def _impact(name):
-    return np.full(35, -40.0) if name == "flat_minus_40" else cn.impact_roughness(0.01)
+    return np.full(35, -40.0) if name == "flat_minus_40" else crough.impact_roughness(0.01)
 
 
 def _per_metre(case, vehicle, fraction, rule="noisemodelling"):
     """Rolling and bridge L_W' [dB re 1 pW/m] of one vehicle type in one period, as the case defines it."""
     track = case["track"]
     v_kmh = vehicle["speed_kmh"]
-    _, a3 = cn.contact_filter(*vehicle["contact_filter"])
-    assert cn.contact_filter(*vehicle["contact_filter"])[0] == tuple(vehicle["contact_filter"])
-    lr = cb.band_roughness(cn.rail_roughness(track["rail_roughness"]), cn.wheel_roughness(vehicle["brake"], rule),
-                           a3, v_kmh / 3.6, rule=rule, impact_db=_impact(track["impact"]))
-    _, track_db = cn.track_transfer(track["sleeper"], track["pad_stiffness_npm"])
-    diameter, vehicle_db = cn.vehicle_transfer(vehicle["transfer_wheel_diameter_m"])
+    _, a3 = crough.contact_filter(*vehicle["contact_filter"])
+    assert crough.contact_filter(*vehicle["contact_filter"])[0] == tuple(vehicle["contact_filter"])
+    lr = cb.band_roughness(crough.rail_roughness(track["rail_roughness"]),
+                           crough.wheel_roughness(vehicle["brake"], rule), a3, v_kmh / 3.6, rule=rule,
+                           impact_db=_impact(track["impact"]))
+    _, track_db = xfer.track_transfer(track["sleeper"], track["pad_stiffness_npm"])
+    diameter, vehicle_db = xfer.vehicle_transfer(vehicle["transfer_wheel_diameter_m"])
     assert diameter == vehicle["transfer_wheel_diameter_m"]
     lw0 = cn.rolling_sound_power(lr, vehicle["axles"], track_db, vehicle_db,
-                                 bridge_db=cn.bridge_transfer(track["bridge"]))
+                                 bridge_db=xfer.bridge_transfer(track["bridge"]))
     # One vehicle per metre (Q = 1000 v per hour, eq. 2.3.1), then the period's share and the case's tracks.
     share = 10 * np.log10(fraction) - 10 * np.log10(1000 * v_kmh * case["n_tracks"])
-    out = {"rolling": cn.line_sound_power_db(level(power(lw0.track) + power(lw0.vehicle)), 1000 * v_kmh, v_kmh)}
+    out = {"rolling": cdir.line_sound_power_db(level(power(lw0.track) + power(lw0.vehicle)), 1000 * v_kmh, v_kmh)}
     if lw0.bridge is not None:
-        out["bridge"] = cn.line_sound_power_db(lw0.bridge, 1000 * v_kmh, v_kmh)
+        out["bridge"] = cdir.line_sound_power_db(lw0.bridge, 1000 * v_kmh, v_kmh)
     return {k: v + share for k, v in out.items()}
 
 
@@ -102,8 +106,8 @@ def test_noisemodelling_rule_fills_bands_off_its_grid():
 
 
 def test_wheel_roughness_at_noisemodelling_precision_rounds_to_the_directive_values():
-    for brake in cn.BRAKE_TYPES:
-        np.testing.assert_allclose(cn.wheel_roughness(brake, "noisemodelling"), cn.wheel_roughness(brake),
+    for brake in crough.BRAKE_TYPES:
+        np.testing.assert_allclose(crough.wheel_roughness(brake, "noisemodelling"), crough.wheel_roughness(brake),
                                    rtol=0, atol=0.005 + 1e-12)
 
 
@@ -127,8 +131,8 @@ def test_both_rules_reproduce_table_values_where_bands_fall_on_table_wavelengths
 
 def test_the_reference_rule_maps_each_table_before_combining():
     # Independent method: np.interp of each table at lambda = v / f_i, then eq. 2.3.6 and 2.3.10 per band.
-    _, a3 = cn.contact_filter(50e3, 0.92)
-    rail, wheel, joints = cn.rail_roughness("E"), cn.wheel_roughness("cast_iron"), cn.impact_roughness(0.01)
+    _, a3 = crough.contact_filter(50e3, 0.92)
+    rail, wheel, joints = crough.rail_roughness("E"), crough.wheel_roughness("cast_iron"), crough.impact_roughness(0.01)
     for v in (10.0, 20.0, 33.3):
         lam = v / T.band_hz
         at = [np.interp(lam, T.wavelength_m, table) for table in (rail, wheel, a3, joints)]
@@ -149,7 +153,8 @@ def test_a_shared_spectrums_power_is_read_once_and_cannot_be_changed_by_a_caller
     # band_roughness_power reads a 1-D spectrum (wheel, contact filter, baseline rail) through a
     # cache shared by the models and the baseline: the same numbers as a fresh reading, read-only.
     speed = np.linspace(8.0, 40.0, 37)
-    rail, wheel, a3 = cn.rail_roughness("E"), cn.wheel_roughness("cast_iron"), next(iter(T.contact_filters.values()))
+    rail, wheel = crough.rail_roughness("E"), crough.wheel_roughness("cast_iron")
+    a3 = next(iter(T.contact_filters.values()))
     fresh = ((power(cb.at_band_frequencies(rail, speed)) + power(cb.at_band_frequencies(wheel, speed)))
              * power(cb.at_band_frequencies(a3, speed)))
     for _ in range(2):

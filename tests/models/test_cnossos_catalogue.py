@@ -10,7 +10,9 @@ from hypothesis import strategies as st
 
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_catalogue as cc
+from rail_monitor.models import cnossos_roughness as crough
 from rail_monitor.models import cnossos_tables as ct
+from rail_monitor.models import cnossos_transfer as xfer
 
 T = ct.tables()
 
@@ -42,12 +44,12 @@ def catalogue() -> str:
 
 def test_the_catalogues_tables_are_read_as_the_packages_are():
     t = cc.with_catalogue(T, catalogue())
-    name, track = cn.track_transfer("monoblock", 3.5e8, t)      # the edition's own still there
+    name, track = xfer.track_transfer("monoblock", 3.5e8, t)      # the edition's own still there
     np.testing.assert_array_equal(track, T.by_frequency[name])
     np.testing.assert_array_equal(t.by_frequency["track_slab"], TRACK)       # the values exactly as written
-    assert cn.vehicle_transfer(0.77, t) == (0.76, pytest.approx(WHEEL))     # nearest diameter, now 760 mm
-    assert cn.vehicle_transfer(0.92, t)[0] == 0.92
-    key, a3 = cn.contact_filter(80e3, 0.76, t)
+    assert xfer.vehicle_transfer(0.77, t) == (0.76, pytest.approx(WHEEL))     # nearest diameter, now 760 mm
+    assert xfer.vehicle_transfer(0.92, t)[0] == 0.92
+    key, a3 = crough.contact_filter(80e3, 0.76, t)
     assert key == (80e3, 0.76)
     np.testing.assert_array_equal(a3, FILTER)                                # put on the ascending grid
     np.testing.assert_array_equal(cn.traction_sound_power("shunter", "B", "constant", t), LOCO_B)

@@ -10,8 +10,11 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 from rail_monitor.models import corrugation as cg
+from rail_monitor.models import corrugation_bands as cbands
+from rail_monitor.models import corrugation_state as cstate
 from rail_monitor.models import hertz
 from rail_monitor.models import track as tr
+from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.contact_filter import hertzian_line_filter
 
 CASES = [(kc, zeta) for kc in (1e-3, 0.1, 1.0, 10.0, 100.0) for zeta in (0.05, 0.2, 0.5)]
@@ -55,7 +58,7 @@ def test_log_kernel_tends_to_the_linear_one_for_small_kb():
 
 
 def test_wavelength_bands_cover_10_to_1000_mm_in_third_octaves():
-    bands = cg.wavelength_bands(0.01, 1.0)
+    bands = cbands.wavelength_bands(0.01, 1.0)
     assert bands[0] == pytest.approx(0.01) and bands[-1] == pytest.approx(1.0)
     np.testing.assert_allclose(np.diff(np.log10(bands)), 0.1)
     assert len(bands) == 21
@@ -67,7 +70,7 @@ def uic60_kernel():
     contact = hertz.contact_ellipse(0.42, 1e6, np.inf, 0.3, hertz.contact_modulus(210e9, 0.28), 75e3)
     kc, a = float(contact.stiffness), float(contact.a)
     f = np.geomspace(5.0, 8000.0, 500)
-    h = cg.growth_kernel(kc, tr.bay_averaged_receptance(f, tr.Track()) + tr.wheel_receptance(f, 600.0))
+    h = cg.growth_kernel(kc, tr.bay_averaged_receptance(f, tr.Track()) + wrn.wheel_receptance(f, 600.0))
 
     def kernel_at(freq):
         lf = np.log(np.clip(freq, f[0], f[-1]))
@@ -118,21 +121,21 @@ def test_with_the_contact_filter_a_25_percent_spread_cuts_peak_growth_by_about_4
 
 def test_band_amplitude_is_the_energy_sum_of_its_components():
     z = np.array([[1e-6, 2e-6, 2e-6], [3e-6, 0.0 + 1e-30, 4e-6]])
-    np.testing.assert_allclose(cg.band_amplitude(np.log(z)), np.sqrt((z**2).sum(axis=1)), rtol=1e-12)
+    np.testing.assert_allclose(cstate.band_amplitude(np.log(z)), np.sqrt((z**2).sum(axis=1)), rtol=1e-12)
 
 
 def test_passes_to_band_level_solves_the_energy_sum():
     # One component: the closed form ln(Z_level / Z) / g (docs/models.md).
-    assert float(cg.passes_to_band_level(np.log([[1e-6]]), [[2e-6]], np.log(3e-6))[0]) == pytest.approx(
+    assert float(cstate.passes_to_band_level(np.log([[1e-6]]), [[2e-6]], np.log(3e-6))[0]) == pytest.approx(
         np.log(3.0) / 2e-6, rel=1e-9)
     # Several components: the root satisfies sum Z_p^2 exp(2 g_p n) = Z_level^2.
     x = np.log(np.array([[1e-6, 2e-6, 0.5e-6], [1e-6, 1e-6, 1e-6]]))
     g = np.array([[1e-6, -2e-6, 5e-6], [-1e-6, 0.0, -3e-7]])
-    n = cg.passes_to_band_level(x, g, np.log(8e-6))
+    n = cstate.passes_to_band_level(x, g, np.log(8e-6))
     lhs = np.sqrt(np.sum(np.exp(2 * (x[0] + g[0] * n[0]))))
     assert lhs == pytest.approx(8e-6, rel=1e-9)
     assert np.isinf(n[1])                                        # nothing grows
-    assert cg.passes_to_band_level(x, g, np.log(1e-6))[0] == 0.0  # already past the level
+    assert cstate.passes_to_band_level(x, g, np.log(1e-6))[0] == 0.0  # already past the level
 
 
 def test_a_bands_passes_to_level_do_not_depend_on_the_bands_solved_with_it(monkeypatch):
@@ -142,18 +145,18 @@ def test_a_bands_passes_to_level_do_not_depend_on_the_bands_solved_with_it(monke
     x = np.log(rng.uniform(1e-7, 5e-6, (300, 4, 5)))
     g = rng.normal(0, 1e-6, (300, 4, 5)) * rng.integers(0, 2, (300, 4, 1))
     level = np.log(np.array([2e-6, 4e-6, 8e-6, 1.6e-5]))
-    whole = cg.passes_to_band_level(x, g, level)
+    whole = cstate.passes_to_band_level(x, g, level)
     assert np.isfinite(whole).any() and np.isinf(whole).any()
-    one_by_one = np.stack([cg.passes_to_band_level(x[i:i + 1], g[i:i + 1], level)[0] for i in range(300)])
-    monkeypatch.setattr(cg, "BAND_BLOCK", 7)
-    assert np.array_equal(one_by_one, whole) and np.array_equal(cg.passes_to_band_level(x, g, level), whole)
+    one_by_one = np.stack([cstate.passes_to_band_level(x[i:i + 1], g[i:i + 1], level)[0] for i in range(300)])
+    monkeypatch.setattr(cstate, "BAND_BLOCK", 7)
+    assert np.array_equal(one_by_one, whole) and np.array_equal(cstate.passes_to_band_level(x, g, level), whole)
 
 
 def test_band_limits_share_each_range_equally():
     # Grassie, Saxon & Smith (1999): a range whose bands all sit at their limit has the range's r.m.s.
-    bands = cg.wavelength_bands(0.01, 1.0)
-    lim = cg.band_limits(bands)
-    for (lo, hi), limit in cg.GRASSIE_1999_LIMITS[:4]:
+    bands = cbands.wavelength_bands(0.01, 1.0)
+    lim = cbands.band_limits(bands)
+    for (lo, hi), limit in cbands.GRASSIE_1999_LIMITS[:4]:
         inside = (bands >= lo * (1 - 1e-9)) & (bands < hi * (1 - 1e-9))
         assert np.sqrt(np.sum(lim[inside] ** 2)) == pytest.approx(limit, rel=1e-12)
 
@@ -161,7 +164,7 @@ def test_band_limits_share_each_range_equally():
 def test_the_first_band_to_level_is_the_earliest_band_and_none_when_nothing_grows():
     x = np.log(np.array([[[1e-6, 1e-6], [1e-6, 1e-6], [1e-6, 1e-6]], [[1e-6, 1e-6]] * 3]))
     g = np.array([[[1e-6, 0.0], [3e-6, 0.0], [3e-6, 0.0]], [[0.0, -1e-6]] * 3])
-    band, passes = cg.first_band_to_level(x, g, np.log(np.array([4e-6, 4e-6, 4e-6])))
+    band, passes = cstate.first_band_to_level(x, g, np.log(np.array([4e-6, 4e-6, 4e-6])))
     # Bands 1 and 2 tie: the first of them; one component alone: ln(Z_level / Z) / g (docs/models.md).
     assert band.tolist() == [1, -1] and passes[0] == pytest.approx(np.log(np.sqrt(16 - 1)) / 3e-6, rel=1e-9)
     assert np.isinf(passes[1])

@@ -5,8 +5,8 @@ the same order) bit for bit."""
 
 import numpy as np
 
-from rail_monitor.models import corrugation as cg
 from rail_monitor.models import corrugation_jit as jit
+from rail_monitor.models import corrugation_state as cstate
 
 
 def _states(seed: int = 11):
@@ -19,12 +19,12 @@ def _states(seed: int = 11):
 def test_band_log_amplitude_equals_the_numpy_engine():
     x, _, _ = _states()
     # log of a sum of exps: each engine's exp and log differ in the last bit, nothing more.
-    np.testing.assert_allclose(jit.band_log_amplitude(x), cg.band_log_amplitude(x), rtol=0, atol=1e-13)
+    np.testing.assert_allclose(jit.band_log_amplitude(x), cstate.band_log_amplitude(x), rtol=0, atol=1e-13)
 
 
 def test_passes_to_band_level_equals_the_numpy_engine_with_its_exact_cases():
     x, g, level = _states()
-    want, got = cg.passes_to_band_level(x, g, level), jit.passes_to_band_level(x, g, level)
+    want, got = cstate.passes_to_band_level(x, g, level), jit.passes_to_band_level(x, g, level)
     # The same zeros (at or past the level) and infinities (nothing grows), bit for bit.
     assert np.array_equal(want == 0.0, got == 0.0) and np.array_equal(np.isinf(want), np.isinf(got))
     assert (want == 0.0).any() and np.isinf(want).any() and (np.isfinite(want) & (want > 0)).any()
@@ -49,7 +49,7 @@ def _history(seed: int = 3):
 def test_history_sums_equal_the_numpy_engine_bit_for_bit():
     log0, total, by_state, growth, friction = _history()
     want_state, got_state = by_state.copy(), by_state.copy()
-    want, got = cg.history_sums(log0, total, want_state, growth, friction), \
+    want, got = cstate.history_sums(log0, total, want_state, growth, friction), \
         jit.history_sums(log0, total, got_state, growth, friction)
     assert all(np.array_equal(w, g) for w, g in zip(want, got, strict=True)) and np.array_equal(want_state, got_state)
     # The sums themselves: ln Z after the last pass and the growth by friction state, to rounding.
@@ -63,7 +63,7 @@ def test_window_growth_equals_the_numpy_engine_bit_for_bit():
     end = np.arange(200, 500)
     start = end - rng.integers(1, 200, len(end))
     axles = rng.integers(4, 40, len(end)).astype(float)
-    want, got = cg.window_growth(prefix, start, end, axles), jit.window_growth(prefix, start, end, axles)
+    want, got = cstate.window_growth(prefix, start, end, axles), jit.window_growth(prefix, start, end, axles)
     assert all(np.array_equal(w, g) for w, g in zip(want, got, strict=True))
 
 
@@ -72,7 +72,7 @@ def test_add_by_day_equals_the_numpy_engine_with_repeated_days():
     day = np.sort(np.random.default_rng(4).integers(0, 9, len(growth)))  # many passes a day
     scale = np.random.default_rng(5).uniform(0.5, 2.0, len(growth))
     want, got = np.zeros((9, 4, 6, 5)), np.zeros((9, 4, 6, 5))
-    cg.add_by_day(want, day, friction - 1, growth, scale)
+    cstate.add_by_day(want, day, friction - 1, growth, scale)
     jit.add_by_day(got, day, friction - 1, growth, scale)
     assert np.array_equal(want, got) and np.abs(got).sum() > 0
 
@@ -83,7 +83,7 @@ def test_table_growth_equals_the_numpy_engine_bit_for_bit():
     n = 400
     idx = (rng.integers(0, 3, n), rng.integers(0, 4, n), rng.integers(0, 2, n), rng.integers(0, 29, n))
     w, scale = rng.uniform(0, 1, n), rng.integers(2, 40, n).astype(float)
-    want, got = cg.table_growth(table, *idx, w, scale), jit.table_growth(table, *idx, w, scale)
+    want, got = cstate.table_growth(table, *idx, w, scale), jit.table_growth(table, *idx, w, scale)
     assert np.array_equal(want, got)
     # at a grid point (w = 0) the table's own row, times the scale
     np.testing.assert_array_equal(jit.table_growth(table, *idx, np.zeros(n), np.ones(n)), table[idx])
@@ -103,6 +103,6 @@ def test_the_first_band_to_level_is_the_full_solves_argmin_to_the_bit():
     assert np.array_equal(band, want) and (band[:50] == -1).all() and (passes[50:60] == 0.0).all()
     assert (band == 4).sum() > 40 and ((band >= 0) & (passes > 0)).sum() > 200
     assert np.array_equal(passes, full[np.arange(len(full)), np.argmin(full, axis=1)])
-    twin = cg.first_band_to_level(x, g, level)
+    twin = cstate.first_band_to_level(x, g, level)
     assert np.array_equal(twin[0], band)
     np.testing.assert_allclose(twin[1], passes, rtol=1e-11)

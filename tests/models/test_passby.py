@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 
-from rail_monitor.models import levels, passby, passby_kernel
+from rail_monitor.models import levels, passby, passby_kernel, passby_paths
 
 RECEIVER = passby.Receiver(7.5, 1.2, 0.05, 0.0, 1.0)
 
@@ -51,7 +51,7 @@ def test_lpaeq_weights_give_the_pass_bys_lpaeq_for_any_spectrum():
     gain_db = rng.uniform(-3.0, 3.0, len(band))
     g = passby.pass_geometry(band, length, speed, RECEIVER)
     want = passby.pass_by(lw, band, length, speed, RECEIVER, gain_db, time_weighted=False, geometry=g).lpaeq_tp_dba
-    got = levels.level(np.sum(levels.power(lw) * passby.lpaeq_weights(g, levels.power(gain_db)), axis=-1))
+    got = levels.level(np.sum(levels.power(lw) * passby_paths.lpaeq_weights(g, levels.power(gain_db)), axis=-1))
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad, solve_ivp
 
-from rail_monitor.models import axle_layout, levels, passby, passby_axles, passby_kernel
+from rail_monitor.models import axle_layout, levels, passby, passby_axles, passby_axles_peak, passby_kernel
 
 RECEIVER = passby.Receiver(7.5, 1.2, 0.5, 0.0, 1.0)
 (R1, _), (R2, _) = RECEIVER.paths()
@@ -57,7 +57,7 @@ def test_f_weighted_peak_matches_a_time_integration_over_every_axle(vehicles, sp
     span = (-(0.5 * length + 200.0) / speed, (0.5 * length + 200.0) / speed)
     sol = solve_ivp(lambda t, y: (_all_axle_history(layout, length, speed, t) - y) / tau, span, [0.0],
                     max_step=0.002, rtol=1e-9, atol=1e-16)
-    got = passby_axles.f_weighted_peak([(np.ones(1), R1), (np.ones(1), R2)], layout, [length], [speed], D)
+    got = passby_axles_peak.f_weighted_peak([(np.ones(1), R1), (np.ones(1), R2)], layout, [length], [speed], D)
     assert 10 * np.log10(got[0]) == pytest.approx(10 * np.log10(sol.y[0].max()), abs=0.02)
 
 
@@ -65,7 +65,7 @@ def test_a_slow_single_axle_peaks_at_its_closest_approach():
     """One axle passing slowly (v tau << d): the F-weighted peak is the squared pressure at x = 0,
     W (g_direct(0) + g_image(0)), within 0.01 dB."""
     layout = axle_layout.axle_layout([4.0], [1], [1], 0.0, 0.0)
-    got = passby_axles.f_weighted_peak([(np.ones(1), R1), (np.ones(1), R2)], layout, [4.0], [0.5], D)
+    got = passby_axles_peak.f_weighted_peak([(np.ones(1), R1), (np.ones(1), R2)], layout, [4.0], [0.5], D)
     want = 4.0 * (passby_kernel.point_kernel(0.0, D, R1) + passby_kernel.point_kernel(0.0, D, R2))
     assert 10 * np.log10(got[0]) == pytest.approx(10 * np.log10(want), abs=0.01)
 
@@ -94,7 +94,7 @@ def test_extreme_but_valid_trains_cost_bounded_memory_and_give_finite_levels():
     layout = axle_layout.axle_layout(length, vehicles, axles, 0.7, 1.0)
     assert layout.offsets_m.shape[1] == axle_layout.MAX_AXLES_PER_VEHICLE
     tracemalloc.start()
-    peak = passby_axles.f_weighted_peak([(np.ones(3), R1), (np.ones(3), R2)], layout, length, speed, D)
+    peak = passby_axles_peak.f_weighted_peak([(np.ones(3), R1), (np.ones(3), R2)], layout, length, speed, D)
     mean = passby_axles.window_kernel(layout, length, D, R1)
     _, most = tracemalloc.get_traced_memory()
     tracemalloc.stop()
@@ -158,13 +158,13 @@ def test_the_compiled_engine_gives_the_numpy_engines_peaks():
     r3 = float(np.hypot(D, 2.8))
     paths = [[(rng.uniform(0.5, 2.0, 300), R1), (rng.uniform(0.5, 2.0, 300), R2)],
              [(rng.uniform(0.5, 2.0, 300), R1), (rng.uniform(0.5, 2.0, 300), R2), (rng.uniform(0, 1, 300), r3)]]
-    want = passby_axles.f_weighted_peaks(paths, layout, length, speed, D, "numpy")
-    got = passby_axles.f_weighted_peaks(paths, layout, length, speed, D, "numba")
+    want = passby_axles_peak.f_weighted_peaks(paths, layout, length, speed, D, "numpy")
+    got = passby_axles_peak.f_weighted_peaks(paths, layout, length, speed, D, "numba")
     np.testing.assert_allclose(got, want, rtol=1e-13, atol=0.0)
     whole = layout.vehicles <= 4   # within the near zone whatever the speed: no arctangent
     assert whole.any() and np.array_equal(got[:, whole], want[:, whole])
     for m, p in enumerate(paths):  # a set alone, on the joint window (the largest path distance)
-        alone = passby_axles.f_weighted_peak(p, layout, length, speed, D, "numba", window_r=r3)
+        alone = passby_axles_peak.f_weighted_peak(p, layout, length, speed, D, "numba", window_r=r3)
         np.testing.assert_array_equal(alone, got[m])
 
 
@@ -172,10 +172,10 @@ def test_a_pass_gets_the_same_peak_alone_as_in_a_batch_with_either_engine():
     layout, length, speed, rng = _mixed_trains(40, 8)
     paths = [(rng.uniform(0.5, 2.0, 40), R1), (rng.uniform(0.5, 2.0, 40), R2)]
     for engine in ("numpy", "numba"):
-        batch = passby_axles.f_weighted_peak(paths, layout, length, speed, D, engine)
+        batch = passby_axles_peak.f_weighted_peak(paths, layout, length, speed, D, engine)
         for i in (0, 17, 39):
-            one = passby_axles._take(layout, np.array([i]))
-            alone = passby_axles.f_weighted_peak([(c[i:i + 1], r) for c, r in paths], one, length[i:i + 1],
+            one = layout.take(np.array([i]))
+            alone = passby_axles_peak.f_weighted_peak([(c[i:i + 1], r) for c, r in paths], one, length[i:i + 1],
                                                  speed[i:i + 1], D, engine)
             assert alone[0] == batch[i], engine
 
@@ -186,10 +186,11 @@ def test_the_numpy_blocks_change_no_bit(monkeypatch, elements):
     # summed one at a time in a fixed order, so any block size gives the same bits.
     layout, length, speed, rng = _mixed_trains(120, 8)
     paths = [(rng.uniform(0.5, 2.0, 120), R1), (rng.uniform(0.5, 2.0, 120), R2)]
-    want = (passby_axles.f_weighted_peak(paths, layout, length, speed, D),
+    want = (passby_axles_peak.f_weighted_peak(paths, layout, length, speed, D),
             passby_axles.window_kernels(layout, length, D, [R1, R2]))
-    monkeypatch.setattr(passby_axles, "HISTORY_ELEMENTS", elements)
-    got = (passby_axles.f_weighted_peak(paths, layout, length, speed, D),
+    for module in (passby_axles, passby_axles_peak):  # each sizes its own blocks by it
+        monkeypatch.setattr(module, "HISTORY_ELEMENTS", elements)
+    got = (passby_axles_peak.f_weighted_peak(paths, layout, length, speed, D),
            passby_axles.window_kernels(layout, length, D, [R1, R2]))
     for w, g in zip(want, got, strict=True):
         np.testing.assert_array_equal(g, w)
@@ -213,7 +214,7 @@ def test_near_axle_terms_over_a_common_denominator_are_the_direct_quotients():
     r2 = [R1 * R1, R2 * R2, float(np.hypot(D, 2.8)) ** 2]
     broad = BROADSIDE * D * D
     direct = (broad / (x2 + D * D) + OMNI)
-    for got, rk in zip(passby_axles.near_axle_terms(x2, D, r2, broad), r2, strict=True):
+    for got, rk in zip(passby_axles_peak.near_axle_terms(x2, D, r2, broad), r2, strict=True):
         np.testing.assert_allclose(got, direct / (x2 + rk), rtol=2e-15, atol=0.0)
 
 
@@ -223,11 +224,11 @@ def test_passes_of_one_train_share_its_window_kernel_to_the_bit(engine):
     # what it gets alone, and a train differing in one offset's last bit is its own.
     layout, length, _, _ = _mixed_trains(30, 4)
     rows = np.random.default_rng(5).integers(0, 30, 400)
-    many = passby_axles._take(layout, rows)
+    many = layout.take(rows)
     first, inverse = passby_axles.distinct_trains(many, length[rows])
     assert len(first) == len(np.unique(rows)) and np.array_equal(rows[first][inverse], rows)
     got = passby_axles.window_kernels(many, length[rows], D, [R1, R2], engine)
-    alone = np.stack([passby_axles.window_kernels(passby_axles._take(layout, np.array([i])), length[i:i + 1], D,
+    alone = np.stack([passby_axles.window_kernels(layout.take(np.array([i])), length[i:i + 1], D,
                                                   [R1, R2], engine)[:, 0] for i in rows], axis=1)
     np.testing.assert_array_equal(got, alone)
     nudged = axle_layout.AxleLayout(many.vehicles, many.pitch_m, many.offsets_m.copy())

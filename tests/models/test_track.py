@@ -13,6 +13,7 @@ import pytest
 from scipy.signal import find_peaks
 
 from rail_monitor.models import track as tr
+from rail_monitor.models import wheel_rail_noise as wrn
 
 UIC60 = tr.Track()
 LOSSLESS = UIC60.with_(rail_loss_factor=0.0, pad_loss_factor=0.0, ballast_loss_factor=0.0)
@@ -83,7 +84,7 @@ def test_discrete_supports_converge():
 
 def test_wheel_receptance_is_a_mass_line():
     f = np.array([10.0, 100.0])
-    r = tr.wheel_receptance(f, 600.0)
+    r = wrn.wheel_receptance(f, 600.0)
     np.testing.assert_allclose(r, -1.0 / (600.0 * (2 * np.pi * f) ** 2))
 
 

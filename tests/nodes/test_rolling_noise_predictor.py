@@ -10,7 +10,7 @@ from rclpy.parameter import Parameter
 
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.messages.fields import train_pass_fields
-from rail_monitor.models.corrugation import band_limits, wavelength_bands
+from rail_monitor.models.corrugation_bands import band_limits, wavelength_bands
 from rail_monitor.nodes.convert import time_msg, to_msg
 from rail_monitor.nodes.qos import STATE_QOS, STREAM_QOS
 from rail_monitor.nodes.rolling_noise_predictor import RollingNoisePredictor

@@ -10,8 +10,10 @@ from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.passes import FRICTION_DRY, PassTable, with_class_defaults
 from rail_monitor.core.site import site_from_values
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_roughness as crough
 from rail_monitor.models import cnossos_tables as ct
-from rail_monitor.models.corrugation import band_limits, wavelength_bands
+from rail_monitor.models import cnossos_transfer as xfer
+from rail_monitor.models.corrugation_bands import band_limits, wavelength_bands
 from rail_monitor.noise.config import MODELS, noise_config
 from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.noise.records import Corrugation
@@ -249,10 +251,11 @@ def test_the_sites_cnossos_power_per_vehicle_is_the_directives_l_w0(site_values,
         cls = model.site.vehicle(name)
         passes = _passes(model.site, name, [speed])
         got = model.vehicle_sound_power(passes, "cnossos")
-        _, a3 = cn.contact_filter(cls.wheel_load_n, cls.wheel_diameter_m)
-        lr = cb.band_roughness(cn.rail_roughness("E"), cn.wheel_roughness(cls.brake_type, rule), a3, speed, rule=rule)
-        want = cn.rolling_sound_power(lr, cls.axles_per_vehicle, cn.track_transfer("monoblock", 3.5e8)[1],
-                                      cn.vehicle_transfer(cls.wheel_diameter_m)[1])
+        _, a3 = crough.contact_filter(cls.wheel_load_n, cls.wheel_diameter_m)
+        lr = cb.band_roughness(crough.rail_roughness("E"), crough.wheel_roughness(cls.brake_type, rule), a3, speed,
+                               rule=rule)
+        want = cn.rolling_sound_power(lr, cls.axles_per_vehicle, xfer.track_transfer("monoblock", 3.5e8)[1],
+                                      xfer.vehicle_transfer(cls.wheel_diameter_m)[1])
         for component in ("track", "vehicle"):
             np.testing.assert_allclose(got[component][0], getattr(want, component), rtol=0, atol=1e-9)
         if cls.freight:
@@ -272,11 +275,11 @@ def test_a_site_on_the_2015_edition_takes_that_editions_terms(site_values):
     model = RollingNoiseModel(load_site(SITE_FILE), noise_config(values))
     cls = model.site.vehicle("freight")
     got = model.vehicle_sound_power(_passes(model.site, "freight", [14.0]), "cnossos")
-    _, a3 = cn.contact_filter(cls.wheel_load_n, cls.wheel_diameter_m, "2015")
-    lr = cb.band_roughness(cn.rail_roughness("M", "2015"), cn.wheel_roughness(cls.brake_type, edition="2015"), a3,
-                           14.0, edition="2015")
-    want = cn.rolling_sound_power(lr, cls.axles_per_vehicle, cn.track_transfer("monoblock", 3.5e8, "2015")[1],
-                                  cn.vehicle_transfer(cls.wheel_diameter_m, "2015")[1], bridge_constant_db=4.0)
+    _, a3 = crough.contact_filter(cls.wheel_load_n, cls.wheel_diameter_m, "2015")
+    lr = cb.band_roughness(crough.rail_roughness("M", "2015"), crough.wheel_roughness(cls.brake_type, edition="2015"),
+                           a3, 14.0, edition="2015")
+    want = cn.rolling_sound_power(lr, cls.axles_per_vehicle, xfer.track_transfer("monoblock", 3.5e8, "2015")[1],
+                                  xfer.vehicle_transfer(cls.wheel_diameter_m, "2015")[1], bridge_constant_db=4.0)
     for component in ("track", "vehicle", "superstructure"):
         np.testing.assert_allclose(got[component][0], getattr(want, component), rtol=0, atol=1e-9)
     np.testing.assert_array_equal(model.vertical_db, np.abs(model.vertical_db))

@@ -16,9 +16,9 @@ OVERRIDES = {"noise_model": "noise.model", "rail_roughness": "noise.rail_roughne
 
 
 def add_parser(models: argparse._SubParsersAction) -> None:
-    from rail_monitor.models.cnossos import SLEEPER_TYPES
     from rail_monitor.models.cnossos_bands import INTERPOLATION_RULES
     from rail_monitor.models.cnossos_tables import EDITIONS
+    from rail_monitor.models.cnossos_transfer import SLEEPER_TYPES
     from rail_monitor.noise.config import MODELS, ROUGHNESS_SOURCES
 
     r = models.add_parser("noise", help="rolling noise pass-by levels and spectra (CNOSSOS-EU and mechanics), "

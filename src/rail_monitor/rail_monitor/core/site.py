@@ -18,7 +18,8 @@ from rail_monitor.core.friction import FRICTION_NAMES
 from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 from rail_monitor.core.timeutil import time_zone
 from rail_monitor.models import hertz
-from rail_monitor.models.cnossos import BRAKE_TYPES, TRACTION_TYPES
+from rail_monitor.models.cnossos import TRACTION_TYPES
+from rail_monitor.models.cnossos_roughness import BRAKE_TYPES
 from rail_monitor.models.squeal import K3_CONVENTIONS, RIG_PEAK_FRICTION
 from rail_monitor.models.track import Track
 

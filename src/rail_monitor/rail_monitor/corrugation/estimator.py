@@ -29,7 +29,8 @@ from rail_monitor.corrugation.history import KeptPasses, RowQueue, dropped
 from rail_monitor.corrugation.records import Forecast, ForecastInterval, StateSnapshot, Trajectory
 from rail_monitor.corrugation.season import DailyGrowth
 from rail_monitor.models import calibration
-from rail_monitor.models import corrugation as cg
+from rail_monitor.models import corrugation_bands as cbands
+from rail_monitor.models import corrugation_state as cstate
 from rail_monitor.models.engine import corrugation_kernels
 
 
@@ -41,7 +42,7 @@ class CorrugationEstimator:
         self.tables = tables or GrowthTables(site, cfg)
         self.tables.set_k_b(cfg.k_b)
         self.bands = self.tables.bands
-        acceptance = cg.band_limits(self.bands) * cfg.acceptance_factor
+        acceptance = cbands.band_limits(self.bands) * cfg.acceptance_factor
         if np.any(np.isnan(acceptance)):
             raise ConfigError("corrugation bands reach outside the 10-3000 mm of the Grassie et al. (1999) limits")
         self.threshold = acceptance * cfg.intervention_factor
@@ -257,7 +258,7 @@ class CorrugationEstimator:
     @property
     def amplitude(self) -> np.ndarray:
         """r.m.s. roughness per band [m]."""
-        return cg.band_amplitude(self.log_components)
+        return cstate.band_amplitude(self.log_components)
 
     @property
     def log_amplitude(self) -> np.ndarray:

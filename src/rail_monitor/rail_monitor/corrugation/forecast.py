@@ -1,7 +1,7 @@
 """The grinding forecast: time to the intervention threshold of each band, and the recent traffic.
 
 For one component, passes to threshold = ln(Z_threshold / Z) / g per axle pass; for a band,
-the energy sum of its components (:func:`rail_monitor.models.corrugation.passes_to_band_level`);
+the energy sum of its components (:func:`rail_monitor.models.corrugation_state.passes_to_band_level`);
 days = train passes / train passes per day (docs/models.md, "Grinding forecast").
 """
 
@@ -13,7 +13,7 @@ from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation.history import KeptPasses
 from rail_monitor.corrugation.records import Forecast, ForecastInterval
 from rail_monitor.models import calibration
-from rail_monitor.models import corrugation as cg
+from rail_monitor.models import corrugation_state as cstate
 from rail_monitor.models.engine import corrugation_kernels
 
 # Forecasts further out than a century get no date (0): a band that barely grows (full-sliding
@@ -95,7 +95,7 @@ def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth
         days = _seasonal_days(state, np.exp(delta), season, np.log(threshold))
     else:
         growth = np.einsum("df,fbp->dbp", np.exp(delta), growth_by_state)
-        axle_passes = cg.passes_to_band_level(state, growth, np.log(threshold))
+        axle_passes = cstate.passes_to_band_level(state, growth, np.log(threshold))
         with np.errstate(invalid="ignore"):
             days = np.where(axle_passes == 0.0, 0.0, axle_passes * days_per_axle_pass)
     q = (0.1, 0.5, 0.9)
@@ -116,7 +116,7 @@ def _seasonal_days(state: np.ndarray, scale: np.ndarray, season: np.ndarray, log
         s, k = state[lo:lo + block], scale[lo:lo + block]
         daily = np.einsum("df,jfbp->djbp", k, season)                 # (d, S, B, P)
         path = s[:, None] + np.cumsum(daily, axis=1)
-        level = cg.band_log_amplitude(np.concatenate([s[:, None], path], axis=1))  # (d, S + 1, B)
+        level = cstate.band_log_amplitude(np.concatenate([s[:, None], path], axis=1))  # (d, S + 1, B)
         over = level >= log_threshold
         first = np.argmax(over, axis=1)                               # first day at or past it
         crossed = over.any(axis=1)
@@ -126,6 +126,6 @@ def _seasonal_days(state: np.ndarray, scale: np.ndarray, season: np.ndarray, log
             frac = np.where(at > before, (log_threshold - before) / (at - before), 1.0)
         days = np.where(first == 0, 0.0, first - 1 + np.clip(frac, 0.0, 1.0))
         mean = np.einsum("df,fbp->dbp", k, year) / len(season)
-        later = len(season) + cg.passes_to_band_level(path[:, -1], mean, log_threshold)
+        later = len(season) + cstate.passes_to_band_level(path[:, -1], mean, log_threshold)
         out[lo:lo + block] = np.where(crossed, days, later)
     return out

@@ -24,7 +24,9 @@ from rail_monitor.core.passes import MAX_SPEED_MPS
 from rail_monitor.core.site import Site
 from rail_monitor.corrugation.config import SPEED_STEP_MPS, CorrugationConfig
 from rail_monitor.models import corrugation as cg
+from rail_monitor.models import corrugation_bands
 from rail_monitor.models import track as tr
+from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.contact_filter import hertzian_line_filter
 from rail_monitor.models.engine import corrugation_kernels
 
@@ -72,10 +74,10 @@ class GrowthTables:
 
     def __init__(self, site: Site, cfg: CorrugationConfig) -> None:
         self.sliding_wear_ratio = cfg.sliding_wear_ratio
-        self.bands = cg.wavelength_bands(cfg.shortest_wavelength_m, cfg.longest_wavelength_m)
+        self.bands = corrugation_bands.wavelength_bands(cfg.shortest_wavelength_m, cfg.longest_wavelength_m)
         self.classes = list(site.vehicles)
         self.speeds = np.arange(1, round(MAX_SPEED_MPS / SPEED_STEP_MPS) + 1) * SPEED_STEP_MPS
-        self._sub = cg.band_sub_wavelengths(self.bands, cfg.points_per_band)
+        self._sub = corrugation_bands.band_sub_wavelengths(self.bands, cfg.points_per_band)
         self._track = site.track
         self._wheels = []  # per class: Hertz stiffness [N/m], semi-axis a [m], unsprung mass [kg]
         for name in self.classes:
@@ -100,7 +102,7 @@ class GrowthTables:
             freq = self.speeds[None, :, None] / self._sub[:, None, :]
             kernels = []
             for kc, a, unsprung in self._wheels:
-                h = cg.growth_kernel(kc, r_rail + tr.wheel_receptance(f_rail, unsprung)[:, None])
+                h = cg.growth_kernel(kc, r_rail + wrn.wheel_receptance(f_rail, unsprung)[:, None])
                 filt = hertzian_line_filter(self._sub, a)[:, None, :]
                 kernels.append([filt * filt * _interp_log(freq, f_rail, h[:, x]) for x in range(h.shape[1])])
             self._kernel = np.stack(kernels, axis=1)

@@ -27,6 +27,10 @@ class AxleLayout:
     def axles_per_vehicle(self) -> FloatArray:
         return np.sum(np.isfinite(self.offsets_m), axis=1).astype(float)
 
+    def take(self, rows: NDArray[np.int64]) -> AxleLayout:
+        """The layout of the passes at rows."""
+        return AxleLayout(self.vehicles[rows], self.pitch_m[rows], self.offsets_m[rows])
+
     @property
     def length_per_axle_m(self) -> FloatArray:
         """P / k: the length of train whose power each axle radiates [m] (passes,)."""

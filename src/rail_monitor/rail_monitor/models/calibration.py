@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rail_monitor.models import corrugation as cg
+from rail_monitor.models import corrugation_state as cstate
 
 LN_PER_DB = np.log(10.0) / 20.0  # ln Z per dB of a roughness level (20 lg Z)
 Z_P10 = -1.2815515655446004      # standard normal 10 % quantile
@@ -126,7 +126,7 @@ def band_level_jacobian(log_components: np.ndarray, growth: np.ndarray) -> tuple
     .. [1] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
        acoustic phenomena", seminar paper, section 2.1, eqs. 1-2 (the growth scaled).
     """
-    level = cg.band_log_amplitude(log_components)
+    level = cstate.band_log_amplitude(log_components)
     weight = np.exp(2.0 * (log_components - level[:, None]))
     return level, np.einsum("bp,fbp->bf", weight, growth), weight
 

@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from rail_monitor.models.cnossos import SOURCE_HEIGHTS
+from rail_monitor.models.cnossos_directivity import SOURCE_HEIGHTS
 from rail_monitor.models.cnossos_tables import Tables, table_rows
 
 # A user's catalogue (with_catalogue): what its columns may add, by the table's first column.

@@ -15,8 +15,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
-MAX_NEWTON_STEPS = 200  # as models.corrugation._passes_to_level
-STEP_TOL, LEFT_TOL = 1e-12, 1e-13  # as models.corrugation
+MAX_NEWTON_STEPS = 200  # as models.corrugation_state._passes_to_level
+STEP_TOL, LEFT_TOL = 1e-12, 1e-13  # as models.corrugation_state
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -32,7 +32,7 @@ def _band_log_amplitude(x, out):  # pragma: no cover  (compiled; its twin is the
 
 
 def band_log_amplitude(log_components: ArrayLike) -> FloatArray:
-    """models.corrugation.band_log_amplitude, compiled: ln of each band's r.m.s. [ln m]."""
+    """models.corrugation_state.band_log_amplitude, compiled: ln of each band's r.m.s. [ln m]."""
     x = np.asarray(log_components, float)
     flat = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
     out = np.empty(len(flat))
@@ -140,7 +140,7 @@ def _first_band_to_level(x, g, target, band, passes):  # pragma: no cover
 
 def first_band_to_level(log_components: ArrayLike, growth: ArrayLike,
                         log_level: ArrayLike) -> tuple[NDArray[np.int64], FloatArray]:
-    """models.corrugation.first_band_to_level, compiled, solving only the bands that can be first."""
+    """models.corrugation_state.first_band_to_level, compiled, solving only the bands that can be first."""
     x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
     shape, (b, p) = x.shape[:-2], x.shape[-2:]
     band, passes = np.empty(int(np.prod(shape)), np.int64), np.empty(int(np.prod(shape)))
@@ -150,7 +150,7 @@ def first_band_to_level(log_components: ArrayLike, growth: ArrayLike,
 
 
 def passes_to_band_level(log_components: ArrayLike, growth: ArrayLike, log_level: ArrayLike) -> FloatArray:
-    """models.corrugation.passes_to_band_level, compiled: passes [-] until each band's r.m.s.
+    """models.corrugation_state.passes_to_band_level, compiled: passes [-] until each band's r.m.s.
     reaches the level."""
     x, g = np.broadcast_arrays(np.asarray(log_components, float), np.asarray(growth, float))
     shape, p = x.shape[:-1], x.shape[-1]
@@ -175,7 +175,7 @@ def _history_sums(log_components, total, by_state, growth, friction, steps, summ
 
 def history_sums(log_components: FloatArray, total: FloatArray, by_state: FloatArray, growth: FloatArray,
                  friction: NDArray[np.int64]) -> tuple[FloatArray, FloatArray]:
-    """models.corrugation.history_sums, compiled: one pass over the passes for the three sums."""
+    """models.corrugation_state.history_sums, compiled: one pass over the passes for the three sums."""
     growth = np.ascontiguousarray(growth, float)
     steps = np.empty_like(growth)
     summed = np.empty((len(growth) + 1, *growth.shape[1:]))
@@ -197,7 +197,7 @@ def _window_growth(prefix, start, end, axles, growth, top):  # pragma: no cover
 
 def window_growth(prefix: FloatArray, start: NDArray[np.int64], end: NDArray[np.int64],
                   axles: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """models.corrugation.window_growth, compiled: no gathered copies of the prefix sum."""
+    """models.corrugation_state.window_growth, compiled: no gathered copies of the prefix sum."""
     n, (_, b, p) = len(end), prefix.shape
     growth, top = np.empty((n, b, p)), np.empty((n, b))
     _window_growth(np.ascontiguousarray(prefix), np.asarray(start, np.int64), np.asarray(end, np.int64),
@@ -215,7 +215,7 @@ def _add_by_day(daily, day, friction, growth, scale):  # pragma: no cover
 
 def add_by_day(daily: FloatArray, day: NDArray[np.int64], friction: NDArray[np.int64], growth: FloatArray,
                scale: FloatArray) -> None:
-    """models.corrugation.add_by_day, compiled."""
+    """models.corrugation_state.add_by_day, compiled."""
     _add_by_day(daily, np.asarray(day, np.int64), np.asarray(friction, np.int64),
                 np.ascontiguousarray(growth, float), np.asarray(scale, float))
 
@@ -232,7 +232,7 @@ def _table_growth(table, class_idx, friction, regime, j, w, scale, out):  # prag
 
 def table_growth(table: FloatArray, class_idx: NDArray[np.int64], friction: NDArray[np.int64],
                  regime: NDArray[np.int64], j: NDArray[np.int64], w: FloatArray, scale: FloatArray) -> FloatArray:
-    """models.corrugation.table_growth, compiled: no gathered copies of the table's rows."""
+    """models.corrugation_state.table_growth, compiled: no gathered copies of the table's rows."""
     out = np.empty((len(j), *table.shape[-2:]))
     _table_growth(table, class_idx, friction, regime, j, np.asarray(w, float), np.asarray(scale, float), out)
     return out

@@ -24,6 +24,6 @@ def corrugation_kernels(engine: str) -> ModuleType:
         from rail_monitor.models import corrugation_jit
 
         return corrugation_jit
-    from rail_monitor.models import corrugation
+    from rail_monitor.models import corrugation_state
 
-    return corrugation
+    return corrugation_state

@@ -2,7 +2,7 @@
 models.passby_axles (its numpy engine), fused into one loop per pass so no time history is held.
 
 Every operation is that of the numpy engine in the same order (each axle's term over one common
-denominator, models.passby_axles.near_axle_terms; the sum over axles vehicle by vehicle, then the
+denominator, models.passby_axles_peak.near_axle_terms; the sum over axles vehicle by vehicle, then the
 far line segments, then the paths, then IEC 61672-1's exponential average), without
 fast-math, so the two agree to the bit but for the arctangent, which numba takes from the C
 library and numpy from its own SIMD routines (they differ in the last bit for some arguments).
@@ -140,7 +140,7 @@ def f_weighted_peaks(length: FloatArray, speed: FloatArray, dt: FloatArray, deca
                      before: NDArray[np.int64], samples: NDArray[np.int64], lo: NDArray[np.int64],
                      hi: NDArray[np.int64], layout: AxleLayout, weight: FloatArray, d: float, radii: list[float],
                      use: Sequence[Sequence[int]], c: Sequence[Sequence[FloatArray]]) -> FloatArray:
-    """models.passby_axles.f_weighted_peaks's numba engine, given its per-pass windows (models x passes)."""
+    """models.passby_axles_peak.f_weighted_peaks's numba engine, given its per-pass windows (models x passes)."""
     n = len(length)
     width = max(len(u) for u in use)
     use_a = np.zeros((len(use), width), np.int64)

@@ -338,36 +338,3 @@ def static_stiffness(track: Track) -> float:
     s = 1.0 / (1.0 / track.pad_stiffness_npm + 1.0 / track.ballast_stiffness_npm) / track.sleeper_spacing_m
     beta = (s / (4.0 * track.young_modulus_pa * track.second_moment_m4)) ** 0.25
     return 2.0 * s / beta
-
-
-def wheel_receptance(frequency: ArrayLike, unsprung_mass: float = 600.0,
-                     modes: tuple[tuple[float, float, float], ...] = ()) -> ComplexArray:
-    """Vertical wheel receptance at the contact: the rigid unsprung mass plus the wheel's modes.
-
-    Each mode adds 1 / (m_n (w_n^2 - w^2 + 2 i zeta_n w_n w)).
-
-    Parameters
-    ----------
-    frequency : array_like
-        Frequency [Hz].
-    unsprung_mass : float
-        Unsprung mass per wheel [kg].
-    modes : tuple of (float, float, float)
-        (natural frequency [Hz], modal mass [kg], damping ratio [-]) of each mode seen at the contact.
-
-    Returns
-    -------
-    ndarray of complex
-        Receptance [m/N].
-
-    References
-    ----------
-    .. [1] D. J. Thompson, *Railway Noise and Vibration: Mechanisms, Modelling and Means of Control*,
-       Elsevier, Oxford, 2009, the chapter on wheel vibration.
-    """
-    w = 2 * np.pi * np.asarray(frequency, float)
-    out = -1.0 / (unsprung_mass * w**2) + 0j
-    for fn, mn, zn in modes:
-        wn = 2 * np.pi * fn
-        out = out + 1.0 / (mn * (wn**2 - w**2 + 2j * zn * wn * w))
-    return out

@@ -12,7 +12,10 @@ import numpy as np
 from rail_monitor.core.cache import cached_arrays
 from rail_monitor.core.site import Site, VehicleClass
 from rail_monitor.models import cnossos as cn
+from rail_monitor.models import cnossos_directivity as cdir
+from rail_monitor.models import cnossos_roughness as crough
 from rail_monitor.models import cnossos_tables as ct
+from rail_monitor.models import cnossos_transfer as xfer
 from rail_monitor.models import wheel_modes as wm
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.track import Track
@@ -26,7 +29,7 @@ def source_component(kind: str, source: str) -> str:
 
 # CNOSSOS-EU's components radiated from source B (4 m above the rail head); the others from A.
 SOURCE_B_COMPONENTS = tuple(source_component(kind, "B") for kind in ("traction", "aerodynamic"))
-AERODYNAMIC_COMPONENTS = tuple(source_component("aerodynamic", s) for s in cn.SOURCE_HEIGHTS)
+AERODYNAMIC_COMPONENTS = tuple(source_component("aerodynamic", s) for s in cdir.SOURCE_HEIGHTS)
 
 
 @dataclass(frozen=True)
@@ -49,10 +52,10 @@ def class_terms(site: Site, cfg: NoiseConfig, tables: ct.Tables, track_db: np.nd
     for name, v in site.vehicles.items():
         traction = {} if v.traction == "none" else {
             source_component("traction", src): cn.traction_sound_power(v.traction, src, "constant", tables)
-            for src in cn.SOURCE_HEIGHTS}
+            for src in cdir.SOURCE_HEIGHTS}
         contact = site.contact_patch(v.wheel_diameter_m / 2.0, v.wheel_load_n)
-        (a3_load, a3_diameter), a3 = cn.contact_filter(v.wheel_load_n, v.wheel_diameter_m, tables)
-        _, veh = cn.vehicle_transfer(v.wheel_diameter_m, tables)
+        (a3_load, a3_diameter), a3 = crough.contact_filter(v.wheel_load_n, v.wheel_diameter_m, tables)
+        _, veh = xfer.vehicle_transfer(v.wheel_diameter_m, tables)
         cnossos = {"track": track_db + rolling_excess_db, "vehicle": veh + rolling_excess_db}
         if v.freight:  # L_H,VEH,SUP of Table G-3c: 0 dB, for freight vehicles only (eq. 2.3.9)
             cnossos["superstructure"] = np.full(len(tables.band), rolling_excess_db)
@@ -60,7 +63,7 @@ def class_terms(site: Site, cfg: NoiseConfig, tables: ct.Tables, track_db: np.nd
             cnossos["bridge"] = bridge_db
         mech = mechanics_transfer(tables.band, site.track, v, float(contact.stiffness), cfg)
         a3_patch = float(site.contact_patch(a3_diameter / 2.0, a3_load).a)
-        out[name] = ClassTerms(cn.wheel_roughness(v.brake_type, cfg.interpolation, tables), a3, a3_patch, cnossos,
+        out[name] = ClassTerms(crough.wheel_roughness(v.brake_type, cfg.interpolation, tables), a3, a3_patch, cnossos,
                                mech, traction)
     return out
 

@@ -11,9 +11,10 @@ import numpy as np
 
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, resolve, section, values_of
-from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_roughness as crough
 from rail_monitor.models import cnossos_tables as ct
+from rail_monitor.models import cnossos_transfer as xfer
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.cnossos_catalogue import with_catalogue
 from rail_monitor.models.passby import Receiver
@@ -25,7 +26,7 @@ MODELS = ("cnossos", "mechanics")
 PASS_BY_SOURCES = ("axles", "line")
 CONTACT_FILTERS = ("hertz_line", "cnossos")
 ROUGHNESS_SOURCES = ("E", "M", "measured")
-_CLASS_E = cn.rail_roughness("E")
+_CLASS_E = crough.rail_roughness("E")
 
 NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("model", "cnossos", "Source model of noise/rolling: CNOSSOS-EU (Directive 2015/996 as amended by "
@@ -51,8 +52,8 @@ NOISE_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("track_transfer", "", "Track transfer column to use (a track_<name> of the tables or the catalogue); "
               "'': by sleeper_type and the pad class."),
     ParamSpec("sleeper_type", "monoblock", "Sleeper type for CNOSSOS's track transfer (Table G-3a); the pad class "
-              "follows track.pad_stiffness_npm.", choices=cn.SLEEPER_TYPES),
-    ParamSpec("bridge", "none", "Bridge at the site (CNOSSOS Table G-7; edition 2021).", choices=cn.BRIDGE_TYPES),
+              "follows track.pad_stiffness_npm.", choices=xfer.SLEEPER_TYPES),
+    ParamSpec("bridge", "none", "Bridge at the site (CNOSSOS Table G-7; edition 2021).", choices=xfer.BRIDGE_TYPES),
     ParamSpec("bridge_constant_db", 0.0, "Edition 2015's bridge constant C_bridge, added to the rolling noise [dB]; "
               "0: no bridge.", 0.0, 30.0),
     ParamSpec("joints_per_100m", 0.0, "Rail joints (impact noise, CNOSSOS Table G-4) per 100 m [-]; 0: none.",

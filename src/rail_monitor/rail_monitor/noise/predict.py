@@ -12,15 +12,13 @@ corrugation. The corrugation state adds, in energy, its growth since grinding in
 bands (its r.m.s. amplitude squared minus its post-grinding amplitude squared, at the nearest
 baseline wavelength within 1/6 octave), so a freshly ground state is the baseline itself and a
 measured baseline is not counted twice. The increase since grinding is LpAeq,Tp with the current
-state minus LpAeq,Tp on the baseline (INCREASE_REFERENCE). The wheel roughness is CNOSSOS-EU's
-for the class's brake type.
+state minus that on the baseline (INCREASE_REFERENCE). The wheel roughness is CNOSSOS-EU's, per brake type.
 
-Per pass: the class's wheel (diameter; the transfers use the Hertz contact stiffness at its
-nominal load, tabulated per class; the mechanics model's contact filter takes the pass's own
-Hertz patch, from its wheel and load as in its contact state; CNOSSOS's is the Directive's table
-for the class's nominal load and diameter), axles and length from the pass (class defaults filled),
-speed from the pass. Sound power per metre of train: L_W' = L_R,TOT + L_H + 10 lg(axles / length)
-per band.
+Per pass: the class's wheel (diameter; the transfers use the Hertz contact stiffness at its nominal
+load, tabulated per class; the mechanics model's contact filter takes the pass's own Hertz patch,
+from its wheel and load as in its contact state; CNOSSOS's is the Directive's table for the class's
+nominal load and diameter), axles, length and speed from the pass (class defaults filled). Sound
+power per metre of train: L_W' = L_R,TOT + L_H + 10 lg(axles / length) per band.
 """
 
 from __future__ import annotations
@@ -35,17 +33,19 @@ from rail_monitor.core.passes import KMH_PER_MPS, PassTable
 from rail_monitor.core.site import Site
 from rail_monitor.models import cnossos as cn
 from rail_monitor.models import cnossos_bands as cb
+from rail_monitor.models import cnossos_directivity as cdir
+from rail_monitor.models import cnossos_roughness as crough
+from rail_monitor.models import cnossos_transfer as xfer
 from rail_monitor.models import wheel_rail_noise as wrn
 from rail_monitor.models.axle_layout import AxleLayout, axle_layout
 from rail_monitor.models.levels import level, power
-from rail_monitor.models.passby import (
+from rail_monitor.models.passby import pass_by_levels, pass_geometry
+from rail_monitor.models.passby_paths import (
     BandPaths,
     PassGeometry,
     a_weighted_paths,
     f_weighted_peaks,
     lpaeq_weights,
-    pass_by_levels,
-    pass_geometry,
     power_paths,
 )
 from rail_monitor.noise.class_terms import (
@@ -79,18 +79,18 @@ class RollingNoiseModel:
         self.band, self.band_hz = t.band, t.band_hz
         self.receiver = cfg.receiver
         (_, psi), _ = self.receiver.paths()
-        self.vertical_db = cn.vertical_directivity_a_db(psi, self.band_hz, ed)
+        self.vertical_db = cdir.vertical_directivity_a_db(psi, self.band_hz, ed)
         self.vertical_gain = power(self.vertical_db)
         self.baseline_db = self._baseline()
-        self.impact_db = cn.impact_roughness(cfg.joints_per_100m / 100.0, t) if cfg.joints_per_100m > 0 else None
+        self.impact_db = crough.impact_roughness(cfg.joints_per_100m / 100.0, t) if cfg.joints_per_100m > 0 else None
         if cfg.track_transfer:
             self.track_name, track_db = cfg.track_transfer, t.by_frequency[cfg.track_transfer]
         else:
-            self.track_name, track_db = cn.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm, t)
-        self.bridge_db = cn.bridge_transfer(cfg.bridge, t)
+            self.track_name, track_db = xfer.track_transfer(cfg.sleeper_type, site.track.pad_stiffness_npm, t)
+        self.bridge_db = xfer.bridge_transfer(cfg.bridge, t)
         # The curve-squeal term and the 2015 bridge constant raise every rolling component alike.
         excess = (cn.curve_squeal_db(site.curve_radius_m) if cfg.curve_squeal else 0.0) + cfg.bridge_constant_db
-        self.receiver_b = dataclasses.replace(self.receiver, source_height_m=cn.SOURCE_HEIGHTS["B"])
+        self.receiver_b = dataclasses.replace(self.receiver, source_height_m=cdir.SOURCE_HEIGHTS["B"])
         self.classes = class_terms(site, cfg, t, track_db, excess, self.bridge_db)
 
     def component_names(self, model: str) -> list[str]:
@@ -113,7 +113,7 @@ class RollingNoiseModel:
     def _baseline(self) -> np.ndarray:
         source = self.cfg.rail_roughness
         if source != "measured":
-            return cn.rail_roughness(source, self.tables)
+            return crough.rail_roughness(source, self.tables)
         wl = np.asarray(self.cfg.rail_roughness_wavelength_m, float)
         return np.interp(self.grid, wl, np.asarray(self.cfg.rail_roughness_db, float))
 
@@ -272,7 +272,7 @@ class RollingNoiseModel:
             components[comp][rows] = power(lw0) * per_metre
         if self.cfg.aerodynamic:
             speed_kmh = passes.speed_mps[rows] * KMH_PER_MPS
-            for src in cn.SOURCE_HEIGHTS:
+            for src in cdir.SOURCE_HEIGHTS:
                 components[source_component("aerodynamic", src)][rows] = \
                     power(cn.aerodynamic_sound_power(speed_kmh, src, self.tables)) * per_metre
 
@@ -297,7 +297,7 @@ class RollingNoiseModel:
         return power_paths(total, geometry, self.vertical_gain, (sum(high), geometry_b) if high else None)
 
     def _lpaeq_weights(self, geometries: tuple[PassGeometry, PassGeometry | None]) -> dict[bool, np.ndarray]:
-        """models.passby.lpaeq_weights of source A's line (with the vertical directivity) and of
+        """models.passby_paths.lpaeq_weights of source A's line (with the vertical directivity) and of
         source B's where the passes have one, keyed by whether the line is B's."""
         low, high = geometries
         out = {False: lpaeq_weights(low, self.vertical_gain)}
@@ -340,7 +340,7 @@ class RollingNoiseModel:
             both = cb.band_roughness_power(rail_db, terms.wheel_db, 0.0, speed, self.band_hz, rule, None,
                                            self.edition, rail_power)
             return both * power(filter_db), terms.mechanics
-        combined = cn.total_roughness(rail_db, terms.wheel_db, 0.0)
+        combined = crough.total_roughness(rail_db, terms.wheel_db, 0.0)
         lr = cb.at_band_frequencies(combined, speed, self.band_hz, rule, self.edition) + filter_db
         return power(lr), terms.mechanics
 

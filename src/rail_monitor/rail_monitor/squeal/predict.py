@@ -17,7 +17,7 @@ import numpy as np
 from rail_monitor.core.contact import ContactState, contact_state
 from rail_monitor.core.passes import FRICTION_MODIFIER, PassTable
 from rail_monitor.core.site import Site
-from rail_monitor.models import squeal
+from rail_monitor.models import squeal, squeal_radiation
 from rail_monitor.squeal.config import RISK_HIGH, RISK_LOW, RISK_MEDIUM, RISK_NONE, SquealConfig
 
 
@@ -46,8 +46,8 @@ def wheel_mode(site: Site, vehicle_class: np.ndarray) -> WheelMode:
                      col["squeal_radiation_efficiency"])
 
 
-def _levels(cfg: SquealConfig, mode: WheelMode, amplitude: np.ndarray) -> squeal.RadiatedLevel:
-    return squeal.radiated_level(
+def _levels(cfg: SquealConfig, mode: WheelMode, amplitude: np.ndarray) -> squeal_radiation.RadiatedLevel:
+    return squeal_radiation.radiated_level(
         amplitude, mode.frequency_hz, radiating_area=mode.area_m2, radiation_efficiency=mode.efficiency,
         spatial_average=cfg.spatial_average, distance=cfg.receiver_distance_m)
 
@@ -81,7 +81,7 @@ def predict(cfg: SquealConfig, site: Site, passes: PassTable) -> dict[str, np.nd
         "frequency_hz": mode.frequency_hz,
         "level_db": lev.level_db,
         "level_dba": lev.level_dba,
-        "relative_level_db": squeal.relative_level(lc.amplitude, cfg.reference_amplitude_mps),
+        "relative_level_db": squeal_radiation.relative_level(lc.amplitude, cfg.reference_amplitude_mps),
         "friction_modifier_benefit_db": friction_modifier_benefit(cfg, site, passes, mode, lev.level_dba, cs),
         "risk": risk,
     }
@@ -123,7 +123,7 @@ def friction_modifier_benefit(cfg: SquealConfig, site: Site, passes: PassTable, 
 
 
 def level_and_risk(cfg: SquealConfig, mode: WheelMode, amplitude: np.ndarray,
-                   unstable: np.ndarray) -> tuple[squeal.RadiatedLevel, np.ndarray]:
+                   unstable: np.ndarray) -> tuple[squeal_radiation.RadiatedLevel, np.ndarray]:
     """The radiated level at the site's receiver of a wheel velocity amplitude [m/s] of a mode,
     and the risk class (RISK_*, int8) from the site's dB(A) limits."""
     lev = _levels(cfg, mode, amplitude)

@@ -189,6 +189,7 @@ def receptance_curves(site: Any) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """The site's track receptances [m/N] (continuous Timoshenko and Euler, discrete at mid-span
     and above a sleeper) and its first class's wheel, on 20 Hz-5 kHz [Hz]."""
     from rail_monitor.models import track as tr
+    from rail_monitor.models import wheel_rail_noise as wrn
 
     f = np.geomspace(20.0, 5000.0, 600)
     mid, above = tr.discrete_receptance(f, site.track, position=np.array([0.5, 0.0])).T
@@ -196,4 +197,4 @@ def receptance_curves(site: Any) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     return f, {"continuous, Timoshenko": tr.continuous_receptance(f, site.track),
                "continuous, Euler": tr.continuous_receptance(f, site.track, "euler"),
                "discrete, mid-span": mid, "discrete, above a sleeper": above,
-               f"wheel ({wheel:g} kg)": tr.wheel_receptance(f, wheel)}
+               f"wheel ({wheel:g} kg)": wrn.wheel_receptance(f, wheel)}

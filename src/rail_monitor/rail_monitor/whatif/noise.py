@@ -55,7 +55,7 @@ def growth_states(values: Mapping[str, Any], site: Site, cls: VehicleClass, spee
     from rail_monitor.advice.growth import growth_at_speeds
     from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.corrugation.estimator import CorrugationEstimator
-    from rail_monitor.models.corrugation import band_amplitude
+    from rail_monitor.models.corrugation_state import band_amplitude
 
     est = CorrugationEstimator(site, corrugation_config(values))
     per_axle = growth_at_speeds(est, np.array([speed_mps]), FRICTION_BY_NAME["dry"])[..., 0]

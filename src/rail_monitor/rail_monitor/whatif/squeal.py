@@ -14,7 +14,7 @@ from rail_monitor.core.contact import creep_stiffness
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.passes import FRICTION_BY_NAME, PassTable
 from rail_monitor.core.site import Site, site_from_values
-from rail_monitor.models import hertz, squeal, squeal_ode
+from rail_monitor.models import hertz, squeal, squeal_ode, squeal_radiation
 from rail_monitor.squeal.config import SquealConfig, squeal_config
 from rail_monitor.squeal.predict import WheelMode, level_and_risk, wheel_mode
 
@@ -82,12 +82,12 @@ def sweep(case: SquealCase, crabbing_mps: np.ndarray, reference_mps: float | Non
         "angle_of_attack_mrad": 1e3 * np.arcsin(np.clip(vc / case.speed_mps, -1.0, 1.0)),
         "velocity_amplitude_mps": lc.amplitude,
         "regime": lc.regime,
-        "relative_level_db": squeal.relative_level(lc.amplitude, ref),
+        "relative_level_db": squeal_radiation.relative_level(lc.amplitude, ref),
         "critical_slip_velocity_mps": np.broadcast_to(lc.critical_slip, vc.shape),
         "effective_damping_nspm": np.broadcast_to(lc.effective_damping, vc.shape),
     }
     if cfg is not None:
-        freq = np.broadcast_to(squeal.squeal_frequency(case.mass_kg, case.stiffness_npm), vc.shape)
+        freq = np.broadcast_to(squeal_radiation.squeal_frequency(case.mass_kg, case.stiffness_npm), vc.shape)
         mode = WheelMode(freq, np.full(vc.shape, case.mass_kg), np.full(vc.shape, case.damping_nspm),
                          np.full(vc.shape, case.radiating_area_m2), np.full(vc.shape, case.radiation_efficiency))
         lev, out["risk"] = level_and_risk(cfg, mode, lc.amplitude, lc.unstable)
