@@ -132,8 +132,7 @@ class SiteEngine:
         observer = IndirectObserver(self.model, rcfg, self.estimator.bands) if rcfg.indirect_days > 0 else None
         self.squeal = SquealSite(self.site, self.cfg.squeal, RISK_NAMES.index(self.cfg.alerts.squeal_min_risk),
                                  rcfg.held_predictions)
-        self.squeal.waiting_max = max(self.squeal.waiting_max, len(self._measurements))  # a history's, known at once
-        self.squeal.take(self._measurements)
+        self.squeal.expect(self._measurements)
         # Events are checked against the passes taken when they fall due, as the node checks them on arrival.
         self.corrugation = CorrugationSite(self.estimator, observer, self._event_ahead)
         self.corrugation.pending = in_time_order(events)

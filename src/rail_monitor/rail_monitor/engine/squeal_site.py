@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import heapq
 from collections import Counter, OrderedDict, deque
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -62,7 +62,7 @@ class SquealSite:
         self.window = cfg.fit_window_passes
         self.fit = SquealFit(site, cfg, fit_config(cfg, min_risk)) if self.interval_ns > 0 else None
         self.held_max = held
-        self.waiting_max = held  # measurements ahead of every accepted pass (a batch's owner raises it)
+        self.waiting_max = held  # measurements ahead of every accepted pass (a history's own: expect())
         self.window_end_ns = 0                          # end of the open window (0: none yet)
         # Accepted passes awaiting their measurement, oldest first: (stamp, train id) -> (table, row);
         # newer ones in the tables not yet indexed (indexed when a measurement is looked up: a history
@@ -136,6 +136,11 @@ class SquealSite:
             if self.waiting.pop(heapq.heappop(self._waiting_order), None) is not None:
                 self.counts["no accepted pass (unknown, rejected, or measured twice)"] += 1
 
+    def expect(self, measurements: Sequence[Measurement]) -> None:
+        """A history's measurements, known before its passes (batch): all of them may wait."""
+        self.waiting_max = max(self.waiting_max, len(measurements))
+        self.take(measurements)
+
     def take(self, measurements: Sequence[Measurement]) -> None:
         """Measured pass-bys: paired with their held passes, or waiting for them; one whose squeal
         measures are not measures, or whose pass is neither held nor to come, is counted by reason."""
@@ -188,13 +193,13 @@ class SquealSite:
                 self.fit.refine(code)
                 k1_0, k2_0 = (float(x[0]) for x in self.configured.contact.creep(np.array([code])))
                 states.append((code, (k1_0, k2_0), self.fit.quantiles(code)))
-        self._use(states)
+        self._use((code, q) for code, _, q in states)
         self.calibrations.append(Calibration(stamp_ns, tuple(states)))
 
-    def _use(self, states: list[tuple[int, tuple[float, float], CurveQuantiles]]) -> None:
+    def _use(self, fitted: Iterable[tuple[int, CurveQuantiles]]) -> None:
         """The squeal model's site: the configured one with each fitted state's P50 curve."""
         curves = {}
-        for code, _, q in states:
+        for code, q in fitted:
             name = FRICTION_NAMES[code]
             curves.update({f"creep_{name}_k1": q.k1[1], f"creep_{name}_k2": q.k2[1]})
         self.site = replace(self.configured, contact=replace(self.configured.contact, **curves))
@@ -246,4 +251,4 @@ class SquealSite:
         self.held, self.waiting, self._waiting_order = OrderedDict(), dict(self.waiting), list(self._waiting_order)
         self._unindexed, self._unindexed_rows = deque(), 0
         self.hold(held)
-        self._use([(code, (0.0, 0.0), fit.quantiles(code)) for code in FRICTION_NAMES if fit.seen[code][0]])
+        self._use((code, fit.quantiles(code)) for code in FRICTION_NAMES if fit.seen[code][0])
