@@ -11,6 +11,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from rail_monitor.alerts.config import KIND_SQUEAL_DRIFT
 from rail_monitor.batch.run import run_models
 from rail_monitor.core.friction import FRICTION_BY_NAME, FRICTION_NAMES
 from rail_monitor.core.simulator_params import simulator_config
@@ -18,6 +19,7 @@ from rail_monitor.core.site import site_from_values
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.engine import checkpoint
 from rail_monitor.engine.site import SiteEngine
+from rail_monitor.measured.records import SQUEAL_MEASURES
 from rail_monitor.simulation.measurements import station_on_true_rail
 from rail_monitor.simulation.simulator import simulate
 from rail_monitor.site_file import load_parameter_file
@@ -48,12 +50,17 @@ def batch(month):
     return run_models(table, values, threads=1, measurements=measurements)
 
 
-def _same_outputs(a, b) -> None:
+def _same_outputs(a, b, alerts: bool = True) -> None:
     for k in a.squeal:
         np.testing.assert_array_equal(a.squeal[k], b.squeal[k], err_msg=k)
     assert [c.stamp_ns for c in a.calibrations] == [c.stamp_ns for c in b.calibrations]
     for x, y in zip(a.calibrations, b.calibrations, strict=True):
         assert x.states == y.states
+    assert not alerts or _drift(a) == _drift(b)
+
+
+def _drift(result) -> list:
+    return [a for a in result.alerts if a.kind == KIND_SQUEAL_DRIFT]
 
 
 def test_each_window_is_fitted_and_the_passes_after_it_are_predicted_on_its_median(month, batch):
@@ -72,13 +79,13 @@ def test_each_window_is_fitted_and_the_passes_after_it_are_predicted_on_its_medi
                                   predict(cfg, site, batch.accepted.take(before))["level_dba"])
     last = cals[-1]
     curves = {}
-    for code, _, q in last.states:
+    for code, _, q, _ in last.states:
         curves.update({f"creep_{FRICTION_NAMES[code]}_k1": q.k1[1], f"creep_{FRICTION_NAMES[code]}_k2": q.k2[1]})
     fitted = replace(site, contact=replace(site.contact, **curves))
     after = t > last.stamp_ns
     for k in ("level_dba", "risk", "velocity_amplitude_mps"):
         np.testing.assert_array_equal(batch.squeal[k][after], predict(cfg, fitted, batch.accepted.take(after))[k])
-    assert {FRICTION_NAMES[code] for code, _, _ in last.states} == {"dry", "wet"}  # the month's states
+    assert {FRICTION_NAMES[code] for code, *_ in last.states} == {"dry", "wet"}  # the month's states
 
 
 def test_four_weeks_of_measured_squeal_close_on_the_true_curves(batch):
@@ -87,7 +94,7 @@ def test_four_weeks_of_measured_squeal_close_on_the_true_curves(batch):
     that interval spans at most 6 % of its median (measured: dry 0.355-0.366 over 1,895 passes, 3.1 %;
     wet 0.153-0.161 over 358, 4.5 %; the prior's P10-P90 spans 107 %); the configured peaks miss
     the truth by 17-20 %."""
-    last = {FRICTION_NAMES[code]: (k0, q) for code, k0, q in batch.calibrations[-1].states}
+    last = {FRICTION_NAMES[code]: (k0, q) for code, k0, q, _ in batch.calibrations[-1].states}
     for name in last:
         k1 = TRUTH[name][0]
         (k1_0, _), q = last[name]
@@ -130,7 +137,8 @@ def test_a_checkpoint_mid_history_resumes_the_fit(month, batch, tmp_path):
     second = SiteEngine(values, threads=1, measurements=later)
     second.resume(str(path))
     b = second.feed(table.take(slice(cut, None)))
-    _same_outputs(type(batch).merged([a, b], [], None), batch)
+    # The alerts' windows and runs are not checkpointed: a resumed engine starts them afresh.
+    _same_outputs(type(batch).merged([a, b], [], None), batch, alerts=False)
 
 
 def test_fit_days_zero_keeps_the_configured_curves(month):
@@ -167,3 +175,56 @@ def test_hostile_measurements_are_counted_by_reason_and_change_nothing(month):
     assert out.calibrations == [] and engine.squeal.site == clean.site
     for k in ("level_dba", "risk"):
         np.testing.assert_array_equal(out.squeal[k], clean.squeal[k])
+
+
+# The simulated station's own flag error (simulation.measurements.simulate_measurements).
+STATION_FLAG_ERROR = 0.02
+
+
+@pytest.fixture(scope="module")
+def six_weeks():
+    values = load_parameter_file(SITE_FILE)
+    values.update({"simulator.days": 42.0, "squeal.fit_days": FIT_DAYS, "squeal.fit_flag_error": STATION_FLAG_ERROR})
+    table = simulate(site_from_values(values), simulator_config(values)).sorted()
+    station = station_on_true_rail(table, values, 1.0, int(values["simulator.seed"]), TRUTH)
+    return values, table, sorted(station.measurements, key=lambda m: m.key)
+
+
+def _judged(result) -> list[tuple[str, float, float, float]]:
+    """Every window the drift alert judges (30 passes or more): state, measured share, P10, P90."""
+    return [(s, k / n, lo, hi) for c in result.calibrations for s, n, k, lo, hi in c.share_windows() if n >= 30]
+
+
+def test_a_steady_site_stays_inside_its_predicted_share(six_weeks, month, batch):
+    """Six weeks of a site whose curves do not change, the fit told the station's flag error: every
+    judged window's measured share lies inside the P10-P90 the model predicted for it before the fit
+    took it (measured: 11 of 11 windows of 30 passes or more; by chance about 1 in 5 would fall outside,
+    and the test allows that) and no drift alert is
+    raised. The month's run, whose fit takes the default flag error (5 %) where the station errs on
+    2 %, hears the dry state squealing less than the model's floor allows, three windows running:
+    its drift alert says so."""
+    values, table, measurements = six_weeks
+    steady = run_models(table, values, threads=1, measurements=measurements)
+    judged = _judged(steady)
+    outside = [w for w in judged if not w[2] <= w[1] <= w[3]]
+    assert len(judged) >= 10 and len(outside) <= len(judged) // 5, outside
+    assert not _drift(steady)
+    assert [(a.key, a.active) for a in _drift(batch)] == [("dry", True)] and "less than" in _drift(batch)[0].summary
+
+
+def test_a_station_gone_quiet_on_dry_passes_raises_the_drift_alert_for_dry_only(six_weeks):
+    """From day 14 the station flags no dry pass squealing (a detector gone deaf, or a lubricator no
+    pass record names): the fit cannot follow a share below its flag error, each window's share (0)
+    falls below the predicted P10, and the third such window raises dry's drift alert; wet, heard as
+    before, is not raised."""
+    values, table, measurements = six_weeks
+    cut = int(table.stamp_ns[0]) + int(14 * NS_PER_DAY)
+    dry = {k for k, f in zip(zip(table.stamp_ns.tolist(), table.train_id.tolist(), strict=True),
+                             table.friction_state.tolist(), strict=True) if f == FRICTION_BY_NAME["dry"]}
+    quiet = [replace(m, squeal_detected=False, **SQUEAL_MEASURES) if m.stamp_ns >= cut and m.key in dry else m
+             for m in measurements]
+    out = run_models(table, values, threads=1, measurements=quiet)
+    drift = _drift(out)
+    assert [(a.key, a.active) for a in drift] == [("dry", True)], drift
+    assert "less than predicted, 3 fits running" in drift[0].summary and drift[0].value < drift[0].threshold
+    assert drift[0].stamp_ns <= cut + int(3 * FIT_DAYS * NS_PER_DAY)

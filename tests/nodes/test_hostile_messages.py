@@ -46,6 +46,7 @@ from rail_msgs.msg import (
     MeasuredPassNoise,
     RollingNoise,
     RoughnessSurvey,
+    SquealCalibration,
     SquealPrediction,
     TrainPass,
 )
@@ -117,6 +118,18 @@ def _hostile_outputs() -> tuple[list[SquealPrediction], list[RollingNoise]]:
     return squeal, noise
 
 
+def _hostile_fits() -> list[SquealCalibration]:
+    """Squeal fits the drift alert cannot judge: arrays of different lengths, more squealing passes
+    than passes, a NaN share where the window had passes, and a P10 above its P90."""
+    def fit(**f) -> SquealCalibration:
+        fields = {"friction_state": ["dry"], "window_passes": [100], "window_squealing": [90],
+                  "window_share_p10": [0.1], "window_share_p90": [0.2], **f}
+        return _stamped(SquealCalibration(**fields), T0 + 80)
+
+    return [fit(window_passes=[100, 100]), fit(window_squealing=[101]), fit(window_share_p10=[math.nan]),
+            fit(window_share_p10=[0.3])]
+
+
 def _hostile_measurements(first) -> list[MeasuredPassNoise]:
     """A good measurement of the first pass (sent twice), and one of each kind the alert manager
     must refuse: a NaN band, an absurd level, a receiver 30 m away, class 9, ids without levels,
@@ -160,7 +173,8 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
         ("/clock", Clock, CLOCK_QOS), ("train_pass", TrainPass, STREAM_QOS),
         ("roughness_survey", RoughnessSurvey, EVENT_QOS), ("corrugation/state", CorrugationState, STATE_QOS),
         ("noise/squeal", SquealPrediction, STREAM_QOS), ("noise/rolling", RollingNoise, STREAM_QOS),
-        ("noise/measured", MeasuredPassNoise, STREAM_QOS), ("/diagnostics", DiagnosticArray, DIAGNOSTICS_QOS))}
+        ("noise/measured", MeasuredPassNoise, STREAM_QOS), ("/diagnostics", DiagnosticArray, DIAGNOSTICS_QOS),
+        ("noise/squeal_calibration", SquealCalibration, STREAM_QOS))}
     client = hostile.create_client(EvaluateSpeedDistribution, "evaluate_speed_distribution")
     assert wait_until(lambda: pubs["train_pass"].get_subscription_count() >= 5 and client.service_is_ready()
                       and all(p.get_subscription_count() >= 1 for p in pubs.values()), 20)
@@ -184,6 +198,7 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
                         ("corrugation/state", states_raw),
                         ("noise/squeal", squeals), ("noise/rolling", noises),
                         ("noise/measured", _hostile_measurements(first)),
+                        ("noise/squeal_calibration", fits := _hostile_fits()),
                         ("/diagnostics", [_diagnostic("fake", 2000)])):
         for m in msgs:
             pubs[topic].publish(m)
@@ -211,8 +226,10 @@ def test_one_of_each_hostile_message_stops_no_node_and_each_is_counted(graph, si
     refused = {k: n for k, n in alerts.inputs.items() if " refused: " in k}
     assert sum(n for k, n in refused.items() if k.startswith("corrugation/state")) == len(states) + 2, refused
     assert sum(n for k, n in refused.items() if "not a readable CDR message" in k) == 2, refused
-    assert sum(n for k, n in refused.items() if k.startswith("noise/squeal")) == len(squeals), refused
+    assert sum(n for k, n in refused.items() if k.startswith("noise/squeal refused")) == len(squeals), refused
     assert sum(n for k, n in refused.items() if k.startswith("noise/rolling")) == len(noises), refused
+    assert wait_until(lambda: sum(n for k, n in alerts.inputs.items()
+                                  if k.startswith("noise/squeal_calibration refused")) == len(fits), 10), alerts.inputs
     assert est.surveys_rejected["stamp more than 366 d ahead of the stream (stamps.max_ahead_of_stream_s)"] == 2, \
         est.surveys_rejected
     assert any(why.startswith("ValueError") for why in process.CALLBACK_ERRORS), process.CALLBACK_ERRORS

@@ -262,7 +262,8 @@ def test_measured_squeal_by_angle_of_attack_and_the_repeat_squealers_named():
 def test_the_squeal_models_fits_are_reported_from_the_bag(tmp_path):
     """A run whose measured squeal re-fits the squeal model (two weeks, weekly fits): the report's
     table gives each friction state's latest fit as the bag recorded it, and its figure plots every
-    fit's P50 with the P10-P90 band and the configured curve (issue 55)."""
+    fit's P50 with the P10-P90 band and the configured curve, and how its windows' measured squeal
+    shares stood against the shares predicted for them (issue 55)."""
     from rail_monitor.core.simulator_params import simulator_config
     from rail_monitor.core.site import site_from_values
     from rail_monitor.simulation.measurements import station_on_true_rail
@@ -275,11 +276,17 @@ def test_the_squeal_models_fits_are_reported_from_the_bag(tmp_path):
     result = run_models(table, values, threads=1, measurements=station.measurements)
     assert len(result.calibrations) >= 2
     run = load_run(write_bag(result, tmp_path / "bag", "curve_250"))
-    last = {code: q for code, _, q in result.calibrations[-1].states}
+    last = {code: q for code, _, q, _ in result.calibrations[-1].states}
     rows = {r["friction state"]: r for r in report_tables.squeal_fits(run.squeal_fits, "UTC")}
     assert rows["dry"]["k1 P10 / P50 / P90"] == " / ".join(f"{v:.4g}" for v in last[1].k1)
     assert rows["dry"]["measured passes"] == last[1].passes and rows["dry"]["k1 configured"] == 0.3
     assert len(run.squeal_fits["dry"]["stamp_ns"]) == len(result.calibrations)
+    # The windows judged against the share predicted before each fit, as the bag carries them.
+    windows = [w for c in result.calibrations for w in c.share_windows() if w[0] == "dry"]
+    outside = sum(not lo <= k / n <= hi for _, n, k, lo, hi in windows)
+    assert rows["dry"]["windows outside predicted P10-P90"] == f"{outside} of {len(windows)}"
+    _, n, k, lo, hi = windows[-1]
+    assert rows["dry"]["last window: measured / predicted [%]"] == f"{100 * k / n:.1f} / {100 * lo:.1f}-{100 * hi:.1f}"
     fig = report_plots.squeal_fits(run.squeal_fits, "UTC")
     assert [ax.get_ylabel() for ax in fig.axes] == ["friction peak k1 [-]", "falling slope k2 [-]"]
     files = build_report(run, SiteConfig.from_values(values), tmp_path / "report", "curve_250.yaml")

@@ -13,12 +13,12 @@ from rail_monitor.core.params import ParamSpec, resolve, section, values_of
 
 # WaysideAlert.KIND_* and SEVERITY_* values.
 (KIND_GRINDING_DUE, KIND_GRINDING_FORECAST, KIND_NOISE_LIMIT, KIND_SQUEAL, KIND_INPUT_REJECTED, KIND_WHEEL_DEFECT,
- KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH, KIND_SQUEAL_MEASURED, KIND_SQUEAL_OFFENDER) = range(1, 11)
+ KIND_NOISE_DRIFT, KIND_SQUEAL_MISMATCH, KIND_SQUEAL_MEASURED, KIND_SQUEAL_OFFENDER, KIND_SQUEAL_DRIFT) = range(1, 12)
 KIND_NAMES = {KIND_GRINDING_DUE: "grinding due", KIND_GRINDING_FORECAST: "grinding forecast",
               KIND_NOISE_LIMIT: "noise limit", KIND_SQUEAL: "squeal", KIND_INPUT_REJECTED: "inputs rejected",
               KIND_WHEEL_DEFECT: "wheel defect", KIND_NOISE_DRIFT: "noise drift",
               KIND_SQUEAL_MISMATCH: "squeal mismatch", KIND_SQUEAL_MEASURED: "squeal measured",
-              KIND_SQUEAL_OFFENDER: "repeat squealer"}
+              KIND_SQUEAL_OFFENDER: "repeat squealer", KIND_SQUEAL_DRIFT: "squeal model drift"}
 SEVERITY_INFO, SEVERITY_WARNING, SEVERITY_CRITICAL = range(3)
 NOISE_METRICS = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba")  # RollingNoise single numbers
 RISK_NAMES = ("none", "low", "medium", "high")
@@ -81,6 +81,11 @@ ALERT_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("squeal_offender_raise_p", 1e-5, "A vehicle is named when the chance of squealing that often, at "
               "the site's measured share for passes of the same predicted risk, falls below this [-].", 1e-15, 0.5),
     ParamSpec("squeal_offender_clear_p", 0.01, "It is cleared when that chance rises above this [-].", 1e-15, 1.0),
+    ParamSpec("squeal_drift_windows", 3, "Squeal fits running whose window's measured squeal share of a friction "
+              "state lies outside the share the model predicted for it (P10-P90), on one side, that raise the "
+              "state's model-drift alert (a window inside clears it) [-].", 1, 1000),
+    ParamSpec("squeal_drift_min_passes", 30, "Measured passes of a state a fit window needs to be judged [-].",
+              1, 100_000),
 )
 # Every alert parameter may be changed on a running alert_manager (ros2 param set): an operator
 # tunes limits and windows without a restart; the same checks refuse a bad value with the reason.
@@ -122,6 +127,8 @@ class AlertConfig:
     squeal_offender_min_passes: int
     squeal_offender_raise_p: float
     squeal_offender_clear_p: float
+    squeal_drift_windows: int
+    squeal_drift_min_passes: int
     lead_time_days: float
 
 

@@ -20,6 +20,7 @@ from rail_monitor.alerts.config import (
     KIND_NOISE_DRIFT,
     KIND_NOISE_LIMIT,
     KIND_SQUEAL,
+    KIND_SQUEAL_DRIFT,
     KIND_SQUEAL_MEASURED,
     KIND_SQUEAL_MISMATCH,
     KIND_SQUEAL_OFFENDER,
@@ -30,6 +31,7 @@ from rail_monitor.alerts.config import (
     AlertConfig,
     counts_as_squeal,
 )
+from rail_monitor.alerts.squeal_drift import SquealDrift
 from rail_monitor.alerts.squealers import RepeatSquealers
 from rail_monitor.alerts.windows import Window, hysteresis_changes
 from rail_monitor.core.text import printable
@@ -74,6 +76,7 @@ class AlertManager:
         self._heard = Window(cfg.squeal_measured_window_passes)
         self.squealers = RepeatSquealers(cfg.squeal_offender_window_passes, cfg.squeal_offender_min_passes,
                                          cfg.squeal_offender_raise_p, cfg.squeal_offender_clear_p)
+        self.drift = SquealDrift(cfg.squeal_drift_windows, cfg.squeal_drift_min_passes)
 
     def retune(self, cfg: AlertConfig) -> None:
         """Take new limits and windows (a running node's parameters changed): each window keeps its
@@ -88,6 +91,7 @@ class AlertManager:
         s.window, s.min_passes, s.raise_p, s.clear_p = (cfg.squeal_offender_window_passes,
                                                         cfg.squeal_offender_min_passes,
                                                         cfg.squeal_offender_raise_p, cfg.squeal_offender_clear_p)
+        self.drift.windows, self.drift.min_passes = cfg.squeal_drift_windows, cfg.squeal_drift_min_passes
 
     # -- raise / clear ----------------------------------------------------------------------------
     def _set(self, active: bool, kind: int, key: str, stamp_ns: int, severity: int, summary: str, value: float,
@@ -318,6 +322,13 @@ class AlertManager:
                         cfg.squeal_offender_raise_p if v.flagged else cfg.squeal_offender_clear_p, "-"))
         return [e for e in events if e]
 
+    def on_squeal_fit(self, stamp_ns: int, windows: Sequence[tuple[str, int, int, float, float]]) -> list[Alert]:
+        """One fit of the squeal model (a SquealCalibration): per friction state, its window's measured
+        passes, those flagged squealing and the predicted share's P10 and P90 [-] (alerts.squeal_drift)."""
+        events = [self._set(bool(v.side), KIND_SQUEAL_DRIFT, v.state, stamp_ns,
+                            SEVERITY_WARNING if v.side else SEVERITY_INFO, v.summary, v.share,
+                            v.p90 if v.side > 0 else v.p10, "-") for v in self.drift.changes(windows)]
+        return [e for e in events if e]
 
 MISMATCHES = ("measured, not predicted", "predicted, not measured")  # the squeal-mismatch alerts' keys
 

@@ -234,6 +234,9 @@ class SiteEngine:
                 trajs.append((lo, traj))
             traj = trajs[0][1] if len(trajs) == 1 else Trajectory.concat(trajs)
             squeal = squeal_job.result()
+            calibrations = self.squeal.take_calibrations()
+            for c in calibrations:
+                self.alerts.on_squeal_fit(c.stamp_ns, c.share_windows())
             _feed_alerts(self.alerts, table, reasons, accepted, squeal, traj)  # while the noise is finishing
             for job in noise_jobs:
                 job.result()
@@ -250,7 +253,7 @@ class SiteEngine:
                            trajectory=traj, noise=noise, alerts=[a for a in events if a.stamp_ns < later],
                            standing=self.standing(), advice=None, estimator=self.estimator,
                            receiver=self.model.receiver, left_out=dict(left_out), measurements=measured,
-                           residuals=residuals, calibrations=self.squeal.take_calibrations())
+                           residuals=residuals, calibrations=calibrations)
 
     def _squeal(self, accepted: PassTable) -> dict[str, np.ndarray]:
         """The squeal of the passes, each on the curves fitted before it (engine.squeal_site)."""

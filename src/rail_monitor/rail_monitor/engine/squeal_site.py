@@ -38,6 +38,7 @@ from rail_monitor.corrugation.surveys import split_before
 from rail_monitor.measured.records import Measurement, squeal_observation_refusal
 from rail_monitor.squeal.calibration import CurveQuantiles, SquealFit, fit_config
 from rail_monitor.squeal.config import SquealConfig
+from rail_monitor.squeal.share_check import ShareCheck
 
 PREFIX = "squeal_fit_"  # its checkpoint records
 MERGE_TABLES = 64       # held tables not yet indexed, merged into one past this many
@@ -46,10 +47,17 @@ MERGE_TABLES = 64       # held tables not yet indexed, merged into one past this
 @dataclass(frozen=True)
 class Calibration:
     """One fit: at stamp_ns (the window's end), per friction state fitted so far, the configured
-    curve (k1, k2) [-] and the posterior's quantiles."""
+    curve (k1, k2) [-], the posterior's quantiles, and the window's measured share with the share
+    the model predicted before the fit took it (None: no passes of the state in the window)."""
 
     stamp_ns: int
-    states: tuple[tuple[int, tuple[float, float], CurveQuantiles], ...]
+    states: tuple[tuple[int, tuple[float, float], CurveQuantiles, ShareCheck | None], ...]
+
+    def share_windows(self) -> list[tuple[str, int, int, float, float]]:
+        """Per state with passes in the window: its name, the passes, those flagged squealing, and the
+        predicted share's P10 and P90 [-] (what the squeal-drift alert judges)."""
+        return [(FRICTION_NAMES[code], w.passes, w.squealed, w.predicted[0], w.predicted[2])
+                for code, _, _, w in self.states if w is not None]
 
 
 class SquealSite:
@@ -183,8 +191,8 @@ class SquealSite:
             return
         pending = sorted(self.pending, key=lambda p: p[0])  # the same order whichever way they came
         self.pending = []
-        self.fit.observe(PassTable.concat([p[1] for p in pending]), *(np.array([p[i] for p in pending], float)
-                                                                      for i in (2, 3, 4)))
+        checks = self.fit.observe(PassTable.concat([p[1] for p in pending]),
+                                  *(np.array([p[i] for p in pending], float) for i in (2, 3, 4)))
         self.counts["paired"] += len(pending)
         states = []
         for code in FRICTION_NAMES:
@@ -192,8 +200,8 @@ class SquealSite:
             if self.fit.seen[code][0]:
                 self.fit.refine(code)
                 k1_0, k2_0 = (float(x[0]) for x in self.configured.contact.creep(np.array([code])))
-                states.append((code, (k1_0, k2_0), self.fit.quantiles(code)))
-        self._use((code, q) for code, _, q in states)
+                states.append((code, (k1_0, k2_0), self.fit.quantiles(code), checks.get(code)))
+        self._use((code, q) for code, _, q, _ in states)
         self.calibrations.append(Calibration(stamp_ns, tuple(states)))
 
     def _use(self, fitted: Iterable[tuple[int, CurveQuantiles]]) -> None:

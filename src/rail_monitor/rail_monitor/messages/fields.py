@@ -277,13 +277,16 @@ def indirect_roughness_fields(obs: Observation, frame_id: str) -> Fields:
 def squeal_calibration_fields(c: Calibration, frame_id: str) -> Fields:
     """One fit of the squeal model: per friction state fitted, its configured curve and quantiles."""
     out: Fields = {"header": header_fields(c.stamp_ns, frame_id),
-                   "friction_state": [FRICTION_NAMES[code] for code, _, _ in c.states],
-                   "k1_configured": [k[0] for _, k, _ in c.states], "k2_configured": [k[1] for _, k, _ in c.states],
-                   "measured_passes": [q.passes for _, _, q in c.states],
-                   "squealing_passes": [q.squealed for _, _, q in c.states]}
+                   "friction_state": [FRICTION_NAMES[code] for code, *_ in c.states],
+                   "k1_configured": [k[0] for _, k, *_ in c.states], "k2_configured": [k[1] for _, k, *_ in c.states],
+                   "measured_passes": [q.passes for _, _, q, _ in c.states],
+                   "squealing_passes": [q.squealed for _, _, q, _ in c.states],
+                   "window_passes": [w.passes if w else 0 for *_, w in c.states],
+                   "window_squealing": [w.squealed if w else 0 for *_, w in c.states]}
     for i, p in enumerate(("p10", "p50", "p90")):
-        out[f"k1_{p}"] = [q.k1[i] for _, _, q in c.states]
-        out[f"k2_{p}"] = [q.k2[i] for _, _, q in c.states]
+        out[f"k1_{p}"] = [q.k1[i] for _, _, q, _ in c.states]
+        out[f"k2_{p}"] = [q.k2[i] for _, _, q, _ in c.states]
+        out[f"window_share_{p}"] = [w.predicted[i] if w else float("nan") for *_, w in c.states]
     return out
 
 

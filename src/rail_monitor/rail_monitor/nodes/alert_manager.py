@@ -4,7 +4,8 @@ Subscribes ``train_pass`` (rejected inputs), ``noise/squeal``, ``noise/rolling``
 ``corrugation/state`` (every state, in order) and ``noise/measured`` (rail_msgs/MeasuredPassNoise:
 each measurement is paired with its pass's predictions, which this node takes anyway, and its
 residuals are published on ``noise/residual``, rail_msgs/NoiseResidual, and raise the wheel-defect
-and drift alerts; rail_monitor.measured); publishes each raise and clear on ``alerts``
+and drift alerts; rail_monitor.measured) and ``noise/squeal_calibration`` (each fit of the squeal
+model: the squeal-drift alert per friction state); publishes each raise and clear on ``alerts``
 (rail_msgs/WaysideAlert; reliable, transient local, depth 1000) and the standing set on
 ``alerts/standing`` (rail_msgs/WaysideAlertArray; latched), so a late subscriber sees the
 standing alerts at once. Thresholds and hysteresis: ``alerts.*``
@@ -37,6 +38,7 @@ from rail_monitor.messages.fields import (
     measurement_from_msg,
     noise_residual_fields,
     time_columns_ns,
+    time_ns,
     wayside_alert_array_fields,
     wayside_alert_fields,
 )
@@ -59,6 +61,7 @@ from rail_msgs.msg import (
     MeasuredPassNoise,
     NoiseResidual,
     RollingNoise,
+    SquealCalibration,
     SquealPrediction,
     WaysideAlert,
     WaysideAlertArray,
@@ -88,6 +91,8 @@ class AlertManagerNode(PassConsumerNode):
         self.residual_pub = self.create_publisher(NoiseResidual, "noise/residual", STREAM_QOS)
         self.measured_sub = subscribe_batched(self, MeasuredPassNoise, "noise/measured", self._on_measured,
                                               STREAM_SUB_QOS, self.max_batch)
+        subscribe_batched(self, SquealCalibration, "noise/squeal_calibration", self._on_squeal_fits, STREAM_SUB_QOS,
+                          self.max_batch)
         # Each stream in its own order (streams do not interact): what is queued is taken at once and
         # fed as one series; alerts/standing (latched, latest only) is published once per series.
         # Raw: the messages taken are read from their CDR together, as columns (not converted by rclpy).
@@ -162,6 +167,18 @@ class AlertManagerNode(PassConsumerNode):
             self.get_logger().warning(f"noise/measured refused: {dict(self.tracker.refused)}",
                                       throttle_duration_sec=self.log_throttle_s)
 
+    def _on_squeal_fits(self, msgs: list[SquealCalibration]) -> None:
+        topic = "noise/squeal_calibration"
+        for m in msgs:
+            self.inputs[topic] += 1
+            why = squeal_fit_refusal(m)
+            if why:
+                self._refuse(topic, why)
+                continue
+            windows = zip(m.friction_state, m.window_passes, m.window_squealing, m.window_share_p10,
+                          m.window_share_p90, strict=True)
+            self._emit(self.alerts.on_squeal_fit(time_ns(m.header.stamp), [w for w in windows if w[1]]))
+
     def _residuals(self, residuals: list[Residual]) -> None:
         for r in residuals:
             self.sent.publish(self.residual_pub, noise_residual_fields(r, self.site.site_id))
@@ -211,6 +228,19 @@ class AlertManagerNode(PassConsumerNode):
         if self.alerts.standing:
             return DiagnosticStatus.WARN, f"{len(self.alerts.standing)} alert(s) standing"
         return super()._level()
+
+
+def squeal_fit_refusal(m: SquealCalibration) -> str:
+    """Why a SquealCalibration cannot be judged for drift ('' if it can)."""
+    if len({len(getattr(m, f)) for f in ("friction_state", "window_passes", "window_squealing", "window_share_p10",
+                                         "window_share_p90")}) != 1:
+        return "its friction states and window arrays differ in length"
+    if any(k > p for p, k in zip(m.window_passes, m.window_squealing, strict=True)):
+        return "more squealing passes than passes in its window"
+    if not all(0.0 <= lo <= hi <= 1.0 for p, lo, hi in zip(m.window_passes, m.window_share_p10, m.window_share_p90,
+                                                           strict=True) if p):
+        return "a predicted share outside [0, 1], or its P10 above its P90"
+    return ""
 
 
 def retune_alerts(node: Node, alerts: AlertManager, lead_time_days: float,

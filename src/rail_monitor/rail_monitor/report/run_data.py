@@ -23,6 +23,7 @@ _TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "
           "MeasuredPassNoise", "NoiseResidual", "SquealCalibration")
 _FIT = ("k1_configured", "k2_configured", "k1_p10", "k1_p50", "k1_p90", "k2_p10", "k2_p50", "k2_p90",
         "measured_passes", "squealing_passes")
+_FIT_WINDOW = ("window_passes", "window_squealing", "window_share_p10", "window_share_p50", "window_share_p90")
 _MEASURED = ("lpaeq_tp_dba", "lpafmax_dba", "tel_dba", "squeal_detected", "instrument_class", *SQUEAL_MEASURES)
 _RESIDUAL = ("residual_lpaeq_dba", "residual_lpafmax_dba", "residual_tel_dba", "residual_mid_db", "baseline_mid_db",
              "drift_db", "excess_mid_db", "loudest_vehicle_id", "loudest_vehicle_excess_db")
@@ -137,10 +138,12 @@ def _run_of(path: Path, got: dict[str, list[Any]]) -> RunData:
                                         _RESIDUAL)
     for msg in got["rail_msgs/msg/SquealCalibration"]:  # one row per fit of each state
         for i, state in enumerate(msg.friction_state):
-            fit = run.squeal_fits.setdefault(state, {"stamp_ns": [], **{k: [] for k in _FIT}})
+            fit = run.squeal_fits.setdefault(state, {"stamp_ns": [], **{k: [] for k in _FIT + _FIT_WINDOW}})
             fit["stamp_ns"].append(time_ns(msg.header.stamp))
             for k in _FIT:
                 fit[k].append(getattr(msg, k)[i])
+            for k in _FIT_WINDOW:  # a bag of 0.26.0 has no windows: NaN
+                fit[k].append(getattr(msg, k)[i] if len(getattr(msg, k, ())) > i else np.nan)
     run.squeal_fits = {s: {k: np.array(v) for k, v in f.items()} for s, f in run.squeal_fits.items()}
     run.alerts = sorted((alert_from_msg(m) for m in al), key=lambda a: (a.stamp_ns, a.kind, a.key, a.active))
     run.advisory = advisories[-1] if advisories else None

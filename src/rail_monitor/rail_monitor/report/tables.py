@@ -161,8 +161,22 @@ def squeal_fits(fits: Mapping[str, Mapping[str, np.ndarray]], zone: str) -> list
                      "measured passes": passes,
                      "squealing, measured [%]": 100.0 * f["squealing_passes"][-1] / max(passes, 1),
                      "k1 configured": float(f["k1_configured"][-1]), "k1 P10 / P50 / P90": k1,
-                     "k2 configured": float(f["k2_configured"][-1]), "k2 P10 / P50 / P90": k2})
+                     "k2 configured": float(f["k2_configured"][-1]), "k2 P10 / P50 / P90": k2,
+                     **_share_checks(f)})
     return rows
+
+
+def _share_checks(f: Mapping[str, np.ndarray]) -> dict[str, str]:
+    """A state's fit windows with measured passes: how many had their measured squeal share outside
+    the share the model predicted before the fit (P10-P90), and the last one's."""
+    n = np.asarray(f["window_passes"], float)
+    judged = np.flatnonzero(n > 0)
+    if not len(judged):
+        return {"windows outside predicted P10-P90": "-", "last window: measured / predicted [%]": "-"}
+    share = np.asarray(f["window_squealing"], float)[judged] / n[judged]
+    lo, hi = (np.asarray(f[f"window_share_{p}"], float)[judged] for p in ("p10", "p90"))
+    return {"windows outside predicted P10-P90": f"{int(((share < lo) | (share > hi)).sum())} of {len(judged)}",
+            "last window: measured / predicted [%]": f"{100 * share[-1]:.1f} / {100 * lo[-1]:.1f}-{100 * hi[-1]:.1f}"}
 
 
 def repeat_squealers(alerts: list, zone: str) -> list[dict]:

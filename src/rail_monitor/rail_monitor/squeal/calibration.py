@@ -54,6 +54,7 @@ from rail_monitor.models import squeal
 from rail_monitor.models.squeal_balance import COARSE_BALANCE
 from rail_monitor.squeal.config import RISK_HIGH, RISK_MEDIUM, SquealConfig
 from rail_monitor.squeal.predict import WheelMode, level_and_risk, wheel_mode
+from rail_monitor.squeal.share_check import ShareCheck, share_quantiles
 
 GRID = 21             # points per parameter
 SPAN_SD = 3.0         # the grid's half-width [prior sd]
@@ -77,7 +78,8 @@ class FitConfig:
 def fit_config(cfg: SquealConfig, min_risk: int) -> FitConfig:
     """The fit of a site's squeal parameters (its ``squeal.fit_prior_*``), squealing counted from
     min_risk (the alerts' ``squeal_min_risk``, as a RISK_* value)."""
-    return FitConfig(prior_sd_peak=cfg.fit_prior_sd_peak, prior_sd_slope=cfg.fit_prior_sd_slope, min_risk=min_risk)
+    return FitConfig(prior_sd_peak=cfg.fit_prior_sd_peak, prior_sd_slope=cfg.fit_prior_sd_slope,
+                     flag_error=cfg.fit_flag_error, min_risk=min_risk)
 
 
 @dataclass(frozen=True)
@@ -157,8 +159,11 @@ class SquealFit:
         c = self.squeal_cfg
         return {RISK_MEDIUM: c.risk_medium_dba, RISK_HIGH: c.risk_high_dba}.get(self.cfg.min_risk, -np.inf)
 
-    def _log_likelihood(self, code: int, passes: PassTable, squealed: np.ndarray, level: np.ndarray) -> np.ndarray:
-        """The passes' log-likelihood on the state's grid (GRID, GRID); level at the model's receiver."""
+    def _log_likelihood(self, code: int, passes: PassTable, squealed: np.ndarray, level: np.ndarray,
+                        moments: np.ndarray | None = None) -> np.ndarray:
+        """The passes' log-likelihood on the state's grid (GRID, GRID); level at the model's receiver.
+        moments (2, GRID, GRID), if given, gains the sums over the passes of the chance p of a flag
+        and of p (1 - p) (squeal.share_check)."""
         eps, sd = self.cfg.flag_error, self.cfg.level_sd_db
         out = np.zeros((GRID, GRID))
         for lo in range(0, len(passes), CHUNK):
@@ -169,6 +174,8 @@ class SquealFit:
                 heard = ndtr((model_dba - self._threshold_dba()) / self.cfg.occurrence_sd_db)
             heard = np.where(np.isfinite(model_dba), np.nan_to_num(heard, nan=1.0), 0.0)
             p = eps + (1.0 - 2.0 * eps) * heard
+            if moments is not None:
+                moments += (p.sum(axis=0), (p * (1.0 - p)).sum(axis=0))
             ll = np.where(y, np.log(p), np.log1p(-p))
             measured = y & np.isfinite(level[part])[:, None, None]
             with np.errstate(invalid="ignore"):
@@ -178,22 +185,29 @@ class SquealFit:
             out += ll.sum(axis=0)
         return out
 
-    def observe(self, passes: PassTable, squealed: np.ndarray, level_db: np.ndarray, distance_m: np.ndarray) -> None:
+    def observe(self, passes: PassTable, squealed: np.ndarray, level_db: np.ndarray,
+                distance_m: np.ndarray) -> dict[int, ShareCheck]:
         """Take measured passes (valid, class defaults filled): whether each was flagged squealing,
-        its tone level [dB re 20 uPa] (NaN: not measured) at the microphone's distance [m]."""
+        its tone level [dB re 20 uPa] (NaN: not measured) at the microphone's distance [m]. Returns,
+        per state with passes, their share flagged and the share the posterior before them predicted."""
         squealed = np.asarray(squealed, bool)
         # The tone's level brought to the squeal model's receiver (a point source's spreading).
         level = np.asarray(level_db, float) + 20.0 * np.log10(np.asarray(distance_m, float)
                                                                / self.squeal_cfg.receiver_distance_m)
+        checks = {}
         for code in self.log_post:
             rows = np.flatnonzero(passes.friction_state == code)
             if not len(rows):
                 continue
             part = (passes.take(rows), squealed[rows], level[rows])
             self.kept[code].append(part)
-            self.log_post[code] += self._log_likelihood(code, *part)
+            moments, before = np.zeros((2, GRID, GRID)), self.weights(code)
+            self.log_post[code] += self._log_likelihood(code, *part, moments=moments)
+            flagged = int(squealed[rows].sum())
             self.seen[code][0] += len(rows)
-            self.seen[code][1] += int(squealed[rows].sum())
+            self.seen[code][1] += flagged
+            checks[code] = ShareCheck(len(rows), flagged, share_quantiles(before, *moments, len(rows)))
+        return checks
 
     def _merged(self, code: int) -> tuple[PassTable, np.ndarray, np.ndarray] | None:
         """The state's kept passes as one part (None: none)."""

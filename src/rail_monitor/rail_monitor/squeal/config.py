@@ -35,6 +35,9 @@ SQUEAL_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("fit_prior_sd_peak", 0.4, "Prior standard deviation of ln(k1 / the configured k1) [-].", 0.01, 3.0),
     ParamSpec("fit_prior_sd_slope", 0.05, "Prior standard deviation of k2 / k1 about the configured ratio [-].",
               0.001, 1.0),
+    ParamSpec("fit_flag_error", 0.05, "The station's squeal flag error: the chance that it flags a pass wrongly, "
+              "either way [-]. The fit's likelihood and the predicted share flagged take it; a station better than "
+              "this is heard squealing less than predicted on quiet states.", 0.0, 0.45),
 )
 
 
@@ -53,6 +56,7 @@ class SquealConfig:
     fit_window_passes: int
     fit_prior_sd_peak: float
     fit_prior_sd_slope: float
+    fit_flag_error: float
 
 
 def squeal_config(values: Mapping[str, Any], prefix: str = "squeal.") -> SquealConfig:
