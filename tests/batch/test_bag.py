@@ -111,3 +111,28 @@ def test_batch_applies_and_records_the_history_s_surveys_streamed_as_in_one_call
     plain = _messages(write_bag(run_models(read_bag_passes(bag), site_values), tmp_path / "plain", "curve_250"))
     assert plain["/curve_250/corrugation/state"][:800] == a["/curve_250/corrugation/state"][:800]
     assert plain["/curve_250/corrugation/state"][801] != a["/curve_250/corrugation/state"][801]
+
+
+def test_batch_records_the_history_s_applicator_events_and_leaves_out_a_bad_one(tmp_path, history, capsys):
+    """A history bag with a friction-modifier applicator's start and stop and one event of no known
+    action: rail-monitor batch records the two on friction_applicator (at their stamps, as the
+    replayer sends them), says the third was left out and why, and the report compares before and
+    after the start."""
+    from rail_monitor.bagio.reader import read_applicators
+    from rail_monitor.core.friction import ACTION_START, ACTION_STOP, ApplicatorEvent
+
+    passes, _ = history
+    t = passes.stamp_ns
+    good = [ApplicatorEvent(int(t[1000]) + 1, ACTION_START, "modifier A"), ApplicatorEvent(int(t[2500]) + 1,
+                                                                                         ACTION_STOP, "modifier A")]
+    bad = ApplicatorEvent(int(t[2000]), 9, "?")
+    bag = write_passes_bag(passes, tmp_path / "with_applicator", "curve_250", applicators=[good[0], bad, good[1]])
+    assert read_applicators(bag) == (good, {"action 9 is not start (1) or stop (2)": 1})
+    out = tmp_path / "out"
+    assert main(["batch", str(bag), "--output", str(out), "--chunk", "700"]) == 0
+    said = capsys.readouterr().out
+    assert "1 friction applicator event(s) of" in said and "left out: action 9 is not start (1) or stop (2)" in said
+    recorded = _messages(out)["/curve_250/friction_applicator"]
+    assert [stamp for stamp, _ in recorded] == [e.stamp_ns for e in good]
+    assert read_applicators(out) == (good, {})
+    assert "squeal before and after the applicator" in (tmp_path / "out_report" / "index.html").read_text()

@@ -27,6 +27,7 @@ from rail_monitor.bagio.reader import read_bag_passes, read_messages
 from rail_monitor.bagio.site_record import read_site_record
 from rail_monitor.batch.bag import write_bag
 from rail_monitor.batch.run import run_models
+from rail_monitor.core.friction import ACTION_START, ApplicatorEvent
 from rail_monitor.core.site import site_from_values
 from rail_monitor.corrugation.config import corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
@@ -100,6 +101,13 @@ def _measurements(events) -> list[Measurement]:
     absurd = replace(good[11], lpaeq_tp_dba=400.0)
     unknown = replace(good[12], train_id="NO-SUCH-TRAIN")
     return [*good[:10], nan_band, absurd, *good[12:], good[40], unknown]
+
+
+def _applicators() -> list[ApplicatorEvent]:
+    """A friction-modifier applicator started halfway through the slice (the report compares before
+    and after it; the replayer sends it, the recorder records it)."""
+    t = _slice().stamp_ns
+    return [ApplicatorEvent(int(t[0] + (t[-1] - t[0]) // 2) + 1, ACTION_START, "modifier under test")]
 
 
 def _events() -> list[MaintenanceEvent]:
@@ -200,7 +208,8 @@ def runs(tmp_path_factory) -> dict:
     live = tmp / "live"
     site = _site_file(tmp)
     measured = _measurements(_events())
-    history = write_passes_bag(_slice(), tmp / "history", "curve_250", events=_events(), measurements=measured)
+    history = write_passes_bag(_slice(), tmp / "history", "curve_250", events=_events(), measurements=measured,
+                               applicators=_applicators())
     r = run_cmd("rail-monitor", "monitor", str(history), "--site", str(site), "--output", str(live),
                 "--end-offset-s", str(DAYS * 86400), "--report", str(tmp / "live_report"), "--no-progress", timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
@@ -227,6 +236,8 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
     # the history's surveys and grinding reached the state: recorded, K_b re-fitted, the grinding reset
     surveys = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/RoughnessSurvey"])["rail_msgs/msg/RoughnessSurvey"]
     assert [time_ns(m.header.stamp) for m in surveys] == [e.stamp_ns for e in _events()]
+    # and the applicator's start, sent by the replayer as the history had it
+    assert live.applicator == _applicators()
     states = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/CorrugationState"])["rail_msgs/msg/CorrugationState"]
     # and each day's indirect roughness too, taken as an observation (re-fitting K_b where the state
     # grew since the last survey or observation)
@@ -256,6 +267,7 @@ def test_report_folder_has_images_and_a_page(runs):
         assert f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and f.stat().st_size > 10_000
     page = (runs["report"] / "index.html").read_text()
     assert all(f'src="{f.name}"' in page for f in pngs) and "squeal" in page
+    assert "squeal before and after the applicator" in page
 
 
 def test_live_graph_equals_batch(runs):

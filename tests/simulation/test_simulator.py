@@ -12,7 +12,7 @@ from rail_monitor.core.passes import (
 )
 from rail_monitor.core.simulator_params import simulator_config
 from rail_monitor.core.timeutil import NS_PER_S
-from rail_monitor.simulation.simulator import simulate
+from rail_monitor.simulation.simulator import applicator_events, simulate
 
 
 def _sim(site, values, **over):
@@ -63,3 +63,20 @@ def test_friction_process(site, site_values):
     assert not np.any(t.friction_state[day < 29.9] == FRICTION_CONTAMINATED)
     wet = np.mean(t.friction_state == FRICTION_WET)
     assert 0.05 < wet < 0.30  # long-run 15 % wet hours, less where contamination takes precedence
+
+
+def test_the_applicator_s_start_and_stop_are_the_history_s_events(site_values):
+    """The friction modifier's service days as the applicator's events: a start on day 45 (no pass on
+    the modifier before it), a stop only where service ends inside the history, none where it starts
+    after the history's end or never."""
+    from rail_monitor.core.friction import ACTION_START, ACTION_STOP
+    from rail_monitor.core.timeutil import NS_PER_DAY
+
+    cfg = simulator_config({**site_values, "simulator.days": 90.0})
+    start, = applicator_events(cfg)
+    assert (start.action, start.stamp_ns) == (ACTION_START, cfg.start_ns + 45 * NS_PER_DAY)
+    ended = applicator_events(simulator_config({**site_values, "simulator.friction_modifier_end_day": 60.0}))
+    assert [(e.action, e.stamp_ns - cfg.start_ns) for e in ended] == [(ACTION_START, 45 * NS_PER_DAY),
+                                                                     (ACTION_STOP, 60 * NS_PER_DAY)]
+    for over in ({"simulator.days": 30.0}, {"simulator.friction_modifier_start_day": -1.0}):
+        assert applicator_events(simulator_config({**site_values, **over})) == []

@@ -15,13 +15,21 @@ from typing import Any
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.integrity import Claims, ScannedMessage, check_bag, scan_mcap
-from rail_monitor.codec.typestore import MEASURED_PASS_NOISE, ROUGHNESS_SURVEY, TRAIN_PASS, typestore
+from rail_monitor.codec.typestore import (
+    FRICTION_APPLICATOR,
+    MEASURED_PASS_NOISE,
+    ROUGHNESS_SURVEY,
+    TRAIN_PASS,
+    typestore,
+)
 from rail_monitor.core.errors import InputError, RailMonitorError
+from rail_monitor.core.friction import ApplicatorEvent, applicator_refusal
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.user_file import regular_file
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
 from rail_monitor.measured.records import Measurement
-from rail_monitor.messages.fields import event_from_msg, measurement_from_msg, pass_row
+from rail_monitor.messages.event_fields import applicator_from_msg, event_from_msg
+from rail_monitor.messages.fields import measurement_from_msg, pass_row
 
 
 def _one_line(exc: BaseException) -> str:
@@ -227,6 +235,17 @@ def read_history_inputs(source: str | Path, measured: str | Path | None = None, 
                              "measure roughness --survey-bag writes one)")
         events += found
     return in_time_order(events), read_measurements(measured, skip_bad_rows) if measured else own
+
+
+def read_applicators(path: str | Path, salvage: bool = False) -> tuple[list[ApplicatorEvent], dict[str, int]]:
+    """A history bag's friction-modifier applicator starts and stops (rail_msgs/FrictionApplicator,
+    any topic) in stamp order, and those refused, counted by reason; none for a CSV history or a
+    salvage (which recovers passes only)."""
+    if salvage or is_csv(Path(path)):
+        return [], {}
+    events = [applicator_from_msg(m) for m in read_messages(path, [FRICTION_APPLICATOR]).get(FRICTION_APPLICATOR, ())]
+    refused = Counter(why for why in map(applicator_refusal, events) if why)
+    return sorted((e for e in events if not applicator_refusal(e)), key=lambda e: e.stamp_ns), dict(refused)
 
 
 def read_passes(path: str | Path, topic: str | None = None, skip_bad_rows: bool = False,

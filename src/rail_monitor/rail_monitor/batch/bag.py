@@ -16,6 +16,7 @@ from rail_monitor.bagio.output_folder import Claim, claim_output_folder
 from rail_monitor.bagio.site_record import SITE_RECORD, custom_data
 from rail_monitor.codec.cdr_from_columns import serialize_columns
 from rail_monitor.core.errors import PassOrderError
+from rail_monitor.core.friction import ApplicatorEvent
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.text import printable
 from rail_monitor.corrugation.surveys import MaintenanceEvent
@@ -23,7 +24,7 @@ from rail_monitor.engine.result import SiteOutputs
 from rail_monitor.engine.site import SiteEngine
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual
-from rail_monitor.messages import fields, outputs
+from rail_monitor.messages import event_fields, fields, outputs
 from rail_monitor.messages.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
 
 
@@ -63,7 +64,13 @@ class BatchBag:
     def events(self, events: list[MaintenanceEvent]) -> None:
         """Surveys and grinding events given to the run, on the topic the replayer sends them on."""
         for event in events:
-            self._put("roughness_survey", fields.roughness_survey_fields(event, self.frame), event.stamp_ns)
+            self._put("roughness_survey", event_fields.roughness_survey_fields(event, self.frame), event.stamp_ns)
+
+    def applicators(self, events: Sequence[ApplicatorEvent]) -> None:
+        """A friction-modifier applicator's starts and stops, on the topic the replayer sends them on
+        (the models do not take them; the report does)."""
+        for e in events:
+            self._put("friction_applicator", event_fields.friction_applicator_fields(e, self.frame), e.stamp_ns)
 
     def measured(self, measurements: list[Measurement], residuals: list[Residual]) -> None:
         """Measurements given to the run (as the replayer sends them) and the residuals computed."""
@@ -99,9 +106,11 @@ class BatchBag:
 
 
 def write_bag(result: SiteOutputs, folder: str | Path, namespace: str, compression: str = "zstd",
-              site: dict[str, str] | None = None) -> Path:
-    """Record a whole history's outputs (run_models) in a new bag folder."""
+              site: dict[str, str] | None = None, applicators: Sequence[ApplicatorEvent] = ()) -> Path:
+    """Record a whole history's outputs (run_models) in a new bag folder, with the history's
+    applicator starts and stops."""
     with BatchBag(folder, namespace, result.site.site_id, compression, site) as bag:
+        bag.applicators(applicators)
         bag.add(result)  # its events include those after the last pass (run_models)
         bag.finish([], result.advice, result.estimator.newest_ns)
     return Path(folder)
@@ -128,13 +137,16 @@ class Recorded:
 
 def run_to_bag(chunks: Iterable[PassTable], values: Mapping[str, Any], folder: str | Path, namespace: str,
                site: dict[str, str] | None = None, events: Sequence[MaintenanceEvent] = (),
-               measurements: Sequence[Measurement] = (), claim: Claim | None = None) -> Recorded:
+               measurements: Sequence[Measurement] = (), claim: Claim | None = None,
+               applicators: Sequence[ApplicatorEvent] = ()) -> Recorded:
     """SiteEngine over an iterable of PassTable chunks in time order (and the history's surveys and
     grinding events, and its measured pass-bys), each recorded as it is done (memory: one chunk's
-    outputs). claim: the folder, claimed already (else claimed here)."""
+    outputs), with the history's applicator starts and stops. claim: the folder, claimed already
+    (else claimed here)."""
     run = SiteEngine(values, events=events, measurements=measurements)
     out = Recorded()
     with BatchBag(folder, namespace, run.site.site_id, site=site, claim=claim) as bag:
+        bag.applicators(applicators)
         for chunk in chunks:
             result = run.feed(chunk)
             bag.add(result)
@@ -164,23 +176,28 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
     by chunk (memory flat in its length); a CSV, a salvaged bag, or a bag whose passes are not in
     time order is read whole and sorted. Its measured pass-bys are measured's (a noise station's
     CSV or a bag), else a bag history's own; its surveys and grinding events the history bag's own
-    with those of the bags ``surveys``. A run that fails leaves no output behind."""
-    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_history_inputs
+    with those of the bags ``surveys``; its applicator starts and stops the history bag's own. A run
+    that fails leaves no output behind."""
+    from rail_monitor.bagio.reader import is_csv, iter_bag_passes, read_applicators, read_history_inputs
 
     claim = claim_output_folder(folder)  # atomic: two runs never write one folder
     try:
         events, ms = read_history_inputs(source, measured, skip_bad_rows, salvage, surveys)
+        applicators, refused = read_applicators(source, salvage)
+        notes = [f"{n} friction applicator event(s) of {printable(str(source))} left out: {why}"
+                 for why, n in sorted(refused.items())]
         if not (salvage or is_csv(Path(source))):
             try:
-                return run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms,
-                                  claim)
-            except PassOrderError as exc:
-                note = f"{printable(str(source))}: {exc}; read whole to sort it"
-                claim.empty()
-                rec = _whole(source, values, claim, namespace, site, topic, skip_bad_rows, salvage, events, ms)
-                rec.notes.insert(0, note)
+                rec = run_to_bag(iter_bag_passes(source, topic, chunk), values, folder, namespace, site, events, ms,
+                                 claim, applicators)
+                rec.notes[:0] = notes
                 return rec
-        return _whole(source, values, claim, namespace, site, topic, skip_bad_rows, salvage, events, ms)
+            except PassOrderError as exc:
+                notes.insert(0, f"{printable(str(source))}: {exc}; read whole to sort it")
+                claim.empty()
+        rec = _whole(source, values, claim, namespace, site, topic, skip_bad_rows, salvage, events, ms, applicators)
+        rec.notes[:0] = notes
+        return rec
     except BaseException:
         claim.release()  # what this run claimed and wrote, proven by its claim; nothing else
         raise
@@ -188,7 +205,8 @@ def record_history(source: str | Path, values: Mapping[str, Any], folder: Path, 
 
 def _whole(source: str | Path, values: Mapping[str, Any], claim: Claim, namespace: str,
            site: dict[str, str] | None, topic: str | None, skip_bad_rows: bool, salvage: bool,
-           events: list[MaintenanceEvent], measured: list[Measurement]) -> Recorded:
+           events: list[MaintenanceEvent], measured: list[Measurement],
+           applicators: Sequence[ApplicatorEvent]) -> Recorded:
     from rail_monitor.bagio.reader import read_passes_reported
 
     passes, report = read_passes_reported(source, topic, skip_bad_rows=skip_bad_rows, salvage=salvage)
@@ -198,6 +216,6 @@ def _whole(source: str | Path, values: Mapping[str, Any], claim: Claim, namespac
     if skipped:
         notes.append(f"{len(skipped)} malformed row(s) of {printable(str(source))} left out: "
                      + "; ".join(printable(s) for s in skipped[:5]) + ("; ..." if len(skipped) > 5 else ""))
-    rec = run_to_bag([passes], values, claim.folder, namespace, site, events, measured, claim)
+    rec = run_to_bag([passes], values, claim.folder, namespace, site, events, measured, claim, applicators)
     rec.notes = notes
     return rec

@@ -42,7 +42,7 @@ def run(ns: argparse.Namespace) -> int:
     from rail_monitor.bagio.passes_bag import write_passes_bag
     from rail_monitor.core.simulator_params import simulator_config
     from rail_monitor.core.site import site_from_values
-    from rail_monitor.simulation.simulator import simulate
+    from rail_monitor.simulation.simulator import applicator_events, simulate
 
     values = site_values(ns.site)
     if ns.days is not None:
@@ -50,7 +50,8 @@ def run(ns: argparse.Namespace) -> int:
     if ns.seed is not None:
         values["simulator.seed"] = ns.seed
     site = site_from_values(values)
-    table = simulate(site, simulator_config(values))
+    cfg = simulator_config(values)
+    table = simulate(site, cfg)
     if not ns.out and not ns.csv:
         raise RailMonitorError("give --out BAG and/or --csv FILE")
     if ns.k_b_factor <= 0 or ns.surveys_every_days < 0:
@@ -60,9 +61,10 @@ def run(ns: argparse.Namespace) -> int:
     events, measured = _measured_site(ns, values, site, table)
     if ns.out:
         fresh_output(Path(ns.out), ns.force)
-        write_passes_bag(table, ns.out, site.site_id, events=events, measurements=measured)
-        print(f"wrote {len(table)} passes, {len(events)} surveys and {len(measured)} measured pass-bys to bag "
-              f"{ns.out}")
+        applicators = applicator_events(cfg)
+        write_passes_bag(table, ns.out, site.site_id, events=events, measurements=measured, applicators=applicators)
+        print(f"wrote {len(table)} passes, {len(events)} surveys, {len(measured)} measured pass-bys and "
+              f"{len(applicators)} friction applicator events to bag {ns.out}")
     if ns.csv:
         write_csv(table, ns.csv)
         print(f"wrote {len(table)} passes to {ns.csv}")

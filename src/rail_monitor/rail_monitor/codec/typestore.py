@@ -27,6 +27,7 @@ CORRUGATION_STATE = "rail_msgs/msg/CorrugationState"
 ROLLING_NOISE = "rail_msgs/msg/RollingNoise"
 ROUGHNESS_SURVEY = "rail_msgs/msg/RoughnessSurvey"
 MEASURED_PASS_NOISE = "rail_msgs/msg/MeasuredPassNoise"
+FRICTION_APPLICATOR = "rail_msgs/msg/FrictionApplicator"
 
 
 SHIPPED_MSG = Path(__file__).parent.parent / "msg"  # rail_msgs' .msg files, package data

@@ -26,7 +26,6 @@ from rail_monitor.core.friction import FRICTION_NAMES
 from rail_monitor.core.passes import PassTable
 from rail_monitor.core.timeutil import NS_PER_S, TIME_MSG_END_NS, from_sec_nanosec, to_sec_nanosec
 from rail_monitor.corrugation.records import Forecast, StateSnapshot, Trajectory
-from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import SQUEAL_MEASURES, Measurement
 from rail_monitor.measured.residuals import Residual
 from rail_monitor.noise.records import NoisePrediction
@@ -259,12 +258,6 @@ def wayside_alert_array_fields(alerts: list[Alert], stamp_ns: int, frame_id: str
     return {"header": header_fields(stamp_ns, frame_id), "alerts": [wayside_alert_fields(a, frame_id) for a in alerts]}
 
 
-def roughness_survey_fields(event: MaintenanceEvent, frame_id: str) -> Fields:
-    return {"header": header_fields(event.stamp_ns, frame_id), "kind": event.kind,
-            "wavelength_m": np.asarray(event.wavelength_m, float).tolist(),
-            "amplitude_m": np.asarray(event.amplitude_m, float).tolist()}
-
-
 def indirect_roughness_fields(obs: Observation, frame_id: str) -> Fields:
     ind = obs.indirect
     return {"header": header_fields(obs.stamp_ns, frame_id), "window_days": obs.window_days,
@@ -326,12 +319,6 @@ def residual_from_msg(msg: Any) -> Residual:
     values.update(band_centre_hz=np.array(msg.band_centre_hz, float), residual_db=np.array(msg.residual_db, float),
                   vehicle_id=tuple(msg.vehicle_id))
     return Residual(stamp_ns=time_ns(msg.header.stamp), **values)
-
-
-def event_from_msg(msg: Any) -> MaintenanceEvent:
-    """A RoughnessSurvey as a MaintenanceEvent (its checks are apply_event's)."""
-    return MaintenanceEvent(time_ns(msg.header.stamp), int(msg.kind), np.array(msg.wavelength_m, float),
-                            np.array(msg.amplitude_m, float))
 
 
 def alert_from_msg(msg: Any) -> Alert:

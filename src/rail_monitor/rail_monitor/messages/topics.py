@@ -84,4 +84,7 @@ OPTIONAL_TOPICS: dict[str, tuple[str, Qos]] = {
     # A model output like the others (latched): a recorder that matched a moment late lost one.
     "corrugation/indirect_roughness": ("rail_msgs/msg/IndirectRoughness", STREAM),
     # Each fit of the squeal model to the measured squeal (latched, as every model output).
-    "noise/squeal_calibration": ("rail_msgs/msg/SquealCalibration", STREAM)}
+    "noise/squeal_calibration": ("rail_msgs/msg/SquealCalibration", STREAM),
+    # A friction-modifier applicator's start or stop: a site event for the record (no model takes
+    # it), latched so that a recorder that matches late still records it.
+    "friction_applicator": ("rail_msgs/msg/FrictionApplicator", STREAM)}

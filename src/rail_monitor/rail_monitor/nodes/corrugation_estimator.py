@@ -39,10 +39,10 @@ from rail_monitor.engine import checkpoint
 from rail_monitor.engine.corrugation_site import CorrugationSite
 from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
 from rail_monitor.measured.observer import IndirectObserver, Observation
+from rail_monitor.messages.event_fields import event_from_msg
 from rail_monitor.messages.fields import (
     PassHead,
     corrugation_state_cdr,
-    event_from_msg,
     indirect_roughness_fields,
     measurement_from_msg,
 )

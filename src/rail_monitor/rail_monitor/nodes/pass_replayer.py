@@ -2,7 +2,8 @@
 
 Publishes ``train_pass`` (rail_msgs/TrainPass), the bag's roughness surveys and grinding events
 on ``roughness_survey`` (each just before the first pass stamped later than it), its measured
-pass-bys on ``noise/measured`` (each after its pass), and ``/clock``;
+pass-bys on ``noise/measured`` (each after its pass), its friction-modifier applicator's starts and
+stops on ``friction_applicator`` (as surveys; a refused one is logged), and ``/clock``;
 exits 0 when done. See
 rail_monitor.core.node_params.PUBLISH_SPECS for timing, offsets and flow control.
 """
@@ -11,8 +12,9 @@ from __future__ import annotations
 
 import sys
 
-from rail_monitor.bagio.reader import read_history_inputs, read_passes_reported
+from rail_monitor.bagio.reader import read_applicators, read_history_inputs, read_passes_reported
 from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.friction import ApplicatorEvent
 from rail_monitor.core.node_params import REPLAYER_SPECS, ReplayerParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
@@ -37,8 +39,13 @@ class PassReplayer(PassSourceNode):
         self._events, self._measured = read_history_inputs(self.src.source, self.src.measured_source or None,
                                                            self.src.skip_bad_rows, self.src.salvage,
                                                            [p for p in self.src.surveys_source if p])
+        self._applicators, refused = read_applicators(self.src.source, self.src.salvage)
+        for why, n in sorted(refused.items()):
+            self.get_logger().warning(f"{self.src.source}: {n} friction applicator event(s) left out: {why}")
         if self._events:
             self.advertise_events()
+        if self._applicators:
+            self.advertise_applicators()
         if self._measured:
             self.advertise_measurements()
 
@@ -57,6 +64,9 @@ class PassReplayer(PassSourceNode):
 
     def events(self) -> list[MaintenanceEvent]:
         return self._events
+
+    def applicators(self) -> list[ApplicatorEvent]:
+        return self._applicators
 
     def measurements(self) -> list[Measurement]:
         return self._measured

@@ -17,18 +17,20 @@ from rosgraph_msgs.msg import Clock
 from tqdm import tqdm
 
 from rail_monitor.core.errors import RailMonitorError
+from rail_monitor.core.friction import ApplicatorEvent
 from rail_monitor.core.node_params import PUBLISH_SPECS, STAMP_SPECS, PublishParams, StampParams
 from rail_monitor.core.params import ParamGroups, values_of
 from rail_monitor.core.passes import PassTable, publishable
 from rail_monitor.core.timeutil import NS_PER_S
 from rail_monitor.corrugation.surveys import MaintenanceEvent
 from rail_monitor.measured.records import Measurement
-from rail_monitor.messages.fields import measured_pass_noise_fields, roughness_survey_fields, train_pass_columns
+from rail_monitor.messages.event_fields import friction_applicator_fields, roughness_survey_fields
+from rail_monitor.messages.fields import measured_pass_noise_fields, train_pass_columns
 from rail_monitor.messages.topics import DIAGNOSTICS_TOPIC
 from rail_monitor.nodes.base import DIAGNOSTICS_PERIOD_S, Diagnostics, RailNode, RateMeter, announce, declare
 from rail_monitor.nodes.convert import time_msg, to_cdr, to_cdr_many
 from rail_monitor.nodes.qos import CLOCK_QOS, DIAGNOSTICS_QOS, EVENT_QOS, STREAM_QOS
-from rail_msgs.msg import MeasuredPassNoise, RoughnessSurvey, TrainPass
+from rail_msgs.msg import FrictionApplicator, MeasuredPassNoise, RoughnessSurvey, TrainPass
 
 GRAPH_SETTLE_S = 1.0  # the graph's endpoints unchanged this long [s]: every node has subscribed
 CDR_BLOCK = 4096  # passes whose TrainPass bytes are written together from the table's columns
@@ -58,12 +60,15 @@ class PassSourceNode(RailNode):
         self.events_sent = 0
         self.measured_pub = None  # noise/measured, made when the history has measured pass-bys
         self.measurements_sent = 0
+        self.applicator_pub = None  # friction_applicator, made when the history has applicator events
+        self.applicator_sent = 0
         self._bounds = (0, 0)  # stamps of the replay window [ns]
         self._status: dict[str, dict[str, str]] = {}  # latest /diagnostics values, by status name
         self.create_subscription(DiagnosticArray, DIAGNOSTICS_TOPIC, self._on_diagnostics, DIAGNOSTICS_QOS)
         Diagnostics(self, lambda: {"published": self.meter.count, "total": self.total,
                                    "left out": sum(self.left_out.values()), "surveys sent": self.events_sent,
                                    "measurements sent": self.measurements_sent,
+                                   "applicator events sent": self.applicator_sent,
                                    **{f"left out: {why}": n for why, n in self.left_out.items()},
                                    "rate_per_s": f"{self.meter.rate():.1f}",
                                    "pass_time_ns": self.last_stamp_ns, "done": self.done.is_set()})
@@ -78,6 +83,10 @@ class PassSourceNode(RailNode):
 
     def measurements(self) -> list[Measurement]:
         """The measured pass-bys of the history, in stamp order (none by default)."""
+        return []
+
+    def applicators(self) -> list[ApplicatorEvent]:
+        """The friction-modifier applicator's starts and stops, in stamp order (none by default)."""
         return []
 
     def _window(self, table: PassTable) -> PassTable:
@@ -105,6 +114,11 @@ class PassSourceNode(RailNode):
         if self.measured_pub is None:
             self.measured_pub = self.create_publisher(MeasuredPassNoise, "noise/measured", STREAM_QOS)
 
+    def advertise_applicators(self) -> None:
+        """Create the friction_applicator publisher (as advertise_events)."""
+        if self.applicator_pub is None:
+            self.applicator_pub = self.create_publisher(FrictionApplicator, "friction_applicator", STREAM_QOS)
+
     def _send_event(self, event: MaintenanceEvent, ok: Callable[[], bool]) -> None:
         """Publish a survey or grinding event. In other processes, wait until every subscriber holds
         it before the next pass goes out (the estimator takes queued surveys before passes); in
@@ -120,6 +134,13 @@ class PassSourceNode(RailNode):
         self.measured_pub.publish(to_cdr(MeasuredPassNoise, measured_pass_noise_fields(m, self.cfg.site_id)))
         self.measurements_sent += 1
         self._acknowledged(self.measured_pub, ok)
+
+    def _send_applicator(self, event: ApplicatorEvent, ok: Callable[[], bool]) -> None:
+        """Publish an applicator's start or stop (for the recorder: no model takes it; latched, so a
+        recorder matching late gets it), held by the subscribers present before the next pass."""
+        self.applicator_pub.publish(to_cdr(FrictionApplicator, friction_applicator_fields(event, self.cfg.site_id)))
+        self.applicator_sent += 1
+        self._acknowledged(self.applicator_pub, ok)
 
     def _acknowledged(self, pub, ok: Callable[[], bool]) -> None:
         """In other processes, wait until every subscriber of pub holds what it sent (at most
@@ -240,6 +261,9 @@ class PassSourceNode(RailNode):
         measured = [m for m in self.measurements() if lo <= m.stamp_ns <= hi] if len(table) else []
         if measured:
             self.advertise_measurements()
+        applicator = [e for e in self.applicators() if lo <= e.stamp_ns <= hi] if len(table) else []
+        if applicator:
+            self.advertise_applicators()
         announce(self, site=self.cfg.site_id, passes=len(table), surveys=len(events), measured=len(measured),
                  rate=f"{self.cfg.rate:g}", wait_for_subscribers=self.cfg.wait_for_subscribers)
         self._wait_for_subscribers(ok)
@@ -266,6 +290,8 @@ class PassSourceNode(RailNode):
                 self._publish_clock(stamp)
                 while events and events[0].stamp_ns < stamp:  # before the first pass later than it
                     self._send_event(events.pop(0), ok)
+                while applicator and applicator[0].stamp_ns < stamp:
+                    self._send_applicator(applicator.pop(0), ok)
                 while measured and measured[0].stamp_ns < stamp:  # after its own pass
                     self._send_measurement(measured.pop(0), ok)
                 if i % CDR_BLOCK == 0:  # the passes' CDR from their columns, a block at a time
@@ -279,6 +305,8 @@ class PassSourceNode(RailNode):
                     self._throttle(i + 1, ok)
             for event in events if ok() else []:
                 self._send_event(event, ok)
+            for event in applicator if ok() else []:
+                self._send_applicator(event, ok)
             for m in measured if ok() else []:
                 self._send_measurement(m, ok)
             self._throttle(self.meter.count, ok)

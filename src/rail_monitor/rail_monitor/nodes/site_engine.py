@@ -42,8 +42,8 @@ from rail_monitor.measured.config import RESIDUAL_SPECS
 from rail_monitor.measured.records import Measurement
 from rail_monitor.measured.residuals import Residual
 from rail_monitor.messages import outputs
+from rail_monitor.messages.event_fields import event_from_msg
 from rail_monitor.messages.fields import (
-    event_from_msg,
     measurement_from_msg,
     passes_from_columns,
     wayside_alert_array_fields,

@@ -18,10 +18,10 @@ import numpy as np
 
 from rail_monitor import __version__
 from rail_monitor.alerts.config import KIND_NAMES
-from rail_monitor.core.friction import FRICTION_MODIFIER, FRICTION_NAMES
 from rail_monitor.core.text import jsonable, printable
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
 from rail_monitor.engine.site_config import SiteConfig
+from rail_monitor.report import friction_modifier
 from rail_monitor.report import plots as report_plots
 from rail_monitor.report import tables as report_tables
 from rail_monitor.report.run_data import RunData
@@ -93,28 +93,10 @@ def headline(run: RunData, t: Mapping[str, np.ndarray], lim: Mapping[str, Any], 
                            "days": worst["days"], "date": worst["date"],
                            "date_range": worst["date range (traffic P90-P10)"],
                            "due": bool(run.states["grinding_due"][-1])}
-    rows = {r["friction state"]: r for r in tables["friction"]}
-    if rows:
-        on = rows.pop(FRICTION_NAMES[FRICTION_MODIFIER])
-        off = [r for r in rows.values()]
-        n = sum(r["passes"] for r in off)
-        cuts = [(r["passes"], r["friction-modifier cut, predicted, mean of squealing [dB(A)]"]) for r in off]
-        cuts = [(k, c) for k, c in cuts if np.isfinite(c)]
-        out["friction_modifier"] = {
-            "compared": "friction states (no applicator start in the bag)",
-            "on_squealing_percent": on["squealing, predicted [%]"],
-            "off_squealing_percent": sum(r["passes"] * r["squealing, predicted [%]"] for r in off) / n,
-            "on_measured_percent": on.get("squealing, measured [%]"),
-            "off_measured_percent": _pooled(off, "squealing, measured [%]"),
-            "predicted_cut_dba": sum(k * c for k, c in cuts) / sum(k for k, _ in cuts) if cuts else None,
-            "published_cut_dba": list(report_tables.FM_CUT_PUBLISHED_DBA)}
+    fm = friction_modifier.summary(tables["friction"], tables.get("applicator", []), run.applicator, zone)
+    if fm:
+        out["friction_modifier"] = fm
     return out
-
-
-def _pooled(rows: list[dict], key: str) -> float | None:
-    """A share [%] pooled over rows by their passes (None where no row has it)."""
-    have = [(r["passes"], r[key]) for r in rows if np.isfinite(r.get(key, np.nan))]
-    return sum(k * v for k, v in have) / sum(k for k, _ in have) if have else None
 
 
 def _headline_lines(h: Mapping[str, Any], lim: Mapping[str, Any]) -> list[str]:
@@ -133,17 +115,8 @@ def _headline_lines(h: Mapping[str, Any], lim: Mapping[str, Any]) -> list[str]:
         lines.append(f"Noise ({n['model']} model, {n['metric']}): median {n['P50 [dB(A)]']:.1f}, P95 "
                      f"{n['P95 [dB(A)]']:.1f} dB(A) against the limit of {n['limit [dB(A)]']:g} dB(A); "
                      f"{n['above limit [%]']:.1f} % of passes above it.")
-    fm = h.get("friction_modifier")
-    if fm:
-        heard = (f"; the station heard {fm['on_measured_percent']:.1f} % against {fm['off_measured_percent']:.1f} %"
-                 if fm["on_measured_percent"] is not None and fm["off_measured_percent"] is not None
-                 and np.isfinite(fm["on_measured_percent"]) else "")
-        cut = (f"; on the squealing passes the model predicts a cut of {fm['predicted_cut_dba']:.1f} dB(A) (published: "
-               f"{fm['published_cut_dba'][0]:g}-{fm['published_cut_dba'][1]:g} dB(A))" if fm["predicted_cut_dba"]
-               is not None else "")
-        lines.append(f"Friction modifier, friction states compared (the bag holds no applicator start): "
-                     f"{fm['on_squealing_percent']:.1f} % of passes on the modifier squeal against "
-                     f"{fm['off_squealing_percent']:.1f} % on the other states{heard}{cut}.")
+    if h.get("friction_modifier"):
+        lines.append(friction_modifier.headline_line(h["friction_modifier"]))
     lines.append(f"Alerts raised: {h['alerts_raised']}.")
     return lines
 
@@ -165,12 +138,13 @@ def write_report(run: RunData, cfg: SiteConfig, out: Path, figures_extra: Mappin
     tables = {"outlook": report_tables.grinding_outlook(run, t, zone),
               "noise": report_tables.noise_percentiles(t, lim, models),
               "classes": report_tables.by_class(t, lim, models),
-              "friction": report_tables.friction_comparison(t, lim),
+              "applicator": friction_modifier.before_after(t, lim, run.applicator),
               "squealers": report_tables.squealing_trains(t, lim), "advice": report_tables.speed_advice(run),
               "offenders": report_tables.repeat_offenders(t, cfg, zone),
               "squeal_angles": report_tables.squeal_by_angle(t, lim),
               "repeat_squealers": report_tables.repeat_squealers(run.alerts, zone),
               "squeal_fits": report_tables.squeal_fits(run.squeal_fits, zone)}
+    tables["friction"] = [] if tables["applicator"] else friction_modifier.by_state(t, lim)
     head = headline(run, t, lim, tables, zone)
     figures = [("timeline", "Passes and squealing passes per day, and the day's highest pass-by level against "
                 "the limit.", report_plots.timeline(report_tables.daily(t, lim, models, zone), models, lim, zone))]
@@ -236,6 +210,9 @@ def _pdf_text_pages(head, tables, lim, meta, run) -> list:
     lines += ["", "Grinding outlook per band:", *_text_table(tables["outlook"], 8)]
     if tables["friction"]:
         lines += ["", "Friction modifier, squeal per friction state:", *_text_table(tables["friction"])]
+    if tables["applicator"]:
+        lines += ["", "Friction modifier, before and after the applicator's start:",
+                  *_text_table(tables["applicator"])]
     if tables["advice"]:
         lines += ["", "Speed advice per class (at its recent mean speed):", *_text_table(tables["advice"])]
     lines += ["", f"Loudest squealing trains (of {len(tables['squealers'])}, all in squealing_trains.csv):"]
@@ -292,6 +269,13 @@ def _html(run, values, head, tables, lim, figures, meta, listen=()) -> str:
                 "bag holds no such event). The cut is the model's, on the squealing passes of each state; "
                 "Eadie &amp; Santoro (2006) measured 6.3-22.8 dB(A) at transit curves.</p>"
                 if tables["friction"] else "")
+    if tables["applicator"]:
+        friction = (f"<h2>Friction modifier: squeal before and after the applicator's start</h2>"
+                    f"{_html_table(tables['applicator'])}<p class=\"meta\">Every pass before the applicator's first "
+                    "start against every pass after it (to its next stop), whatever friction state each records. "
+                    "Levels are energy means over all passes of a side (a quiet pass at the model's background) "
+                    "and over its loudest passes, as many as squealed before the start; Eadie &amp; Santoro "
+                    "(2006) measured cuts of 6.3-22.8 dB(A) at transit curves.</p>")
     measured = (f"<h2>Measured noise: wheel-defect suspects (repeat offenders)</h2>"
                 f"{_html_table(tables['offenders'], 25)}{fig('measured')}" if "measured" in figs else "")
     if tables["squeal_angles"]:

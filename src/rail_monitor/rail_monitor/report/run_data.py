@@ -15,12 +15,14 @@ import numpy as np
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.bagio.reader import iter_messages, read_messages
 from rail_monitor.core.errors import InputError, RailMonitorError
+from rail_monitor.core.friction import ApplicatorEvent, applicator_refusal
 from rail_monitor.core.passes import PassTable
 from rail_monitor.measured.records import SQUEAL_MEASURES
+from rail_monitor.messages.event_fields import applicator_from_msg
 from rail_monitor.messages.fields import alert_from_msg, pass_row, time_ns
 
 _TYPES = ("TrainPass", "SquealPrediction", "CorrugationState", "RollingNoise", "WaysideAlert", "SpeedAdvisory",
-          "MeasuredPassNoise", "NoiseResidual", "SquealCalibration")
+          "MeasuredPassNoise", "NoiseResidual", "SquealCalibration", "FrictionApplicator")
 _FIT = ("k1_configured", "k2_configured", "k1_p10", "k1_p50", "k1_p90", "k2_p10", "k2_p50", "k2_p90",
         "measured_passes", "squealing_passes")
 _FIT_WINDOW = ("window_passes", "window_squealing", "window_share_p10", "window_share_p50", "window_share_p90")
@@ -46,6 +48,7 @@ class RunData:
     measured: dict[str, np.ndarray] = field(default_factory=dict)               # MeasuredPassNoise fields
     residuals: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)   # NoiseResidual fields, by model
     squeal_fits: dict[str, dict[str, np.ndarray]] = field(default_factory=dict)  # SquealCalibration, by state
+    applicator: list[ApplicatorEvent] = field(default_factory=list)  # FrictionApplicator, in stamp order
 
 
 def load_run(bag: str | Path) -> RunData:
@@ -145,6 +148,8 @@ def _run_of(path: Path, got: dict[str, list[Any]]) -> RunData:
             for k in _FIT_WINDOW:  # a bag of 0.26.0 has no windows: NaN
                 fit[k].append(getattr(msg, k)[i] if len(getattr(msg, k, ())) > i else np.nan)
     run.squeal_fits = {s: {k: np.array(v) for k, v in f.items()} for s, f in run.squeal_fits.items()}
+    events = (applicator_from_msg(m) for m in got["rail_msgs/msg/FrictionApplicator"])
+    run.applicator = sorted((e for e in events if not applicator_refusal(e)), key=lambda e: e.stamp_ns)
     run.alerts = sorted((alert_from_msg(m) for m in al), key=lambda a: (a.stamp_ns, a.kind, a.key, a.active))
     run.advisory = advisories[-1] if advisories else None
     return run

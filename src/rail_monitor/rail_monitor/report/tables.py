@@ -1,5 +1,6 @@
 """The report's numbers: the grinding outlook, squeal and noise against the site's limits, per
-vehicle class, per day, before and after a friction modifier, and the squealing trains.
+vehicle class, per day, and the squealing trains (the friction modifier's in
+:mod:`rail_monitor.report.friction_modifier`).
 
 Every table is a list of rows (dicts, units in the keys), computed from the per-pass table of
 :func:`rail_monitor.report.run_tables.pass_table` (one row per pass with every model output), so the
@@ -15,7 +16,6 @@ from typing import Any
 import numpy as np
 
 from rail_monitor.alerts.config import counts_as_squeal
-from rail_monitor.core.passes import FRICTION_MODIFIER, FRICTION_NAMES
 from rail_monitor.core.timeutil import NS_PER_DAY, format_local_ns
 from rail_monitor.engine.site_config import SiteConfig
 from rail_monitor.report.run_data import RunData
@@ -27,10 +27,10 @@ TOP_SQUEALERS = 20
 
 
 def limits(site: SiteConfig) -> dict[str, Any]:
-    """The site's alert limits the report compares with."""
+    """The site's alert limits the report compares with, and the squeal model's background [dB(A)]."""
     cfg = site.alerts
     return {"metric": cfg.noise_metric, "limit_dba": cfg.noise_limit_dba, "squeal_min_risk": cfg.squeal_min_risk,
-            "lead_time_days": cfg.lead_time_days}
+            "lead_time_days": cfg.lead_time_days, "squeal_background_dba": site.squeal.background_level_dba}
 
 
 def squealing(t: Mapping[str, np.ndarray], min_risk: str) -> np.ndarray:
@@ -40,11 +40,11 @@ def squealing(t: Mapping[str, np.ndarray], min_risk: str) -> np.ndarray:
     return counts_as_squeal(t["squeal_risk"], min_risk)
 
 
-def _processed(t: Mapping[str, np.ndarray]) -> np.ndarray:
+def processed(t: Mapping[str, np.ndarray]) -> np.ndarray:
     return t["status"] == "processed"
 
 
-def _mean(x: np.ndarray) -> float:
+def finite_mean(x: np.ndarray) -> float:
     x = x[np.isfinite(x)]
     return float(x.mean()) if len(x) else float("nan")
 
@@ -52,7 +52,7 @@ def _mean(x: np.ndarray) -> float:
 def noise_percentiles(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], models: list[str]) -> list[dict]:
     """Per model: percentiles of the alert's noise metric over processed passes, and the share above
     the limit."""
-    rows, ok = [], _processed(t)
+    rows, ok = [], processed(t)
     for model in models:
         x = t[f"{model}_{lim['metric']}"][ok]
         x = x[np.isfinite(x)]
@@ -69,59 +69,21 @@ def noise_percentiles(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], model
 
 def by_class(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], models: list[str]) -> list[dict]:
     """Per vehicle class: traffic, speed, squeal share and level, noise median and P95."""
-    ok = _processed(t)
+    ok = processed(t)
     sq = squealing(t, lim["squeal_min_risk"])
     rows = []
     for cls in sorted(set(t["vehicle_class"][ok].tolist())):
         m = ok & (t["vehicle_class"] == cls)
         row = {"class": cls, "passes": int(m.sum()), "share [%]": 100.0 * m.sum() / max(ok.sum(), 1),
-               "mean speed [km/h]": _mean(t["speed_kmh"][m]),
+               "mean speed [km/h]": finite_mean(t["speed_kmh"][m]),
                "squealing [%]": 100.0 * (sq & m).sum() / max(m.sum(), 1),
-               "squeal level, mean of squealing [dB(A)]": _mean(t["squeal_level_dba"][sq & m])
+               "squeal level, mean of squealing [dB(A)]": finite_mean(t["squeal_level_dba"][sq & m])
                if "squeal_level_dba" in t else float("nan")}
         for model in models:
             x = t[f"{model}_{lim['metric']}"][m]
             x = x[np.isfinite(x)]
             row[f"{model} P50 [dB(A)]"] = float(np.median(x)) if len(x) else float("nan")
             row[f"{model} P95 [dB(A)]"] = float(np.percentile(x, 95)) if len(x) else float("nan")
-        rows.append(row)
-    return rows
-
-
-FM_CUT_PUBLISHED_DBA = (6.3, 22.8)  # Eadie & Santoro (2006): friction modifiers at transit curves
-
-
-def friction_comparison(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list[dict]:
-    """Squeal per friction state, where the history has passes on the friction modifier and on
-    another state (else an empty list): the passes, the share squealing as predicted and, where
-    measured, as the station heard it, the mean level of the squealing, and the cut the model
-    predicts a friction modifier makes on the squealing passes (mean of their benefit).
-
-    A comparison of friction states, not of before and after an applicator's start: the bag holds
-    no such event, and where states mix from the first day the first friction-modifier pass says
-    nothing of one (its 'before' may be a single pass)."""
-    ok = _processed(t)
-    sq = squealing(t, lim["squeal_min_risk"])
-    fm = ok & (t["friction_state"] == FRICTION_NAMES[FRICTION_MODIFIER])
-    if not fm.any() or fm.sum() == ok.sum():
-        return []
-    heard = t.get("measured_squeal_detected")
-    rows = []
-    for name in FRICTION_NAMES.values():
-        m = ok & (t["friction_state"] == name)
-        if not m.any():
-            continue
-        row = {"friction state": name, "passes": int(m.sum()),
-               "squealing, predicted [%]": 100.0 * (sq & m).sum() / m.sum()}
-        if heard is not None:
-            measured = m & np.array([v != "" for v in heard], bool)
-            row["squealing, measured [%]"] = (100.0 * np.array([bool(v) for v in heard[measured]]).mean()
-                                              if measured.any() else float("nan"))
-        row["squeal level, mean of squealing [dB(A)]"] = _mean(t["squeal_level_dba"][sq & m])
-        benefit = t.get("squeal_friction_modifier_benefit_db")
-        row["friction-modifier cut, predicted, mean of squealing [dB(A)]"] = (
-            _mean(np.asarray(benefit[sq & m], float)) if benefit is not None and name != FRICTION_NAMES[
-                FRICTION_MODIFIER] else float("nan"))
         rows.append(row)
     return rows
 
@@ -135,7 +97,7 @@ def squeal_by_angle(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list
     heard = t.get("measured_squeal_detected")
     if heard is None:
         return []
-    ok = _processed(t)
+    ok = processed(t)
     measured = ok & np.array([v != "" for v in heard], bool)
     flags = np.array([bool(v) if v != "" else False for v in heard], bool)
     sq = squealing(t, lim["squeal_min_risk"])
@@ -190,7 +152,7 @@ def repeat_squealers(alerts: list, zone: str) -> list[dict]:
 
 def squealing_trains(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list[dict]:
     """Every squealing pass, loudest first."""
-    sq = squealing(t, lim["squeal_min_risk"]) & _processed(t)
+    sq = squealing(t, lim["squeal_min_risk"]) & processed(t)
     idx = np.flatnonzero(sq)
     idx = idx[np.argsort(-t["squeal_level_dba"][idx], kind="stable")]
     return [{"train_id": t["train_id"][i], "time (local)": t["time_local"][i], "class": t["vehicle_class"][i],
@@ -204,7 +166,7 @@ def daily(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], models: list[str]
     squealing passes, and the highest noise metric per model [dB(A)]."""
     import pandas as pd
 
-    ok = _processed(t)
+    ok = processed(t)
     local = pd.to_datetime(t["stamp_ns"][ok], utc=True).tz_convert(zone).normalize()
     frame = pd.DataFrame({"day": local, "squealing": squealing(t, lim["squeal_min_risk"])[ok],
                           **{m: t[f"{m}_{lim['metric']}"][ok] for m in models}})
@@ -250,7 +212,7 @@ def grinding_outlook(run: RunData, t: Mapping[str, np.ndarray], zone: str) -> li
 
 def weekly_rate_spread(t: Mapping[str, np.ndarray]) -> tuple[float, float]:
     """10th and 90th percentiles of passes per day over whole weeks of the history (NaN under 2 weeks)."""
-    ok = _processed(t)
+    ok = processed(t)
     stamps = t["stamp_ns"][ok]
     if len(stamps) < 2:
         return float("nan"), float("nan")

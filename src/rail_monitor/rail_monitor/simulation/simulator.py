@@ -21,6 +21,7 @@ from datetime import UTC, datetime
 import numpy as np
 
 from rail_monitor.core.errors import ConfigError
+from rail_monitor.core.friction import ACTION_START, ACTION_STOP, ApplicatorEvent
 from rail_monitor.core.passes import (
     FRICTION_CONTAMINATED,
     FRICTION_DRY,
@@ -115,3 +116,19 @@ def simulate(site: Site, cfg: SimulatorConfig) -> PassTable:
         friction_state=friction,
         train_length_m=np.round(vehicles * per_class("vehicle_length_m"), 2),
     )
+
+
+SIMULATED_PRODUCT = "top-of-rail friction modifier (simulated)"
+
+
+def applicator_events(cfg: SimulatorConfig) -> list[ApplicatorEvent]:
+    """The friction-modifier applicator's start and stop inside the history, from its service days
+    (``simulator.friction_modifier_start_day`` and ``_end_day``): the site events a history of that
+    traffic carries."""
+    start, end = cfg.friction_modifier_start_day, cfg.friction_modifier_end_day
+    if not 0.0 <= start < min(end, cfg.days):
+        return []
+    out = [ApplicatorEvent(cfg.start_ns + round(start * NS_PER_DAY), ACTION_START, SIMULATED_PRODUCT)]
+    if end < cfg.days:
+        out.append(ApplicatorEvent(cfg.start_ns + round(end * NS_PER_DAY), ACTION_STOP, SIMULATED_PRODUCT))
+    return out
