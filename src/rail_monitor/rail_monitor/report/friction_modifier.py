@@ -2,7 +2,9 @@
 start where the bag holds one (rail_msgs/FrictionApplicator), else the friction states compared.
 
 Before and after: the processed passes stamped before the first start, against those after it
-(up to the applicator's next stop, if any), whatever friction state each pass records. Per side:
+(up to the applicator's next stop, if any): all of them, and those on the dry rail (dry or on the
+modifier; wet and contaminated passes left out, as weather and leaf fall change squeal more than
+a modifier does and need not be alike on both sides). Per side:
 the share predicted to squeal (risk at or above the alerts' ``squeal_min_risk``), the share the
 station flagged, and two levels: the squeal model's level at its receiver (a quiet pass counts at
 the model's background, so a pass that stops squealing counts as the fall it makes) and, where
@@ -27,12 +29,20 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.core.friction import ACTION_START, ACTION_STOP, FRICTION_MODIFIER, FRICTION_NAMES, ApplicatorEvent
+from rail_monitor.core.friction import (
+    ACTION_START,
+    ACTION_STOP,
+    FRICTION_DRY,
+    FRICTION_MODIFIER,
+    FRICTION_NAMES,
+    ApplicatorEvent,
+)
 from rail_monitor.core.timeutil import format_local_ns
 from rail_monitor.report.tables import finite_mean, processed, squealing
 
 FM_CUT_PUBLISHED_DBA = (6.3, 22.8)  # Eadie & Santoro (2006): friction modifiers at transit curves
 SIDES = ("before the start", "after the start")
+RAILS = ("all passes", "dry rail (wet and contaminated left out)")
 PREDICTED_LEVEL = "squeal level, energy mean of all passes, predicted [dB(A)]"
 PREDICTED_LOUDEST = "squeal level, energy mean of the loudest, predicted [dB(A)]"
 MEASURED_LEVEL = "pass-by LpAFmax, energy mean, measured [dB(A)]"
@@ -85,22 +95,33 @@ def first_start(events: Sequence[ApplicatorEvent]) -> tuple[ApplicatorEvent, int
 
 def before_after(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], events: Sequence[ApplicatorEvent]
                  ) -> list[dict]:
-    """Rows before and after the applicator's first start, and their difference (empty without a
-    start); units in the keys. The loudest passes of each side are as many of its passes as the
-    share predicted to squeal before the start (the passes a modifier is for)."""
+    """Rows before and after the applicator's first start, and their difference, over all passes
+    and over the dry rail's (empty without a start); units in the keys. The loudest passes of each
+    side are as many of its passes as the share predicted to squeal before the start (the passes a
+    modifier is for)."""
     run = first_start(events)
     if run is None:
         return []
     (start, stop), ok = run, processed(t)
     stamps = np.asarray(t["stamp_ns"], np.int64)
+    dry = np.isin(t["friction_state"], [FRICTION_NAMES[FRICTION_DRY], FRICTION_NAMES[FRICTION_MODIFIER]])
+    rows = []
+    for rail, group in zip(RAILS, (ok, ok & dry), strict=True):
+        sides = (group & (stamps < start.stamp_ns), group & (stamps > start.stamp_ns) & (stamps < stop))
+        rows += _compared(t, lim, rail, sides)
+    return rows
+
+
+def _compared(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], rail: str,
+              sides: tuple[np.ndarray, np.ndarray]) -> list[dict]:
+    """The rows of one group of passes: before, after, and the cut."""
     sq = squealing(t, lim["squeal_min_risk"])
     heard = t.get("measured_squeal_detected")
-    sides = (ok & (stamps < start.stamp_ns), ok & (stamps > start.stamp_ns) & (stamps < stop))
     share = (sq & sides[0]).sum() / max(int(sides[0].sum()), 1)
     rows = []
     for side, m in zip(SIDES, sides, strict=True):
         n = int(m.sum())
-        row: dict[str, Any] = {"passes": side, "count": n,
+        row: dict[str, Any] = {"rail": rail, "passes": side, "count": n,
                                "squealing, predicted [%]": 100.0 * (sq & m).sum() / n if n else float("nan")}
         if heard is not None:
             row["squealing, measured [%]"] = _heard_percent(heard, m)
@@ -113,9 +134,8 @@ def before_after(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], events: Se
             row[MEASURED_LEVEL] = energy_mean(measured)
             row[MEASURED_LOUDEST] = energy_mean(loudest(measured, share))
         rows.append(row)
-    cut = {k: (rows[0][k] - rows[1][k] if k != "passes" else "cut (before minus after)") for k in rows[0]}
-    cut["count"] = ""
-    return [*rows, cut]
+    cut = {k: v - rows[1][k] for k, v in rows[0].items() if k not in ("rail", "passes", "count")}
+    return [*rows, {"rail": rail, "passes": "cut (before minus after)", "count": "", **cut}]
 
 
 def loudest(level_db: np.ndarray, share: float) -> np.ndarray:
@@ -149,15 +169,17 @@ def summary(by_state_rows: list[dict], applicator_rows: list[dict], events: Sequ
     published = list(FM_CUT_PUBLISHED_DBA)
     if applicator_rows:
         start, _ = first_start(events)
-        before, after, cut = applicator_rows
-        return {"compared": "before and after the applicator's start", "start": format_local_ns(start.stamp_ns, zone),
-                "product": start.product, "passes": [before["count"], after["count"]],
+        (all_before, all_after, all_cut), (before, after, cut) = applicator_rows[:3], applicator_rows[3:]
+        return {"compared": "before and after the applicator's start, on the dry rail",
+                "start": format_local_ns(start.stamp_ns, zone), "product": start.product,
+                "passes": [before["count"], after["count"]],
                 "predicted_percent": [before["squealing, predicted [%]"], after["squealing, predicted [%]"]],
                 "measured_percent": [r.get("squealing, measured [%]") for r in (before, after)],
                 "loudest_percent": before["squealing, predicted [%]"],
                 "predicted_cut_dba": cut[PREDICTED_LOUDEST], "measured_cut_dba": cut.get(MEASURED_LOUDEST),
-                "predicted_exposure_cut_dba": cut[PREDICTED_LEVEL],
-                "published_cut_dba": published}
+                "all_passes_predicted_percent": [all_before["squealing, predicted [%]"],
+                                                 all_after["squealing, predicted [%]"]],
+                "all_passes_predicted_cut_dba": all_cut[PREDICTED_LOUDEST], "published_cut_dba": published}
     rows = {r["friction state"]: dict(r) for r in by_state_rows}
     if not rows:
         return None
@@ -202,10 +224,13 @@ def headline_line(fm: Mapping[str, Any]) -> str:
         heard = f"; the station heard {mb:.1f} % and {ma:.1f} %" if _finite(mb) and _finite(ma) else ""
         measured = (f", the measured LpAFmax of as many loudest passes {_fell(fm['measured_cut_dba'])}"
                     if _finite(fm["measured_cut_dba"]) else "")
-        return (f"Friction modifier, before and after the applicator's start {fm['start']}{product}: {pb:.1f} % of "
-                f"{nb} passes predicted to squeal before, {pa:.1f} % of {na} after{heard}; the model's squeal level "
-                f"of the loudest {fm['loudest_percent']:.1f} % of passes {_fell(fm['predicted_cut_dba'])}{measured} "
-                f"{published}, and over all passes {_fell(fm['predicted_exposure_cut_dba'])}.")
+        ab, aa = fm["all_passes_predicted_percent"]
+        return (f"Friction modifier, before and after the applicator's start {fm['start']}{product}, on the dry "
+                f"rail (wet and contaminated passes left out: weather and leaf fall are not the modifier's): "
+                f"{pb:.1f} % of {nb} passes predicted to squeal before, {pa:.1f} % of {na} after{heard}; the "
+                f"model's squeal level of the loudest {fm['loudest_percent']:.1f} % of passes "
+                f"{_fell(fm['predicted_cut_dba'])}{measured} {published}. Over all passes: {ab:.1f} % before, "
+                f"{aa:.1f} % after, the loudest {_fell(fm['all_passes_predicted_cut_dba'])}.")
     heard = (f"; the station heard {fm['on_measured_percent']:.1f} % against {fm['off_measured_percent']:.1f} %"
              if _finite(fm["on_measured_percent"]) and _finite(fm["off_measured_percent"]) else "")
     cut = (f"; on the squealing passes the model predicts a cut of {fm['predicted_cut_dba']:.1f} dB(A) {published}"
