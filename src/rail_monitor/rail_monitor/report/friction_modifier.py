@@ -38,7 +38,7 @@ from rail_monitor.core.friction import (
     ApplicatorEvent,
 )
 from rail_monitor.core.timeutil import format_local_ns
-from rail_monitor.report.tables import finite_mean, processed, squealing
+from rail_monitor.report.tables import finite_mean, heard_flags, processed, squealing
 
 FM_CUT_PUBLISHED_DBA = (6.3, 22.8)  # Eadie & Santoro (2006): friction modifiers at transit curves
 SIDES = ("before the start", "after the start")
@@ -158,8 +158,9 @@ def _numbers(values: np.ndarray) -> np.ndarray:
 
 def _heard_percent(heard: np.ndarray, rows: np.ndarray) -> float:
     """The share of the measured passes among rows the station flagged squealing [%] (NaN: none)."""
-    measured = rows & np.array([v != "" for v in heard], bool)
-    return 100.0 * np.array([bool(v) for v in heard[measured]]).mean() if measured.any() else float("nan")
+    measured, flags = heard_flags(heard)
+    measured &= rows
+    return 100.0 * flags[measured].mean() if measured.any() else float("nan")
 
 
 def summary(by_state_rows: list[dict], applicator_rows: list[dict], events: Sequence[ApplicatorEvent],

@@ -91,15 +91,21 @@ def by_class(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], models: list[s
 AOA_BANDS_MRAD = (0.0, 2.0, 4.0, 6.0, 8.0, 10.0, np.inf)  # the squeal table's angle-of-attack bands
 
 
+def heard_flags(heard: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The station's squeal-flag column (empty text where a pass was not measured): which passes
+    it measured, and which it flagged squealing."""
+    measured = np.array([v != "" for v in heard], bool)
+    return measured, np.array([bool(v) for v in heard], bool) & measured
+
+
 def squeal_by_angle(t: Mapping[str, np.ndarray], lim: Mapping[str, Any]) -> list[dict]:
     """Squeal predicted and, where a station measured it, heard, per angle-of-attack band: the
     model against the site where it matters most (empty without measured passes)."""
     heard = t.get("measured_squeal_detected")
     if heard is None:
         return []
-    ok = processed(t)
-    measured = ok & np.array([v != "" for v in heard], bool)
-    flags = np.array([bool(v) if v != "" else False for v in heard], bool)
+    measured, flags = heard_flags(heard)
+    measured &= processed(t)
     sq = squealing(t, lim["squeal_min_risk"])
     aoa = np.abs(np.asarray(t["angle_of_attack_mrad"], float))
     rows = []
