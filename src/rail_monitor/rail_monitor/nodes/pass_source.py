@@ -123,24 +123,27 @@ class PassSourceNode(RailNode):
         """Publish a survey or grinding event. In other processes, wait until every subscriber holds
         it before the next pass goes out (the estimator takes queued surveys before passes); in
         this one, DDS has delivered it to the hosted subscribers when publish returns."""
-        self.event_pub.publish(to_cdr(RoughnessSurvey, roughness_survey_fields(event, self.cfg.site_id)))
+        self._send(self.event_pub, to_cdr(RoughnessSurvey, roughness_survey_fields(event, self.cfg.site_id)), ok)
         self.events_sent += 1
-        self._acknowledged(self.event_pub, ok)
 
     def _send_measurement(self, m: Measurement, ok: Callable[[], bool]) -> None:
         """Publish a measured pass-by, held by every subscriber before the next pass goes out (the
         alert manager scores measurements in stamp order as long as each comes before any later
         pass's predictions)."""
-        self.measured_pub.publish(to_cdr(MeasuredPassNoise, measured_pass_noise_fields(m, self.cfg.site_id)))
+        self._send(self.measured_pub, to_cdr(MeasuredPassNoise, measured_pass_noise_fields(m, self.cfg.site_id)), ok)
         self.measurements_sent += 1
-        self._acknowledged(self.measured_pub, ok)
 
     def _send_applicator(self, event: ApplicatorEvent, ok: Callable[[], bool]) -> None:
         """Publish an applicator's start or stop (for the recorder: no model takes it; latched, so a
         recorder matching late gets it), held by the subscribers present before the next pass."""
-        self.applicator_pub.publish(to_cdr(FrictionApplicator, friction_applicator_fields(event, self.cfg.site_id)))
+        data = to_cdr(FrictionApplicator, friction_applicator_fields(event, self.cfg.site_id))
+        self._send(self.applicator_pub, data, ok)
         self.applicator_sent += 1
-        self._acknowledged(self.applicator_pub, ok)
+
+    def _send(self, pub, data: bytes, ok: Callable[[], bool]) -> None:
+        """Publish one message's CDR bytes and wait for its acknowledgement (_acknowledged)."""
+        pub.publish(data)
+        self._acknowledged(pub, ok)
 
     def _acknowledged(self, pub, ok: Callable[[], bool]) -> None:
         """In other processes, wait until every subscriber of pub holds what it sent (at most
@@ -269,6 +272,7 @@ class PassSourceNode(RailNode):
         self._wait_for_subscribers(ok)
         if events and self.cfg.wait_for_subscribers > 0:
             self._wait_for_event_subscriber(ok)
+        outbox = ((events, self._send_event), (applicator, self._send_applicator), (measured, self._send_measurement))
         rate, frame = self.cfg.rate, self.cfg.site_id
         batch, period = self.cfg.ack_batch, self.cfg.clock_period_s
         stamps = table.stamp_ns
@@ -288,12 +292,10 @@ class PassSourceNode(RailNode):
                         # never past the pass itself: /clock must not step backwards
                         self._publish_clock(min(stamp, t0 + int((time.monotonic() - wall0) * rate * NS_PER_S)))
                 self._publish_clock(stamp)
-                while events and events[0].stamp_ns < stamp:  # before the first pass later than it
-                    self._send_event(events.pop(0), ok)
-                while applicator and applicator[0].stamp_ns < stamp:
-                    self._send_applicator(applicator.pop(0), ok)
-                while measured and measured[0].stamp_ns < stamp:  # after its own pass
-                    self._send_measurement(measured.pop(0), ok)
+                # Events before the first pass later than them; a measurement after its own pass.
+                for items, send in outbox:
+                    while items and items[0].stamp_ns < stamp:
+                        send(items.pop(0), ok)
                 if i % CDR_BLOCK == 0:  # the passes' CDR from their columns, a block at a time
                     part = table.take(slice(i, i + CDR_BLOCK))
                     block = to_cdr_many(TrainPass, train_pass_columns(part, frame), len(part))
@@ -303,12 +305,9 @@ class PassSourceNode(RailNode):
                 bar.update()
                 if (i + 1) % batch == 0:
                     self._throttle(i + 1, ok)
-            for event in events if ok() else []:
-                self._send_event(event, ok)
-            for event in applicator if ok() else []:
-                self._send_applicator(event, ok)
-            for m in measured if ok() else []:
-                self._send_measurement(m, ok)
+            for items, send in outbox:
+                for item in items if ok() else []:
+                    send(item, ok)
             self._throttle(self.meter.count, ok)
             if self.consumed is None and self.cfg.wait_for_subscribers > 0:
                 self._wait_for_graph(self.meter.count, ok)

@@ -125,12 +125,12 @@ def _compared(t: Mapping[str, np.ndarray], lim: Mapping[str, Any], rail: str,
                                "squealing, predicted [%]": 100.0 * (sq & m).sum() / n if n else float("nan")}
         if heard is not None:
             row["squealing, measured [%]"] = _heard_percent(heard, m)
-        squeal = np.nan_to_num(_numbers(t["squeal_level_dba"][m]), nan=-np.inf)  # not a level: stable
+        squeal = np.nan_to_num(np.asarray(t["squeal_level_dba"][m], float), nan=-np.inf)  # NaN: stable
         level = 10.0 * np.log10(10.0 ** (squeal / 10.0) + 10.0 ** (lim["squeal_background_dba"] / 10.0))
         row[PREDICTED_LEVEL] = energy_mean(level)
         row[PREDICTED_LOUDEST] = energy_mean(loudest(level, share))
         if heard is not None:
-            measured = _numbers(t["measured_lpafmax_dba"][m])
+            measured = np.asarray(t["measured_lpafmax_dba"][m], float)
             row[MEASURED_LEVEL] = energy_mean(measured)
             row[MEASURED_LOUDEST] = energy_mean(loudest(measured, share))
         rows.append(row)
@@ -149,11 +149,6 @@ def energy_mean(level_db: np.ndarray) -> float:
     x = np.asarray(level_db, float)
     x = x[np.isfinite(x)]
     return float(10.0 * np.log10(np.mean(10.0 ** (x / 10.0)))) if len(x) else float("nan")
-
-
-def _numbers(values: np.ndarray) -> np.ndarray:
-    """A measured column (empty text where a pass was not measured) as floats (NaN there)."""
-    return np.array([float(v) if v != "" else np.nan for v in np.asarray(values, object).tolist()], float)
 
 
 def _heard_percent(heard: np.ndarray, rows: np.ndarray) -> float:
