@@ -8,8 +8,8 @@ bench.bare_graph); the live graph's start-up, idle CPU, CPU and latency (bench.l
 1e4, 1e5 and 1e6 passes; a busy site's year live and in batch;
 per-model cost per pass; the recorder against the bare mcap writer; peak memory against passes
 (the graph, the recorder, the streamed batch, and export in parts against read whole);
-many sites on a local Dask cluster of 1 and 2 workers; where a live pass's time goes in the site
-engine (bench.engine_pass).
+many sites on a local Dask cluster of 1 and 2 workers; a grinding programme for 500 sites over 5
+years (bench.plan); where a live pass's time goes in the site engine (bench.engine_pass).
 """
 
 from __future__ import annotations
@@ -33,6 +33,7 @@ from bench import engine_pass as bep
 from bench import graph as bg
 from bench import live as blive
 from bench import noise as bn
+from bench import plan as bplan
 from bench import recorder as br
 from bench import sites as bsites
 from bench import squeal as bs
@@ -231,6 +232,7 @@ def main() -> None:
             + export_rows(values, ns.site, 2_000 if ns.quick else 100_000, tmp)))
         sections.append(("many sites on a local Dask cluster", bsites.rows(values, ns.site, 2 if ns.quick else 4,
                                                                            1000 if ns.quick else 20_000)))
+        sections.append(("a grinding programme for a network", bplan.rows(50 if ns.quick else 500, 5)))
     text = f"Machine: {machine()}\n\n{table(sections)}\n"
     print(text)
     Path(ns.out).parent.mkdir(parents=True, exist_ok=True)

@@ -271,3 +271,17 @@ def node_parameters(values: dict, **extra) -> list:
     from rclpy.parameter import Parameter
 
     return [Parameter(k, value=v) for k, v in {**values, **extra}.items() if not k.startswith("simulator.")]
+
+
+def write_two_sites(folder: Path, days: float) -> None:
+    """Two sites in folder: curve_250.yaml with the example history a.csv, and curve_400.yaml (radius
+    400 m) with b.csv, simulated over days."""
+    from rail_monitor.cli import main
+    from rail_monitor.cli.site import edited_site_text
+
+    text, _ = edited_site_text(SITE_FILE.read_text(), ["site_id=curve_400", "curve_radius_m=400.0",
+                                                       f"simulator.days={days}", "simulator.seed=7"])
+    (folder / "curve_400.yaml").write_text(text)
+    (folder / "curve_250.yaml").write_text(SITE_FILE.read_text())
+    (folder / "a.csv").write_text(EXAMPLE_CSV.read_text())
+    assert main(["simulate", "--site", str(folder / "curve_400.yaml"), "--csv", str(folder / "b.csv")]) == 0

@@ -38,6 +38,8 @@ def test_the_benchmark_harness_runs_and_batch_equals_the_live_graph(tmp_path):
                      r"passes", text), text
     assert re.search(r"\| noise_station hearing 5 passes of 10 s at 48 kHz \| [0-9]+ ms CPU a pass \| heard 5; idle "
                      r"[0-9.]+ % of a core; 100 passes an hour [0-9.]+ % of a core \|", text), text
+    assert re.search(r"\| programme, 50 sites x 5 years, no capacity \| [0-9.]+ s \| [0-9,]+ candidate schedules",
+                     text), text
     assert re.search(r"\| filling 256 MB new to this process \| [0-9.]+ s \| [0-9.]+ s again", text), text
     assert re.search(r"\| batch streamed to a bag, [0-9,]+ passes \| [0-9,]+ MB \|", text), text
     assert re.search(r"\| export to Parquet, [0-9,]+ passes, in parts of 5,000 passes \| [0-9,]+ MB \|", text), text

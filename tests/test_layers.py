@@ -18,7 +18,7 @@ PACKAGE = TOP / "src" / "rail_monitor" / "rail_monitor"
 LAYERS: tuple[tuple[str, ...], ...] = (
     ("models",),                                                  # pure physics
     ("core",),                                                    # what every layer shares
-    ("corrugation", "noise", "squeal", "measured", "alerts", "advice"),  # the per-model packages
+    ("corrugation", "noise", "squeal", "measured", "alerts", "advice", "economics"),  # the per-model packages
     ("engine",),                                                  # a site's state, live and batch alike
     ("codec", "messages", "bagio", "site_file", "batch", "report", "simulation", "station", "whatif"),  # I/O, apps
     ("nodes", "cli"),                                             # ROS 2 glue and the command line

@@ -12,22 +12,16 @@ import pytest
 from rail_monitor.bagio.site_record import read_site_record
 from rail_monitor.batch.sites import read_manifest
 from rail_monitor.cli import main
-from rail_monitor.cli.site import edited_site_text
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.report.run_data import load_run
 
-from conftest import EXAMPLE_CSV, SITE_FILE
+from conftest import write_two_sites
 
 
 @pytest.fixture(scope="module")
 def two_sites(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("sites")
-    text, _ = edited_site_text(SITE_FILE.read_text(), ["site_id=curve_400", "curve_radius_m=400.0",
-                                                       "simulator.days=1.0", "simulator.seed=7"])
-    (tmp / "curve_400.yaml").write_text(text)
-    (tmp / "curve_250.yaml").write_text(SITE_FILE.read_text())
-    (tmp / "a.csv").write_text(EXAMPLE_CSV.read_text())
-    assert main(["simulate", "--site", str(tmp / "curve_400.yaml"), "--csv", str(tmp / "b.csv")]) == 0
+    write_two_sites(tmp, 1.0)
     (tmp / "sites.yaml").write_text("sites:\n  - site: curve_250.yaml\n    history: a.csv\n"
                                     "  - site: curve_400.yaml\n    history: b.csv\n    output: out/b\n")
     return tmp

@@ -48,6 +48,7 @@ def _values_classes():
     from rail_monitor.core import node_params as n
     from rail_monitor.core.site import CONTACT_SPECS, WheelRailContact
     from rail_monitor.corrugation.config import CORRUGATION_SPECS, CorrugationConfig
+    from rail_monitor.economics.config import ECONOMICS_SPECS, EconomicsConfig
     from rail_monitor.measured.config import RESIDUAL_SPECS, ResidualConfig
     from rail_monitor.noise.config import NOISE_SPECS, NoiseConfig
     from rail_monitor.squeal.config import SQUEAL_SPECS, SquealConfig
@@ -59,7 +60,7 @@ def _values_classes():
             (n.ReplayerParams, n.REPLAYER_SPECS, ()), (n.ModeParams, n.MODE_SPECS, ()),
             (n.RecorderParams, n.RECORDER_SPECS, ()), (n.MonitorParams, (*n.MONITOR_SPECS, n.SOURCE), ()),
             (n.StampParams, n.STAMP_SPECS, ()), (n.FoxgloveParams, n.FOXGLOVE_SPECS, ()),
-            (n.EstimatorParams, n.ESTIMATOR_SPECS, ())]
+            (n.EstimatorParams, n.ESTIMATOR_SPECS, ()), (EconomicsConfig, ECONOMICS_SPECS, ())]
 
 
 def test_every_values_class_has_one_typed_field_per_spec():
@@ -76,4 +77,4 @@ def test_every_values_class_has_one_typed_field_per_spec():
         got = [(f.name, f.type if isinstance(f.type, str) else f.type.__name__) for f in dataclasses.fields(klass)]
         assert got == want, klass.__name__
         assert klass.__dataclass_params__.frozen, klass.__name__
-    assert len(classes) == 14
+    assert len(classes) == 15

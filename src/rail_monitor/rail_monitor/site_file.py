@@ -30,6 +30,7 @@ from rail_monitor.core.site import (
 from rail_monitor.core.user_file import read_user_text
 from rail_monitor.core.yaml_text import load_yaml
 from rail_monitor.corrugation.config import CORRUGATION_SPECS
+from rail_monitor.economics.config import ECONOMICS_SPECS
 from rail_monitor.measured.config import RESIDUAL_SPECS
 from rail_monitor.noise.config import NOISE_SPECS
 from rail_monitor.squeal.config import SQUEAL_SPECS
@@ -40,7 +41,7 @@ SECTIONS: tuple[tuple[str, tuple[ParamSpec, ...]], ...] = (
     ("", SITE_SPECS), ("contact.", CONTACT_SPECS), ("track.", TRACK_SPECS),
     ("corrugation.", CORRUGATION_SPECS), ("squeal.", SQUEAL_SPECS), ("noise.", NOISE_SPECS),
     ("alerts.", ALERT_SPECS), ("residual.", RESIDUAL_SPECS), ("stamps.", node_params.STAMP_SPECS),
-    ("station.", STATION_SPECS),
+    ("station.", STATION_SPECS), ("economics.", ECONOMICS_SPECS),
     ("", SIMULATOR_SPECS),
     *(("", specs) for specs in (node_params.PUBLISH_SPECS, node_params.REPLAYER_SPECS, node_params.MODE_SPECS,
                                 node_params.RECORDER_SPECS, node_params.MONITOR_SPECS, node_params.BATCH_SPECS,
@@ -152,6 +153,7 @@ REFERENCE_SECTIONS: tuple[tuple[str, str, tuple[ParamSpec, ...]], ...] = (
     ("Rolling noise", "noise.", NOISE_SPECS), ("Alerts", "alerts.", ALERT_SPECS),
     ("Measured noise: residuals", "residual.", RESIDUAL_SPECS),
     ("Noise station (noise_station)", "station.", STATION_SPECS),
+    ("Grinding economics (rail-monitor plan)", "economics.", ECONOMICS_SPECS),
     ("Stamp plausibility", "stamps.", node_params.STAMP_SPECS), ("Simulator", "", SIMULATOR_SPECS),
     ("Pass sources (pass_replayer, pass_simulator)", "", node_params.PUBLISH_SPECS),
     ("pass_replayer", "", node_params.REPLAYER_SPECS), ("pass_simulator and pass_replayer: mode", "",

@@ -15,6 +15,9 @@ The manifest (YAML; paths relative to the manifest's folder)::
       - site: curve_250.yaml          # site parameter file
         history: curve_250.csv        # bag folder, .mcap, .db3 or .csv
         output: out/curve_250_batch   # optional; default <history>_batch beside the history
+
+``rail-monitor plan`` reads the same manifest, and also takes ``checkpoint:`` (a live site's
+corrugation checkpoint) in place of ``history:``; each task returns the site's grinding outlook.
 """
 
 from __future__ import annotations
@@ -22,9 +25,10 @@ from __future__ import annotations
 import logging
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from rail_monitor.bagio.output_folder import beside
 from rail_monitor.core.errors import ConfigError, RailMonitorError
@@ -32,11 +36,12 @@ from rail_monitor.core.user_file import read_user_text
 from rail_monitor.core.yaml_text import load_yaml
 
 
-# One site of a manifest: its site file, its history, and the bag folder to write.
+# One site of a manifest: its site file, its history (or checkpoint: plan only), and the bag folder to write.
 class SiteJob(NamedTuple):
     site: Path
-    history: Path
-    output: Path
+    history: Path | None
+    output: Path | None
+    checkpoint: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -53,8 +58,9 @@ class SiteResult:
     worker: str
 
 
-def read_manifest(path: str | Path) -> list[SiteJob]:
-    """The jobs of a manifest (ConfigError with one line naming the entry at fault)."""
+def read_manifest(path: str | Path, checkpoints: bool = False) -> list[SiteJob]:
+    """The jobs of a manifest (ConfigError with one line naming the entry at fault); checkpoints:
+    an entry may give ``checkpoint:`` instead of ``history:`` (plan), and has no output."""
     path = Path(path)
     text = read_user_text(path, "a manifest", error=ConfigError)
     doc = load_yaml(text, f"{path}: cannot read the manifest", ConfigError)
@@ -63,20 +69,26 @@ def read_manifest(path: str | Path) -> list[SiteJob]:
         raise ConfigError(f"{path}: expected 'sites:' with a list of entries (site:, history:, output:)")
     jobs, outputs = [], set()
     base = path.parent.resolve()  # absolute: a worker on another host has its own working folder
+    keys = {"site", "history", "output"} | ({"checkpoint"} if checkpoints else set())
     for i, entry in enumerate(entries):
         where = f"{path}: sites[{i}]"
-        if not isinstance(entry, dict) or not {"site", "history"} <= set(entry) or set(entry) - {"site", "history",
-                                                                                                     "output"}:
-            raise ConfigError(f"{where}: expected the keys site and history (and optionally output)")
-        site, history = (base / str(entry[k]) for k in ("site", "history"))
-        for p in (site, history):
+        sources = {"history", "checkpoint"} & set(entry) if isinstance(entry, dict) else set()
+        if not isinstance(entry, dict) or "site" not in entry or len(sources) != 1 or set(entry) - keys:
+            raise ConfigError(f"{where}: expected the keys site and " + ("history or checkpoint" if checkpoints else
+                                                                         "history (and optionally output)"))
+        site, source = base / str(entry["site"]), base / str(entry[next(iter(sources))])
+        for p in (site, source):
             if not p.exists():
                 raise ConfigError(f"{where}: {p} not found")
-        output = base / str(entry["output"]) if entry.get("output") else beside(history, "_batch")
+        if checkpoints:
+            jobs.append(SiteJob(site, source if "history" in entry else None, None,
+                                source if "checkpoint" in entry else None))
+            continue
+        output = base / str(entry["output"]) if entry.get("output") else beside(source, "_batch")
         if output.resolve() in outputs:
             raise ConfigError(f"{where}: output {output} is another site's too")
         outputs.add(output.resolve())
-        jobs.append(SiteJob(site, history, output))
+        jobs.append(SiteJob(site, source, output))
     return jobs
 
 
@@ -96,6 +108,31 @@ def run_site(job: SiteJob) -> SiteResult:
                       time.monotonic() - t0, _worker_name())
 
 
+def outlook_site(job: SiteJob) -> Any:
+    """One site's grinding outlook (economics.outlook.SiteOutlook) from its history, surveys and
+    grinding events applied, or from its checkpoint (a task: imports inside, runs on a worker)."""
+    from rail_monitor.bagio.reader import read_bag_events, read_passes
+    from rail_monitor.core.passes import rejection_reasons, with_class_defaults
+    from rail_monitor.corrugation.estimator import CorrugationEstimator
+    from rail_monitor.economics.outlook import site_outlook
+    from rail_monitor.engine import checkpoint
+    from rail_monitor.engine.corrugation_site import advance_with_events
+    from rail_monitor.engine.site_config import SiteConfig
+    from rail_monitor.site_file import load_parameter_file
+
+    cfg = SiteConfig.from_values(load_parameter_file(job.site))
+    est = CorrugationEstimator(cfg.site, cfg.corrugation)
+    if job.checkpoint is not None:
+        checkpoint.load(est, job.checkpoint)
+    else:
+        passes = read_passes(job.history)
+        ok = rejection_reasons(passes, cfg.site) == ""
+        advance_with_events(est, with_class_defaults(passes.take(ok), cfg.site), read_bag_events(job.history))
+    if not est.total_pass_count:
+        raise RailMonitorError(f"{job.checkpoint or job.history}: no valid pass of site {cfg.site.site_id}")
+    return site_outlook(est, cfg.economics)
+
+
 def _worker_name() -> str:
     try:
         from distributed import get_worker
@@ -105,10 +142,12 @@ def _worker_name() -> str:
         return f"pid {os.getpid()}"
 
 
-def run_sites(jobs: list[SiteJob], workers: int = 0, scheduler: str = "") -> list[SiteResult]:
-    """Every job as a Dask task, results in the manifest's order. workers: processes of the local
-    cluster (0: one per core); scheduler: the address of a running cluster (then workers is
-    not used). A failed site is a RailMonitorError naming it, after the others have finished."""
+def run_sites(jobs: list[SiteJob], workers: int = 0, scheduler: str = "",
+              task: Callable[[SiteJob], Any] = run_site) -> list[Any]:
+    """task (run_site, or outlook_site) of every job as a Dask task, results in the manifest's
+    order. workers: processes of the local cluster (0: one per core); scheduler: the address of a
+    running cluster (then workers is not used). A failed site is a RailMonitorError naming it,
+    after the others have finished."""
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
@@ -119,14 +158,14 @@ def run_sites(jobs: list[SiteJob], workers: int = 0, scheduler: str = "") -> lis
                                silence_logs=logging.WARNING)
         client = Client(cluster)
     try:
-        futures = [client.submit(run_site, job, pure=False, key=f"site-{i}-{job.site.stem}")
+        futures = [client.submit(task, job, pure=False, key=f"site-{i}-{job.site.stem}")
                    for i, job in enumerate(jobs)]
         results, failures = [], []
         for job, fut in zip(jobs, futures, strict=True):
             try:
                 results.append(fut.result())
             except RailMonitorError as exc:
-                failures.append(f"{job.site.name} ({job.history.name}): {exc}")
+                failures.append(f"{job.site.name} ({(job.history or job.checkpoint).name}): {exc}")
         if failures:
             raise RailMonitorError(f"{len(failures)} of {len(jobs)} sites failed: " + "; ".join(failures))
         return results

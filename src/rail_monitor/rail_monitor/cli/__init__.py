@@ -1,5 +1,5 @@
-"""rail-monitor: the command line (site, simulate, info, replay, record, monitor, demo, batch, report,
-export, predict, measure).
+"""rail-monitor: the command line (site, simulate, info, replay, record, monitor, demo, batch, plan,
+report, export, predict, measure).
 
 One module per verb: its arguments, a call into the package's functions (what-ifs, batch mode,
 the report, the nodes), and the printing. Node options are generated from the same ParamSpecs
@@ -21,6 +21,7 @@ from rail_monitor.cli import (
     graph,
     info,
     measure,
+    plan,
     predict_audio,
     predict_corrugation,
     predict_noise,
@@ -47,6 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
         verb.add_parser(models)
     measure.add_parser(sub)
     batch.add_parser(sub)
+    plan.add_parser(sub)
     report.add_parser(sub)
     export.add_parser(sub)
     _state_defaults_once(p)

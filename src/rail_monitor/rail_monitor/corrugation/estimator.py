@@ -296,17 +296,24 @@ class CorrugationEstimator:
             out[f] = growth[k.friction == f + 1].sum(axis=0)
         return out / self._kept_axles
 
-    def forecast_interval(self) -> ForecastInterval:
+    def forecast_interval(self, after_grinding: bool = False) -> ForecastInterval:
         """P10, P50 and P90 of the days to threshold over the K_b posterior and the level variance
         of each band (:func:`.forecast.interval`): at the traffic and friction mix of the same
-        season a year earlier where the history spans a year, else at the recent traffic."""
+        season a year earlier where the history spans a year, else at the recent traffic.
+        after_grinding: of a rail ground now to the configured post-grinding roughness (its
+        uncertainty ``post_grinding_uncertainty_db``), the grinding cycle a programme plans with."""
         rate, axles = self.traffic()
         axles = axles if np.isfinite(axles) else self.site.mean_axles_per_train
         days_per_axle_pass = 1.0 / (rate * axles) if np.isfinite(rate) and rate > 0 else np.inf
         season = self.season.profile(self.newest_ns)
-        return fcst.interval(self.log_components, self.growth_by_state, self.recent_growth_by_state(),
-                             self.calibration, np.sqrt(self.level_var), self.threshold, days_per_axle_pass,
-                             self.newest_ns, None if season is None else season * self.k_b[None, :, None, None])
+        if after_grinding:
+            state, var = self.flat(self.post_grinding), self.post_grinding_var
+            since = np.zeros_like(self.growth_by_state)
+        else:
+            state, since, var = self.log_components, self.growth_by_state, self.level_var
+        return fcst.interval(state, since, self.recent_growth_by_state(), self.calibration, np.sqrt(var),
+                             self.threshold, days_per_axle_pass, self.newest_ns,
+                             None if season is None else season * self.k_b[None, :, None, None])
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic (see :func:`.forecast.traffic`)."""

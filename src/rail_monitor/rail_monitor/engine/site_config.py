@@ -17,6 +17,7 @@ from rail_monitor.core.node_params import STAMP_SPECS, StampParams
 from rail_monitor.core.params import resolve, section, values_of
 from rail_monitor.core.site import Site, site_from_values
 from rail_monitor.corrugation.config import CorrugationConfig, corrugation_config
+from rail_monitor.economics.config import EconomicsConfig, economics_config
 from rail_monitor.measured.config import ResidualConfig, residual_config
 from rail_monitor.noise.config import NoiseConfig, noise_config
 from rail_monitor.squeal.config import SquealConfig, squeal_config
@@ -34,6 +35,7 @@ class SiteConfig:
     residual: ResidualConfig
     alerts: AlertConfig             # with the corrugation lead time
     stamps: StampParams
+    economics: EconomicsConfig
 
     @classmethod
     def from_values(cls, values: Mapping[str, Any]) -> SiteConfig:
@@ -43,4 +45,5 @@ class SiteConfig:
                    noise=noise_config(values), squeal=squeal_config(values), residual=residual_config(values),
                    alerts=alert_config(values, corrugation.lead_time_days),
                    stamps=values_of(StampParams, resolve(STAMP_SPECS, section(values, "stamps."), "stamps.",
-                                                         strict=True)))
+                                                         strict=True)),
+                   economics=economics_config(values))

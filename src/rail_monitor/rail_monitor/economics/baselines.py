@@ -1,0 +1,58 @@
+"""What a programme is measured against: grinding every site on a fixed cycle, and grinding each
+site when its forecast's median says; and what a schedule costs when the truth is known."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from rail_monitor.economics.outlook import SiteOutlook
+from rail_monitor.economics.programme import MONTH_DAYS, Law, Rules, offset_days, schedule_terms, visit_risks
+
+
+def fixed_cycle(outlooks: Sequence[SiteOutlook], rules: Rules, every: int) -> list[np.ndarray]:
+    """Every site visited each ``every`` months whatever its forecast, the sites' phases spread
+    over the cycle (site i first in month i mod every) as a grinding train's round would."""
+    return [np.arange(i % every, rules.months, every) for i in range(len(outlooks))]
+
+
+def when_due(outlooks: Sequence[SiteOutlook], rules: Rules) -> list[np.ndarray]:
+    """Each site visited in the month of its due date's median, then at its cycle's median, with
+    no capacity or budget (months rounded to the nearest, at least one apart)."""
+    out = []
+    for o in outlooks:
+        due, cycle = Law.through(o.due_days), Law.through(o.cycle_days)
+        if not np.isfinite(due.mu):
+            out.append(np.zeros(0, int))
+            continue
+        first = max(0, round((due.quantile(0.5) - offset_days(o, rules)) / MONTH_DAYS))
+        step = max(1, round(cycle.quantile(0.5) / MONTH_DAYS)) if np.isfinite(cycle.mu) else rules.months
+        out.append(np.arange(first, rules.months, step))
+    return out
+
+
+def expected(outlooks: Sequence[SiteOutlook], rules: Rules, visits: Sequence[np.ndarray]) -> tuple[np.ndarray, ...]:
+    """Per site: (expected cost, largest gap risk, expected thresholds passed first) of schedules."""
+    rows = []
+    for o, v in zip(outlooks, visits, strict=True):
+        risks = visit_risks(o, rules, v)
+        rows.append((schedule_terms(o, risks, rules)[0], risks.max(), risks.sum()))
+    return tuple(np.array(c) for c in zip(*rows, strict=True)) if rows else (np.zeros(0),) * 3
+
+
+def realised(o: SiteOutlook, rules: Rules, visits: np.ndarray, due_days: float, cycle_days: float) -> tuple[float, int]:
+    """(cost, thresholds passed first) of a schedule on a site whose true days to threshold now
+    and after a grind are known: a visit after the threshold is corrective; a threshold passed
+    between the last visit and the horizon owes a corrective visit, as in the plan."""
+    cross = due_days - offset_days(o, rules)       # days from the start
+    cost, late = 0.0, 0
+    for m in np.asarray(visits, float) * MONTH_DAYS:
+        passed = m >= cross
+        cost += o.late_visit_cost if passed else o.visit_cost
+        late += int(passed)
+        cross = m + cycle_days
+    if rules.months * MONTH_DAYS > cross:
+        cost += o.late_visit_cost
+        late += 1
+    return cost, late

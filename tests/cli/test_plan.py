@@ -1,0 +1,88 @@
+"""rail-monitor plan (issue 57): a manifest of sites read as histories or checkpoints into their
+grinding outlooks, the programme printed and written, and bad input refused in one line."""
+
+from __future__ import annotations
+
+import csv
+import re
+
+import numpy as np
+import pytest
+
+from rail_monitor.batch.sites import SiteJob, outlook_site, read_manifest
+from rail_monitor.cli import main
+from rail_monitor.core.errors import ConfigError
+
+from conftest import write_two_sites
+
+
+@pytest.fixture(scope="module")
+def network(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("network")
+    write_two_sites(tmp, 3.0)
+    _checkpoint(tmp / "curve_400.yaml", tmp / "b.csv", tmp / "b.npz")
+    (tmp / "sites.yaml").write_text("sites:\n  - site: curve_250.yaml\n    history: a.csv\n"
+                                    "  - site: curve_400.yaml\n    checkpoint: b.npz\n")
+    return tmp
+
+
+def _checkpoint(site, history, path):
+    """The corrugation checkpoint a live site engine would hold after the history."""
+    from rail_monitor.bagio.reader import read_passes
+    from rail_monitor.core.passes import rejection_reasons, with_class_defaults
+    from rail_monitor.corrugation.estimator import CorrugationEstimator
+    from rail_monitor.engine import checkpoint
+    from rail_monitor.engine.site_config import SiteConfig
+    from rail_monitor.site_file import load_parameter_file
+
+    cfg = SiteConfig.from_values(load_parameter_file(site))
+    est = CorrugationEstimator(cfg.site, cfg.corrugation)
+    passes = read_passes(history)
+    est.advance(with_class_defaults(passes.take(rejection_reasons(passes, cfg.site) == ""), cfg.site))
+    checkpoint.save(est, path)
+
+
+def test_a_checkpoint_gives_the_outlook_its_history_gives(network):
+    """A live site's checkpoint (engine.checkpoint, written after its history) and the history itself give
+    the same due dates, cycle and costs, to the bit."""
+    site = network / "curve_400.yaml"
+    a = outlook_site(SiteJob(site, network / "b.csv", None))
+    b = outlook_site(SiteJob(site, None, None, network / "b.npz"))
+    assert a.newest_ns == b.newest_ns and a.visit_cost == b.visit_cost
+    np.testing.assert_array_equal(a.due_days, b.due_days)
+    np.testing.assert_array_equal(a.cycle_days, b.cycle_days)
+    assert np.all(np.isfinite(a.due_days)) and a.due_days[0] < a.due_days[2]
+
+
+def test_plan_prints_and_writes_the_programme(network, capsys):
+    """Both sites ranked, a programme of three years within one visit a month, the two baselines
+    priced beside it; the CSV holds a row per visit and the workbook the same rows and the sites."""
+    out = network / "programme.csv"
+    assert main(["plan", str(network / "sites.yaml"), "--workers", "1", "--years", "3", "--capacity", "1",
+                 "--csv", str(out), "--xlsx", str(network / "programme.xlsx")]) == 0
+    printed = capsys.readouterr().out
+    assert "2 sites, 36 months" in printed and "curve_250" in printed and "curve_400" in printed
+    assert re.search(r"plan: programme: [0-9]+ visits, expected cost [0-9]+", printed)
+    assert re.search(r"plan: fixed [0-9]+-month cycle: [0-9]+ visits", printed)
+    assert "plan: when due (forecast median): " in printed
+    rows = list(csv.DictReader(out.open()))
+    months = [r["month_start"] for r in rows]
+    assert rows and len(set(months)) == len(months)          # capacity 1: never two visits in a month
+    assert {r["site_id"] for r in rows} <= {"curve_250", "curve_400"}
+    import pandas as pd
+
+    book = pd.read_excel(network / "programme.xlsx", sheet_name=None)
+    assert set(book) == {"programme", "sites"} and len(book["programme"]) == len(rows)
+
+
+def test_bad_plan_input_is_one_line(network, capsys):
+    """A manifest entry with a history and a checkpoint, a checkpoint given to batch, a risk out of range."""
+    m = network / "bad.yaml"
+    m.write_text("sites:\n  - site: curve_250.yaml\n    history: a.csv\n    checkpoint: b.npz\n")
+    with pytest.raises(ConfigError, match="history or checkpoint"):
+        read_manifest(m, checkpoints=True)
+    with pytest.raises(ConfigError, match="expected the keys"):
+        read_manifest(network / "sites.yaml")                # a checkpoint is plan's, not batch's
+    assert main(["plan", str(network / "sites.yaml"), "--risk", "1.5"]) == 2
+    err = capsys.readouterr().err
+    assert "--risk in (0, 1)" in err and len(err.strip().splitlines()) == 1
