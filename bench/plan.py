@@ -1,17 +1,27 @@
 """The network grinding programme (rail-monitor plan's solver): sites x years solved without a
-capacity, and with a capacity of 85 % of that programme's busiest month, in one run.
+capacity, and with a capacity of 85 % of that programme's busiest month, in one run; and with
+--simulated N, a network simulated whole (rail-monitor simulate --network: each curve's history and
+surveys of a true rail), planned from its histories, its realised cost over the horizon on the true
+rails against a fixed cycle and grinding at the median forecast.
 
-Run alone: ros2_ws/run python -m bench.plan [--sites 500] [--years 5]
+Run alone: ros2_ws/run python -m bench.plan [--sites 500] [--years 5] [--simulated 50 --days 90]
 """
 
 from __future__ import annotations
 
 import argparse
+import csv
+import tempfile
+import time
+from pathlib import Path
 
 import numpy as np
 
 import bench  # noqa: F401  (private DDS domain, one maths thread)
-from rail_monitor.economics.programme import Rules, plan
+from rail_monitor.batch.sites import outlook_site, read_manifest
+from rail_monitor.cli import main as cli
+from rail_monitor.economics import baselines
+from rail_monitor.economics.programme import MONTH_DAYS, Law, Rules, plan
 from rail_monitor.simulation.network import network_outlooks
 
 Row = tuple[str, str, str]
@@ -30,12 +40,43 @@ def rows(sites: int, years: int) -> list[Row]:
              f"of the unlimited; largest risk {100 * held.risk.max():.1f} %; {held.status.split('(')[0]}")]
 
 
+def simulated_rows(curves: int, days: float, years: int) -> list[Row]:
+    with tempfile.TemporaryDirectory() as tmp:
+        net = Path(tmp) / "net"
+        t = time.perf_counter()
+        assert cli(["simulate", "--network", str(curves), "--days", str(days), "--out", str(net)]) == 0
+        simulated = time.perf_counter() - t
+        truth = {r["site_id"]: r for r in csv.DictReader((net / "truth.csv").open())}
+        t = time.perf_counter()
+        outlooks = [outlook_site(job) for job in read_manifest(net / "sites.yaml", checkpoints=True)]
+        read = time.perf_counter() - t
+    rules = Rules(12 * years, max(o.newest_ns for o in outlooks))
+    every = max(1, round(float(np.median([Law.through(o.cycle_days).quantile(0.5) for o in outlooks])) / MONTH_DAYS))
+    runs = {"programme": plan(outlooks, rules).visits, f"fixed {every}-month cycle": baselines.fixed_cycle(
+        outlooks, rules, every), "at the median forecast": baselines.when_due(outlooks, rules)}
+    spread = np.median([np.log(o.cycle_days[2] / o.cycle_days[0]) / 2.5631 for o in outlooks])
+    rows = [(f"simulated network, {curves} curves x {days:g} days", f"{simulated:.0f} s",
+             f"simulated with monthly surveys; read into outlooks in {read:.0f} s; median ln-spread of the "
+             f"cycle {spread:.2f}")]
+    for name, visits in runs.items():
+        res = [baselines.realised(o, rules, v, float(truth[o.site_id]["true_due_days"]),
+                                  float(truth[o.site_id]["true_cycle_days"]))
+               for o, v in zip(outlooks, visits, strict=True)]
+        n = sum(len(v) for v in visits)
+        rows.append((f"  realised over {years} years on the true rails: {name}", f"{sum(r[0] for r in res):,.0f}",
+                     f"{n} visits, {sum(r[1] for r in res)} thresholds passed first"))
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--sites", type=int, default=500)
     ap.add_argument("--years", type=int, default=5)
+    ap.add_argument("--simulated", type=int, default=0, help="also a network of this many curves simulated whole")
+    ap.add_argument("--days", type=float, default=90.0, help="history of each simulated curve [day]")
     ns = ap.parse_args()
-    for what, figure, note in rows(ns.sites, ns.years):
+    out = rows(ns.sites, ns.years) + (simulated_rows(ns.simulated, ns.days, ns.years) if ns.simulated else [])
+    for what, figure, note in out:
         print(f"{what:55s} {figure:>10s}  {note}")
 
 

@@ -56,10 +56,12 @@ def test_a_checkpoint_gives_the_outlook_its_history_gives(network):
 
 def test_plan_prints_and_writes_the_programme(network, capsys):
     """Both sites ranked, a programme of three years within one visit a month, the two baselines
-    priced beside it; the CSV holds a row per visit and the workbook the same rows and the sites."""
+    priced beside it; the CSV holds a row per visit, the workbook the same rows and the sites, and the
+    timeline is a PNG."""
     out = network / "programme.csv"
     assert main(["plan", str(network / "sites.yaml"), "--workers", "1", "--years", "3", "--capacity", "1",
-                 "--csv", str(out), "--xlsx", str(network / "programme.xlsx")]) == 0
+                 "--csv", str(out), "--xlsx", str(network / "programme.xlsx"), "--plot",
+                 str(network / "timeline.png")]) == 0
     printed = capsys.readouterr().out
     assert "2 sites, 36 months" in printed and "curve_250" in printed and "curve_400" in printed
     assert re.search(r"plan: programme: [0-9]+ visits, expected cost [0-9]+", printed)
@@ -73,6 +75,7 @@ def test_plan_prints_and_writes_the_programme(network, capsys):
 
     book = pd.read_excel(network / "programme.xlsx", sheet_name=None)
     assert set(book) == {"programme", "sites"} and len(book["programme"]) == len(rows)
+    assert (network / "timeline.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_bad_plan_input_is_one_line(network, capsys):

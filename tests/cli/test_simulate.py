@@ -26,3 +26,34 @@ def test_a_measured_site_simulates_into_one_bag_and_batch_names_its_defective_ve
     alerts = read_messages(tmp_path / "out", ["rail_msgs/msg/WaysideAlert"])["rail_msgs/msg/WaysideAlert"]
     named = {a.key.removeprefix("vehicle ") for a in alerts if a.kind == KIND_WHEEL_DEFECT and a.active}
     assert defective <= named
+
+
+def test_a_network_of_curves_with_its_manifest_and_truth(tmp_path, capsys):
+    """simulate --network: each curve its own site file (radius, traffic, wet weather drawn), history bag
+    and true rail's surveys; the manifest plan reads; truth.csv with the true K_b factor and the true
+    rail's due date and cycle, the cycle from a fresh grind beyond the days left of the current one;
+    the same seed gives the same network; an existing folder is refused unless --force."""
+    import csv
+
+    from rail_monitor.batch.sites import read_manifest
+    from rail_monitor.site_file import load_parameter_file
+
+    out = tmp_path / "net"
+    args = ["simulate", "--network", "2", "--days", "6", "--surveys-every-days", "2", "--out", str(out)]
+    assert main(args) == 0
+    assert "wrote 2 curves" in capsys.readouterr().out
+    truth = list(csv.DictReader((out / "truth.csv").open()))
+    jobs = read_manifest(out / "sites.yaml", checkpoints=True)
+    assert [j.site.stem for j in jobs] == [r["site_id"] for r in truth] == ["curve_000", "curve_001"]
+    sites = [load_parameter_file(j.site) for j in jobs]
+    assert sites[0]["curve_radius_m"] != sites[1]["curve_radius_m"]
+    assert sites[0]["simulator.trains_per_hour"] != sites[1]["simulator.trains_per_hour"]
+    for job, row in zip(jobs, truth, strict=True):
+        assert len(read_bag_passes(job.history)) == int(row["passes"]) > 0
+        assert len(read_bag_events(job.history)) == int(row["surveys"]) == 3
+        assert 0.3 <= float(row["k_b_factor"]) <= 3.0
+        assert 0 < float(row["true_due_days"]) < float(row["true_cycle_days"])
+    assert main(args) == 2
+    assert "exists" in capsys.readouterr().err
+    assert main([*args, "--force"]) == 0
+    assert list(csv.DictReader((out / "truth.csv").open())) == truth

@@ -26,14 +26,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--force", action="store_true", help="replace an existing bag folder that rail_monitor created")
     t = s.add_argument_group("a measured site: a true rail, its surveys and a noise station (into the bag)")
     t.add_argument("--k-b-factor", type=float, default=1.0, help="the true rail's K_b over the configured one [-]")
-    t.add_argument("--surveys-every-days", type=float, default=0.0,
-                   help="roughness surveys of the true rail, 1 dB per band, every so many days (0: none)")
+    t.add_argument("--surveys-every-days", type=float, default=None,
+                   help="roughness surveys of the true rail, 1 dB per band, every so many days (default: none; "
+                   "with --network, 30)")
     t.add_argument("--measured", action="store_true", help="a noise station measuring every pass of the true rail "
                    "(4 vehicles with wheel flats among the fleets; their ids are printed)")
     t.add_argument("--measured-csv", help="also write the station's measurements as its CSV")
     t.add_argument("--true-creep", action="append", default=[], metavar="STATE=K1,K2",
                    help="the true rail's creep curve of a friction state (dry, wet, friction_modifier, contaminated), "
                    "kept from the fitting: the station hears squeal by it (repeatable)")
+    n = s.add_argument_group("a network of curves (for rail-monitor plan)")
+    n.add_argument("--network", type=int, default=0, metavar="N",
+                   help="write N curves varied from the site file into the folder --out: radius, traffic, wet "
+                   "weather and a true K_b of their own, each with its site file and its history bag with the true "
+                   "rail's surveys, a manifest (sites.yaml) and each true rail's K_b, due date and cycle (truth.csv)")
     s.set_defaults(func=run)
 
 
@@ -49,6 +55,9 @@ def run(ns: argparse.Namespace) -> int:
         values["simulator.days"] = ns.days
     if ns.seed is not None:
         values["simulator.seed"] = ns.seed
+    if ns.network:
+        return _network(ns, values)
+    ns.surveys_every_days = ns.surveys_every_days or 0.0
     site = site_from_values(values)
     cfg = simulator_config(values)
     table = simulate(site, cfg)
@@ -120,3 +129,58 @@ def parse_true_creep(items: list[str]) -> dict[str, tuple[float, float]]:
                                    "0 < K1 < 2 and -1 < K2 < 1")
         out[state] = (k1, k2)
     return out
+
+
+def _network(ns: argparse.Namespace, values: dict) -> int:
+    """simulate --network: N curves from the site file (simulation.network), each simulated with its
+    true rail's surveys, into one folder with a manifest and the truth."""
+    import csv
+
+    from rail_monitor.bagio.output_folder import claim_output_folder
+    from rail_monitor.bagio.passes_bag import write_passes_bag
+    from rail_monitor.cli.common import site_file
+    from rail_monitor.cli.site import edited_site_text
+    from rail_monitor.core.simulator_params import simulator_config
+    from rail_monitor.core.site import site_from_values
+    from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
+    from rail_monitor.simulation.network import network_sites, true_outlook_days
+    from rail_monitor.simulation.simulator import applicator_events, simulate
+    from rail_monitor.simulation.surveys import simulate_surveys
+    from rail_monitor.site_file import load_parameter_file
+
+    every = 30.0 if ns.surveys_every_days is None else ns.surveys_every_days
+    if not ns.out or ns.csv or ns.measured or ns.measured_csv or ns.true_creep or ns.k_b_factor != 1.0:
+        raise RailMonitorError("--network writes a folder: give --out DIR, and no --csv, --measured, --true-creep "
+                               "or --k-b-factor (each curve draws its own)")
+    if not 1 <= ns.network <= 10_000 or every < 0:
+        raise RailMonitorError("--network must be 1-10000 curves and --surveys-every-days not negative")
+    out = Path(ns.out)
+    fresh_output(out, ns.force)
+    claim_output_folder(out)
+    base = site_file(ns.site).read_text()
+    extra = [f"simulator.days={values['simulator.days']}"]
+    rows = []
+    for curve in network_sites(ns.network, int(values["simulator.seed"]), values["simulator.trains_per_hour"]):
+        text, _ = edited_site_text(base, [*curve.changes, *extra])
+        (out / f"{curve.site_id}.yaml").write_text(text)
+        v = load_parameter_file(out / f"{curve.site_id}.yaml")
+        site, cfg = site_from_values(v), simulator_config(v)
+        table = simulate(site, cfg)
+        events = []
+        if every > 0:
+            series = simulate_surveys(site, v, table, curve.k_b_factor, every, 1.0, int(v["simulator.seed"]) + 100)
+            events = [MaintenanceEvent(int(t), KIND_SURVEY, series.wavelength_m, series.amplitude_m[k])
+                      for k, t in enumerate(series.stamp_ns.tolist())]
+        write_passes_bag(table, out / curve.site_id, site.site_id, events=events, applicators=applicator_events(cfg))
+        due, cycle = true_outlook_days(site, v, table, curve.k_b_factor)
+        rows.append({"site_id": curve.site_id, "k_b_factor": curve.k_b_factor, "curve_radius_m": site.curve_radius_m,
+                     "passes": len(table), "surveys": len(events), "true_due_days": due, "true_cycle_days": cycle})
+    (out / "sites.yaml").write_text("sites:\n" + "".join(f"  - site: {r['site_id']}.yaml\n    history: {r['site_id']}\n"
+                                                         for r in rows))
+    with (out / "truth.csv").open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    print(f"wrote {len(rows)} curves ({sum(r['passes'] for r in rows)} passes, surveys every {every:g} days) to {out}: "
+          f"sites.yaml for rail-monitor plan, truth.csv with each true rail's K_b factor, due date and cycle")
+    return 0

@@ -4,16 +4,17 @@ its visit held to a limit, within a capacity of visits per month and a budget pe
 
 Each site's forecast (economics.outlook) gives the days to its threshold now and after a grind,
 as P10/P50/P90; each is taken as log-normal through them (median P50, ln-spread from P10-P90).
-A site's candidate schedules are a first visit in a month up to its due date's median (or up to
-``pull_forward`` months before its earliest plausible date), then repeat visits at a gap of
-its cycle's 1, 3, 10 or 30 % quantile. A gap's risk is the chance the threshold comes first; a
-visit costs its preventive cost plus that risk times the corrective visit's extra; the span from
-the last visit to the horizon adds its risk times a corrective visit (one is then owed). A risk above the limit is
-charged RISK_WEIGHT late visits per unit of excess, so the limit holds wherever capacity and
-budget allow it and the problem is never infeasible. Choosing one schedule per site is a set
-partition, solved exactly by scipy.optimize.milp (HiGHS branch and cut): already a dependency,
-and its LP relaxation of a partition with few capacity rows is nearly integral, so 500 sites
-solve in seconds (bench.plan). Gaps are treated as independent draws of the cycle
+A site's candidate schedules are no visit, or a first visit in a month from ``pull_forward``
+months before its due date's EARLIEST quantile up to its quantile max(GAP_RISKS), then repeat
+visits at a gap of one of the cycle's GAP_RISKS quantiles. A gap's risk is the chance the
+threshold comes first; a visit costs its preventive cost plus that risk times the corrective
+visit's extra; the span from the last visit to the horizon adds its risk times a corrective visit
+(one is then owed). A gap whose risk is above the limit is charged OVER_LIMIT corrective visits,
+and RISK_WEIGHT more per unit of excess, so the limit holds wherever capacity and budget allow it
+and the problem is never infeasible. Choosing one schedule per site is a set partition, solved by
+scipy.optimize.milp (HiGHS branch and cut, to a 1 % gap): already a dependency, and its LP
+relaxation of a partition with few capacity rows is nearly integral, so 500 sites solve in
+seconds (bench.plan). Gaps are treated as independent draws of the cycle
 (docs/models.md, "Grinding economics and a programme for a network").
 """
 
@@ -33,7 +34,8 @@ MONTH_DAYS = DAYS_PER_YEAR / 12
 Z90 = float(special.ndtri(0.9))
 GAP_RISKS = (0.01, 0.03, 0.1, 0.2, 0.3, 0.5, 0.7)  # a schedule's repeat gaps: these quantiles of the cycle
 EARLIEST = 0.001                     # quantile of the due date from which pull_forward counts
-RISK_WEIGHT = 1.0e4                  # late visits charged per unit of risk above the limit
+RISK_WEIGHT = 1.0e3                  # late visits charged per unit of risk above the limit
+OVER_LIMIT = 10.0                    # and per gap above it at all: the limit holds where it can
 SHORTEST_DAYS = 1e-3                 # a forecast of 0 days (due now), as a log-normal
 
 
@@ -122,7 +124,8 @@ def schedule_terms(o: SiteOutlook, risks: np.ndarray, rules: Rules) -> tuple[flo
     extra = o.late_visit_cost - o.visit_cost
     expected = (len(risks) - 1) * o.visit_cost + float(risks[:-1].sum()) * extra + float(risks[-1]) * o.late_visit_cost
     excess = float(np.maximum(risks - rules.risk_limit, 0.0).sum())
-    return expected, expected + RISK_WEIGHT * o.late_visit_cost * excess
+    over = int((risks > rules.risk_limit).sum())
+    return expected, expected + o.late_visit_cost * (RISK_WEIGHT * excess + OVER_LIMIT * over)
 
 
 def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
@@ -153,10 +156,11 @@ def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
     lates = p_first + repeats * p_gap + tail
     excess = (np.maximum(p_first - limit, 0) + repeats * np.maximum(p_gap - limit, 0)
               + np.maximum(tail - limit, 0))
+    over = (p_first > limit) + repeats * (p_gap > limit) + (tail > limit)
     expected = n * o.visit_cost + (p_first + repeats * p_gap) * extra + tail * o.late_visit_cost
     risk = np.maximum(np.maximum(p_first, tail), p_gap)
-    return Schedules(expected + RISK_WEIGHT * o.late_visit_cost * excess, expected, risk, lates,
-                     np.concatenate(first), np.concatenate(gap))
+    charged = expected + o.late_visit_cost * (RISK_WEIGHT * excess + OVER_LIMIT * over)
+    return Schedules(charged, expected, risk, lates, np.concatenate(first), np.concatenate(gap))
 
 
 def months_of(first: int, gap: int, months: int) -> np.ndarray:

@@ -1,13 +1,22 @@
-"""A network of sites as a grinding programme sees it (economics.outlook.SiteOutlook), with each
-site's truth: for tests and benchmarks of rail-monitor plan, where the forecasts must be known to
-be right (the truth is drawn from them)."""
+"""Networks of curves for rail-monitor plan's tests, benchmarks and demos: forecasts with their
+truth drawn from them (network_outlooks, true_days); and sites to simulate whole, each a variation
+of one site file with its own radius, traffic, wet weather and true K_b (network_sites), with the
+true rail's due date and cycle once its history has run (true_outlook_days)."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
+from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.site import Site
+from rail_monitor.corrugation.surveys import apply_grinding
 from rail_monitor.economics.outlook import SiteOutlook
 from rail_monitor.economics.programme import Z90, Law
+from rail_monitor.simulation.surveys import true_estimator
 
 DAY_NS = 86_400 * 10**9
 
@@ -33,3 +42,42 @@ def true_days(outlooks: list[SiteOutlook], seed: int) -> tuple[np.ndarray, np.nd
     laws = [(Law.through(o.due_days), Law.through(o.cycle_days)) for o in outlooks]
     return (np.array([np.exp(d.mu + d.sigma * zi) for (d, _), zi in zip(laws, z, strict=True)]),
             np.array([np.exp(c.mu + c.sigma * zi) for (_, c), zi in zip(laws, z, strict=True)]))
+
+
+@dataclass(frozen=True)
+class NetworkSite:
+    """One curve of a simulated network: the edits of the base site file (NAME=VALUE) that make it,
+    and its true rail's K_b over the configured one."""
+
+    site_id: str
+    changes: list[str]
+    k_b_factor: float
+
+
+def network_sites(n: int, seed: int, trains_per_hour: Sequence[float]) -> list[NetworkSite]:
+    """n curves: radius log-uniform in 150-1,200 m, the base timetable scaled by 0.5-2, a wet
+    fraction of 0.05-0.35, and a true K_b off the configured one by a log-normal factor (ln-sd 0.5,
+    kept within 0.3-3): what the site's surveys must find."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        radius = float(np.exp(rng.uniform(np.log(150.0), np.log(1200.0))))
+        profile = np.round(np.asarray(trains_per_hour, float) * rng.uniform(0.5, 2.0), 2)
+        wet, factor = rng.uniform(0.05, 0.35), float(np.clip(np.exp(rng.normal(0.0, 0.5)), 0.3, 3.0))
+        site_id = f"curve_{i:03d}"
+        out.append(NetworkSite(site_id, [f"site_id={site_id}", f"curve_radius_m={radius:.0f}",
+                                         f"simulator.trains_per_hour=[{', '.join(f'{x:g}' for x in profile)}]",
+                                         f"simulator.wet_fraction={wet:.3f}", f"simulator.seed={seed * 1000 + i}"],
+                               round(factor, 3)))
+    return out
+
+
+def true_outlook_days(site: Site, values: Mapping[str, Any], passes: PassTable, k_b_factor: float
+                      ) -> tuple[float, float]:
+    """The true rail's days to its threshold after the passes, and after a grind then, at the
+    recent traffic (CorrugationEstimator.forecast of the true K_b: what a site's forecast estimates)."""
+    truth = true_estimator(site, values, k_b_factor)
+    truth.advance(with_class_defaults(passes.take(rejection_reasons(passes, site) == ""), site))
+    due = truth.forecast().days_to_threshold
+    apply_grinding(truth, truth.newest_ns)
+    return float(due), float(truth.forecast().days_to_threshold)
