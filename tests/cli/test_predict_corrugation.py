@@ -90,6 +90,12 @@ def test_the_papers_scenario_asked_directly_lengthens_the_grinding_interval(tmp_
                  "--speed-cv", "0.05", "--advise", "--json"]) == 0
     a = json.loads(capsys.readouterr().out)["advice"]
     assert 1.4 <= a["grinding_interval_factor"] <= 2.0, a["grinding_interval_factor"]
+    png = tmp_path / "cost.png"
+    assert main(["predict", "corrugation", "--site", str(site), "--vehicle-class", "emu", "--speed-mean", "17",
+                 "--speed-cv", "0.05", "--advise", "--plot-cost", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"   # the paper's Figure 2 in shape
+    assert main(["predict", "corrugation", "--site", str(site), "--plot-cost", str(png)]) == 2
+    assert "--plot-cost compares current and advised speeds" in capsys.readouterr().err
 
 
 def test_an_unreadable_history_is_one_line_and_exit_2(tmp_path, capsys):

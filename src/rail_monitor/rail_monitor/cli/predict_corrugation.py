@@ -7,7 +7,10 @@ import argparse
 import sys
 from pathlib import Path
 
+import numpy as np
+
 from rail_monitor.cli.common import add_site_option, print_json, site_values
+from rail_monitor.core.errors import RailMonitorError
 
 
 def add_parser(models: argparse._SubParsersAction) -> None:
@@ -34,12 +37,16 @@ def add_parser(models: argparse._SubParsersAction) -> None:
     c.add_argument("--json", action="store_true", help="print JSON instead of a table")
     c.add_argument("--plot-receptance", metavar="PNG", help="save the track and wheel receptances to this PNG")
     c.add_argument("--plot-growth", metavar="PNG", help="save growth against wavelength (current and advised)")
+    c.add_argument("--plot-cost", metavar="PNG", help="with --advise: save the worst band's growth over axle passes, "
+                   "ground at its threshold, and the cumulative grinding cost (economics.*), current and advised")
     c.set_defaults(func=run)
 
 
 def run(ns: argparse.Namespace) -> int:
     from rail_monitor.whatif.corrugation import predict_corrugation, summary
 
+    if ns.plot_cost and not ns.advise:
+        raise RailMonitorError("--plot-cost compares current and advised speeds: give --advise too")
     values = site_values(ns.site)
     history, events = None, []
     if ns.history:
@@ -57,6 +64,8 @@ def run(ns: argparse.Namespace) -> int:
         _plot_receptance(r, ns.plot_receptance)
     if ns.plot_growth:
         _plot_growth(r, ns.plot_growth)
+    if ns.plot_cost:
+        _plot_cost(r, values, ns.plot_cost)
     return 0
 
 
@@ -105,3 +114,23 @@ def _plot_growth(r, path: str) -> None:
     print(f"plot: {corrugation_growth(r.estimator.bands, curves, path, title=r.where)}", file=sys.stderr)
 
 
+
+
+CYCLES_SHOWN = 5  # the cost figure spans this many of the current speeds' grinding cycles
+
+
+def _plot_cost(r, values: dict, path: str) -> None:
+    from rail_monitor.economics.config import economics_config
+    from rail_monitor.economics.cycles import sawtooth
+    from rail_monitor.whatif.plots import grinding_cycles
+
+    a = r.advice
+    band = int(np.argmin(np.abs(r.estimator.bands - a.current_peak_wavelength_m)))
+    post, thr = float(r.estimator.post_grinding[band]), float(r.estimator.threshold[band])
+    span = (CYCLES_SHOWN + 0.5) * np.log(thr / post) / a.current_peak_growth if a.current_peak_growth > 0 else 1e6
+    n = np.linspace(0.0, span, 2000)
+    curves = {"current speeds": sawtooth(post, thr, a.current_peak_growth, n),
+              f"advised speeds (x{a.grinding_interval_factor:.2f} interval)": sawtooth(post, thr,
+                                                                                   a.recommended_peak_growth, n)}
+    title = f"{r.where}; worst band {1e3 * r.estimator.bands[band]:.0f} mm"
+    print(f"plot: {grinding_cycles(n, curves, thr, economics_config(values).visit(), path, title)}", file=sys.stderr)

@@ -81,6 +81,29 @@ def corrugation_growth(wavelength: np.ndarray, curves: dict[str, np.ndarray], pa
     return _save(fig, path)
 
 
+def grinding_cycles(axle_passes: np.ndarray, curves: dict[str, tuple[np.ndarray, np.ndarray]], threshold_m: float,
+                    visit_cost: float, path: str | Path, title: str = "") -> Path:
+    """The UQ paper's Figure 2 in shape: (a) the worst band's r.m.s. roughness [um] over axle passes,
+    ground at its threshold, (b) the cumulative grinding cost; one curve per speed distribution
+    (curves: label -> (roughness [m], grinds made) per axle pass)."""
+    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(6.4, 5.6), constrained_layout=True)
+    for label, (z, grinds) in curves.items():
+        top.plot(axle_passes, 1e6 * z, lw=1, label=label)
+        bottom.step(axle_passes, visit_cost * grinds, where="post", label=f"{label}: {grinds[-1]} grinds")
+    top.axhline(1e6 * threshold_m, color="tab:red", lw=0.8, ls="--", label="intervention threshold")
+    top.set_ylabel("worst band r.m.s. [um]")
+    top.set_title("(a) corrugation growth", fontsize="medium")
+    bottom.set_ylabel("cumulative grinding cost [cost unit]")
+    bottom.set_title("(b) grinding cost", fontsize="medium")
+    bottom.set_xlabel("axle passes [-]")
+    for ax in (top, bottom):
+        ax.legend(fontsize="small")
+        ax.grid(True, alpha=0.3)
+    if title:
+        fig.suptitle(textwrap.fill(title, 90), fontsize="small")
+    return _save(fig, path)
+
+
 def noise_spectra(band_hz: np.ndarray, panels: dict[str, dict[str, np.ndarray]], path: str | Path,
                   title: str = "") -> Path:
     """A-weighted 1/3-octave Lp [dB(A)] against band centre [Hz], one panel per group of spectra (the
