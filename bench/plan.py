@@ -21,7 +21,7 @@ import bench  # noqa: F401  (private DDS domain, one maths thread)
 from rail_monitor.batch.sites import outlook_site, read_manifest
 from rail_monitor.cli import main as cli
 from rail_monitor.economics import baselines
-from rail_monitor.economics.programme import MONTH_DAYS, Law, Rules, plan
+from rail_monitor.economics.programme import Z90, Rules, plan
 from rail_monitor.simulation.network import network_outlooks
 
 Row = tuple[str, str, str]
@@ -51,10 +51,10 @@ def simulated_rows(curves: int, days: float, years: int) -> list[Row]:
         outlooks = [outlook_site(job) for job in read_manifest(net / "sites.yaml", checkpoints=True)]
         read = time.perf_counter() - t
     rules = Rules(12 * years, max(o.newest_ns for o in outlooks))
-    every = max(1, round(float(np.median([Law.through(o.cycle_days).quantile(0.5) for o in outlooks])) / MONTH_DAYS))
+    every = baselines.median_cycle_months(outlooks, rules)
     runs = {"programme": plan(outlooks, rules).visits, f"fixed {every}-month cycle": baselines.fixed_cycle(
         outlooks, rules, every), "at the median forecast": baselines.when_due(outlooks, rules)}
-    spread = np.median([np.log(o.cycle_days[2] / o.cycle_days[0]) / 2.5631 for o in outlooks])
+    spread = np.median([np.log(o.cycle_days[2] / o.cycle_days[0]) / (2 * Z90) for o in outlooks])
     rows = [(f"simulated network, {curves} curves x {days:g} days", f"{simulated:.0f} s",
              f"simulated with monthly surveys; read into outlooks in {read:.0f} s; median ln-spread of the "
              f"cycle {spread:.2f}")]

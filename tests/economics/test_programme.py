@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from scipy import stats
 
+from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.economics import baselines
 from rail_monitor.economics.outlook import SiteOutlook
 from rail_monitor.economics.programme import (
-    MONTH_DAYS,
     Z90,
     Law,
     Rules,
@@ -25,13 +25,11 @@ from rail_monitor.economics.programme import (
 )
 from rail_monitor.simulation.network import network_outlooks, true_days
 
-DAY_NS = 86_400 * 10**9
-
 
 def _outlook(i: int, due: float, cycle: float, sd: float, cost: float = 500.0, late: float = 1500.0,
              newest_days: float = 0.0) -> SiteOutlook:
     spread = np.exp(sd * Z90 * np.array([-1.0, 0.0, 1.0]))
-    return SiteOutlook(f"s{i}", int(newest_days * DAY_NS), due * spread, cycle * spread, cost, late, 500.0)
+    return SiteOutlook(f"s{i}", int(newest_days * NS_PER_DAY), due * spread, cycle * spread, cost, late, 500.0)
 
 
 def test_the_law_passes_through_the_forecast_quantiles():
@@ -48,7 +46,7 @@ def test_the_law_passes_through_the_forecast_quantiles():
 def test_every_schedule_costs_what_its_visits_cost():
     """The vectorised candidates (schedules) against each one's months costed gap by gap (visit_risks,
     schedule_terms), to 1e-9 relative; a site already past due and one that never is, too."""
-    rules = Rules(36, 40 * DAY_NS)
+    rules = Rules(36, 40 * NS_PER_DAY)
     for o in (_outlook(0, 200.0, 300.0, 0.3), _outlook(1, 10.0, 150.0, 0.5), _outlook(2, np.inf, np.inf, 0.3)):
         s = schedules(o, rules)
         for k in range(len(s.cost)):
@@ -108,8 +106,7 @@ def test_on_a_network_of_known_truth_the_programme_costs_least():
     sites = network_outlooks(80, 11)
     rules = Rules(60, 0)
     due, cyc = true_days(sites, 5)
-    truth = [Law.through(o.cycle_days) for o in sites]
-    every = round(float(np.median([c.quantile(0.5) for c in truth])) / MONTH_DAYS)
+    every = baselines.median_cycle_months(sites, rules)
     runs = {"programme": plan(sites, rules).visits, "fixed": baselines.fixed_cycle(sites, rules, every),
             "due": baselines.when_due(sites, rules)}
     out = {}

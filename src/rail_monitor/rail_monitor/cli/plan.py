@@ -43,7 +43,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(ns: argparse.Namespace) -> int:
     from rail_monitor.batch.sites import outlook_site, read_manifest, run_sites
     from rail_monitor.economics import baselines
-    from rail_monitor.economics.programme import MONTH_DAYS, Law, Rules, plan
+    from rail_monitor.economics.programme import MONTH_DAYS, Rules, plan
 
     if not 0 < ns.years <= 50 or not 0 < ns.risk < 1 or ns.capacity < 0 or ns.budget < 0 or ns.fixed_cycle_months < 0:
         raise RailMonitorError("--years must be in (0, 50], --risk in (0, 1), and --capacity, --budget and "
@@ -57,9 +57,7 @@ def run(ns: argparse.Namespace) -> int:
     start = parse_iso_ns(ns.start) if ns.start else max(o.newest_ns for o in outlooks)
     rules = Rules(max(1, round(12 * ns.years)), start, ns.capacity, ns.budget, ns.risk)
     prog = plan(outlooks, rules)
-    cycles = [Law.through(o.cycle_days).quantile(0.5) for o in outlooks]
-    finite = [c for c in cycles if np.isfinite(c)]
-    every = ns.fixed_cycle_months or max(1, round(float(np.median(finite)) / MONTH_DAYS)) if finite else rules.months
+    every = ns.fixed_cycle_months or baselines.median_cycle_months(outlooks, rules)
 
     def month(m: int) -> str:
         return format_iso_ns(int(start + m * MONTH_DAYS * NS_PER_DAY))[:10]
@@ -105,7 +103,9 @@ def run(ns: argparse.Namespace) -> int:
 
 
 def _date(newest_ns: int, days: float) -> str:
-    return format_iso_ns(int(newest_ns + days * NS_PER_DAY))[:10] if np.isfinite(days) and days < 36_525 else "never"
+    from rail_monitor.corrugation.forecast import MAX_DATED_DAYS
+
+    return format_iso_ns(int(newest_ns + days * NS_PER_DAY))[:10] if days <= MAX_DATED_DAYS else "never"
 
 
 def _write(ns: argparse.Namespace, outlooks: list, prog, month) -> None:

@@ -17,6 +17,13 @@ def fixed_cycle(outlooks: Sequence[SiteOutlook], rules: Rules, every: int) -> li
     return [np.arange(i % every, rules.months, every) for i in range(len(outlooks))]
 
 
+def median_cycle_months(outlooks: Sequence[SiteOutlook], rules: Rules) -> int:
+    """The fixed cycle a network without forecasts would run: the median of the sites' cycle
+    medians, in whole months (at least one; the horizon where no site ever needs grinding)."""
+    cycles = [c for c in (Law.through(o.cycle_days).quantile(0.5) for o in outlooks) if np.isfinite(c)]
+    return max(1, round(float(np.median(cycles)) / MONTH_DAYS)) if cycles else rules.months
+
+
 def when_due(outlooks: Sequence[SiteOutlook], rules: Rules) -> list[np.ndarray]:
     """Each site visited in the month of its due date's median, then at its cycle's median, with
     no capacity or budget (months rounded to the nearest, at least one apart)."""

@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, sparse, special
 
+from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.economics.outlook import DAYS_PER_YEAR, SiteOutlook
 
@@ -206,7 +207,7 @@ def plan(outlooks: Sequence[SiteOutlook], rules: Rules, time_limit_s: float = 60
                         constraints=optimize.LinearConstraint(a, np.concatenate(lb), np.concatenate(ub)),
                         options={"time_limit": time_limit_s, "mip_rel_gap": 1e-2})
     if res.x is None:
-        raise RuntimeError(f"the grinding programme found no solution: {res.message}")
+        raise RailMonitorError(f"the grinding programme found no solution within {time_limit_s:g} s: {res.message}")
     chosen = np.flatnonzero(res.x > 0.5)
     pick = chosen[np.argsort(col_site[chosen])]
     local = pick - np.concatenate([[0], np.cumsum(sizes)[:-1]])

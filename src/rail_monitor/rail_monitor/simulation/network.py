@@ -18,8 +18,6 @@ from rail_monitor.economics.outlook import SiteOutlook
 from rail_monitor.economics.programme import Z90, Law
 from rail_monitor.simulation.surveys import true_estimator
 
-DAY_NS = 86_400 * 10**9
-
 
 def network_outlooks(n: int, seed: int, spread: tuple[float, float] = (0.15, 0.4), visit_cost: float = 500.0,
                      late_visit_cost: float = 1500.0) -> list[SiteOutlook]:
