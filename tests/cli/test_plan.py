@@ -29,7 +29,7 @@ def network(tmp_path_factory):
 def _checkpoint(site, history, path):
     """The corrugation checkpoint a live site engine would hold after the history."""
     from rail_monitor.bagio.reader import read_passes
-    from rail_monitor.core.passes import rejection_reasons, with_class_defaults
+    from rail_monitor.core.passes import accepted_passes
     from rail_monitor.corrugation.estimator import CorrugationEstimator
     from rail_monitor.engine import checkpoint
     from rail_monitor.engine.site_config import SiteConfig
@@ -38,7 +38,7 @@ def _checkpoint(site, history, path):
     cfg = SiteConfig.from_values(load_parameter_file(site))
     est = CorrugationEstimator(cfg.site, cfg.corrugation)
     passes = read_passes(history)
-    est.advance(with_class_defaults(passes.take(rejection_reasons(passes, cfg.site) == ""), cfg.site))
+    est.advance(accepted_passes(passes, cfg.site))
     checkpoint.save(est, path)
 
 

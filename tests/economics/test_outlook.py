@@ -3,11 +3,13 @@ costs from the site's economics parameters."""
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pytest
 
 from rail_monitor.core.errors import ConfigError
-from rail_monitor.core.passes import rejection_reasons, with_class_defaults
+from rail_monitor.core.passes import accepted_passes
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.surveys import apply_grinding
 from rail_monitor.economics.config import economics_config
@@ -23,8 +25,7 @@ def after_sample(sample_passes):
 
     cfg = SiteConfig.from_values(load_parameter_file(SITE_FILE))
     est = CorrugationEstimator(cfg.site, cfg.corrugation)
-    ok = rejection_reasons(sample_passes, cfg.site) == ""
-    est.advance(with_class_defaults(sample_passes.take(ok), cfg.site))
+    est.advance(accepted_passes(sample_passes, cfg.site))
     return est, cfg
 
 
@@ -35,9 +36,7 @@ def test_the_cycle_is_the_forecast_of_the_rail_ground_now(after_sample):
     est, cfg = after_sample
     outlook = site_outlook(est, cfg.economics)
     np.testing.assert_array_equal(outlook.due_days, est.forecast_interval().days)
-    ground = CorrugationEstimator(cfg.site, cfg.corrugation)
-    ground.__dict__.update({k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in est.__dict__.items()})
-    ground.level_var, ground.growth_by_state = est.level_var.copy(), est.growth_by_state.copy()
+    ground = copy.deepcopy(est)
     apply_grinding(ground, est.newest_ns)
     np.testing.assert_array_equal(outlook.cycle_days, ground.forecast_interval().days)
     assert np.all(np.diff(outlook.cycle_days) >= 0) and np.all(np.diff(outlook.due_days) >= 0)

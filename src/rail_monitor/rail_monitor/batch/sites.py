@@ -112,7 +112,7 @@ def outlook_site(job: SiteJob) -> Any:
     """One site's grinding outlook (economics.outlook.SiteOutlook) from its history, surveys and
     grinding events applied, or from its checkpoint (a task: imports inside, runs on a worker)."""
     from rail_monitor.bagio.reader import read_bag_events, read_passes
-    from rail_monitor.core.passes import rejection_reasons, with_class_defaults
+    from rail_monitor.core.passes import accepted_passes
     from rail_monitor.corrugation.estimator import CorrugationEstimator
     from rail_monitor.economics.outlook import site_outlook
     from rail_monitor.engine import checkpoint
@@ -126,8 +126,7 @@ def outlook_site(job: SiteJob) -> Any:
         checkpoint.load(est, job.checkpoint)
     else:
         passes = read_passes(job.history)
-        ok = rejection_reasons(passes, cfg.site) == ""
-        advance_with_events(est, with_class_defaults(passes.take(ok), cfg.site), read_bag_events(job.history))
+        advance_with_events(est, accepted_passes(passes, cfg.site), read_bag_events(job.history))
     if not est.total_pass_count:
         raise RailMonitorError(f"{job.checkpoint or job.history}: no valid pass of site {cfg.site.site_id}")
     return site_outlook(est, cfg.economics)

@@ -87,15 +87,13 @@ def _measured_site(ns: argparse.Namespace, values: dict, site: Site, table: Pass
     creep = parse_true_creep(ns.true_creep)
     if ns.surveys_every_days > 0:
         from rail_monitor.core.site import site_from_values
-        from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
         from rail_monitor.simulation.measurements import true_values
         from rail_monitor.simulation.surveys import simulate_surveys
 
         truth = true_values(values, creep)
         series = simulate_surveys(site_from_values(truth) if creep else site, truth, table, ns.k_b_factor,
                                   ns.surveys_every_days, 1.0, int(values["simulator.seed"]) + 100)
-        events = [MaintenanceEvent(int(t), KIND_SURVEY, series.wavelength_m, series.amplitude_m[k])
-                  for k, t in enumerate(series.stamp_ns.tolist())]
+        events = series.events()
         print(f"true rail: K_b x {ns.k_b_factor:g} = {', '.join(f'{k:.3g}' for k in series.true_k_b)} "
               "(dry, wet, modifier, contaminated)")
     if ns.measured or ns.measured_csv:
@@ -142,7 +140,6 @@ def _network(ns: argparse.Namespace, values: dict) -> int:
     from rail_monitor.cli.site import edited_site_text
     from rail_monitor.core.simulator_params import simulator_config
     from rail_monitor.core.site import site_from_values
-    from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
     from rail_monitor.simulation.network import network_sites, true_outlook_days
     from rail_monitor.simulation.simulator import applicator_events, simulate
     from rail_monitor.simulation.surveys import simulate_surveys
@@ -169,8 +166,7 @@ def _network(ns: argparse.Namespace, values: dict) -> int:
         events = []
         if every > 0:
             series = simulate_surveys(site, v, table, curve.k_b_factor, every, 1.0, int(v["simulator.seed"]) + 100)
-            events = [MaintenanceEvent(int(t), KIND_SURVEY, series.wavelength_m, series.amplitude_m[k])
-                      for k, t in enumerate(series.stamp_ns.tolist())]
+            events = series.events()
         write_passes_bag(table, out / curve.site_id, site.site_id, events=events, applicators=applicator_events(cfg))
         due, cycle = true_outlook_days(site, v, table, curve.k_b_factor)
         rows.append({"site_id": curve.site_id, "k_b_factor": curve.k_b_factor, "curve_radius_m": site.curve_radius_m,

@@ -316,3 +316,9 @@ def synthetic_passes(site: Site, cls: VehicleClass, speeds: np.ndarray, vehicles
         stamp_ns=np.arange(1, n + 1), train_id=[f"speed {v:g}" for v in speeds], vehicle_class=[cls.name] * n,
         vehicle_count=[vehicles] * n, axle_count=[0] * n, speed_mps=speeds, angle_of_attack_rad=[0.0] * n,
         wheel_load_n=[0.0] * n, friction_state=[FRICTION_BY_NAME["dry"]] * n, train_length_m=[0.0] * n), site)
+
+
+def accepted_passes(table: PassTable, site: Site) -> PassTable:
+    """The rows the site accepts (:func:`rejection_reasons` empty), class defaults filled: what
+    the models advance on."""
+    return with_class_defaults(table.take(rejection_reasons(table, site) == ""), site)

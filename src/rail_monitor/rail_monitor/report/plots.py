@@ -28,7 +28,8 @@ from rail_monitor.report.tables import METRIC_LABELS
 CLASS_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 
 
-def _dates(stamp_ns: np.ndarray) -> np.ndarray:
+def dates(stamp_ns: np.ndarray) -> np.ndarray:
+    """Stamps [ns] as numpy datetimes, what matplotlib plots on a date axis."""
     return np.asarray(stamp_ns, np.int64).astype("datetime64[ns]")
 
 
@@ -60,7 +61,7 @@ def class_colours(classes: list[str]) -> dict[str, str]:
 def corrugation(states: Mapping[str, np.ndarray], zone: str, bands_shown: int = 4) -> Figure:
     """r.m.s. roughness of the bands nearest their thresholds against pass time, with each band's
     threshold (dashed), grinding events and the worst band's forecast to its threshold (dotted)."""
-    t = _dates(states["stamp"])
+    t = dates(states["stamp"])
     amp, thr, lam = states["amplitude_m"], states["threshold_m"], states["wavelength_m"]
     shown = np.argsort(-(amp[-1] / thr[-1]))[:bands_shown]
     fig, ax = plt.subplots(figsize=(8.0, 4.6), constrained_layout=True)
@@ -70,11 +71,11 @@ def corrugation(states: Mapping[str, np.ndarray], zone: str, bands_shown: int = 
     w = int(states["worst_band"][-1])
     due = int(states["grinding_due_time"][-1])
     if due and w in shown:
-        end = _dates(np.array([due]))[0]
+        end = dates(np.array([due]))[0]
         ax.semilogy([t[-1], end], [1e6 * amp[-1, w], 1e6 * thr[-1, w]], ":", color="k",
                     label=f"forecast, {1e3 * lam[w]:.1f} mm band")
     for k, g in enumerate(sorted(set(states["last_grinding_time"].tolist()) - {0})):
-        ax.axvline(_dates(np.array([g]))[0], color="grey", lw=1.5, label="grinding" if k == 0 else None)
+        ax.axvline(dates(np.array([g]))[0], color="grey", lw=1.5, label="grinding" if k == 0 else None)
     ax.set_ylabel("r.m.s. roughness [µm]")
     plain_log_ticks(ax.yaxis)
     _time_axis(ax, zone)
@@ -97,7 +98,7 @@ def noise(t: Mapping[str, np.ndarray], models: list[str], lim: Mapping[str, Any]
     for ax, model in zip(axes[:-1], models, strict=True):
         for cls, colour in colours.items():
             m = ok & (t["vehicle_class"] == cls)
-            ax.plot(_dates(t["stamp_ns"][m]), t[f"{model}_{lim['metric']}"][m], ".", ms=2, color=colour, label=cls)
+            ax.plot(dates(t["stamp_ns"][m]), t[f"{model}_{lim['metric']}"][m], ".", ms=2, color=colour, label=cls)
         ax.axhline(lim["limit_dba"], color="tab:red", lw=1.2, label=f"limit {lim['limit_dba']:g} dB(A)")
         ax.set_ylabel(f"{metric} [dB(A)]")
         ax.set_title(f"{metric} at the receiver, {model} model", fontsize="medium")
@@ -144,7 +145,7 @@ def squeal_fits(fits: Mapping[str, Mapping[str, np.ndarray]], zone: str) -> Figu
     falling slope k2, P50 with the P10-P90 band at each fit, the configured value dashed."""
     fig, axes = plt.subplots(2, 1, sharex=True, figsize=(8.0, 5.6), constrained_layout=True)
     for j, (state, f) in enumerate(fits.items()):
-        t = _dates(f["stamp_ns"])
+        t = dates(f["stamp_ns"])
         for ax, k in zip(axes, ("k1", "k2"), strict=True):
             ax.fill_between(t, f[f"{k}_p10"], f[f"{k}_p90"], step="post", color=f"C{j}", alpha=0.25)
             ax.step(t, f[f"{k}_p50"], where="post", color=f"C{j}", label=f"{state}, P50 (band: P10-P90)")
@@ -187,7 +188,7 @@ def timeline(days: Mapping[str, np.ndarray], models: list[str], lim: Mapping[str
     """Per local day: passes and squealing passes (bars), and the day's highest noise metric per model
     against the limit."""
     fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(8.0, 5.6), constrained_layout=True)
-    t = _dates(days["day_ns"])
+    t = dates(days["day_ns"])
     width = np.timedelta64(20, "h")
     ax1.bar(t, days["passes"], width, align="edge", color="lightgrey", label="passes")
     ax1.bar(t, days["squealing"], width, align="edge", color="tab:red",
@@ -219,7 +220,7 @@ def measured(t: Mapping[str, np.ndarray], models: list[str], residual_model: str
     a.set(xlabel="predicted LpAeq,Tp [dB(A)]", ylabel="measured LpAeq,Tp [dB(A)]", title="Measured against predicted")
     a.legend(fontsize=8)
     ok = np.isfinite(np.asarray(t[f"{residual_model}_residual_mid_db"], float))
-    when = _dates(np.asarray(t["stamp_ns"])[ok])
+    when = dates(np.asarray(t["stamp_ns"])[ok])
     b.scatter(when, np.asarray(t[f"{residual_model}_residual_mid_db"], float)[ok], s=4, alpha=0.5,
               label=f"{residual_model}, per pass")
     b.plot(when, np.asarray(t[f"{residual_model}_baseline_mid_db"], float)[ok], "k-", lw=1.2,

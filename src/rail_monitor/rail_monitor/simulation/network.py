@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.passes import PassTable, accepted_passes
 from rail_monitor.core.site import Site
 from rail_monitor.corrugation.surveys import apply_grinding
 from rail_monitor.economics.outlook import SiteOutlook
@@ -75,7 +75,7 @@ def true_outlook_days(site: Site, values: Mapping[str, Any], passes: PassTable, 
     """The true rail's days to its threshold after the passes, and after a grind then, at the
     recent traffic (CorrugationEstimator.forecast of the true K_b: what a site's forecast estimates)."""
     truth = true_estimator(site, values, k_b_factor)
-    truth.advance(with_class_defaults(passes.take(rejection_reasons(passes, site) == ""), site))
+    truth.advance(accepted_passes(passes, site))
     due = truth.forecast().days_to_threshold
     apply_grinding(truth, truth.newest_ns)
     return float(due), float(truth.forecast().days_to_threshold)

@@ -15,11 +15,12 @@ from typing import Any
 
 import numpy as np
 
-from rail_monitor.core.passes import PassTable, rejection_reasons, with_class_defaults
+from rail_monitor.core.passes import PassTable, accepted_passes
 from rail_monitor.core.site import Site
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation.config import K_B_DEFAULTS, corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.surveys import KIND_SURVEY, MaintenanceEvent
 from rail_monitor.models.calibration import LN_PER_DB
 
 
@@ -34,6 +35,11 @@ class SurveySeries:
     amplitude_m: np.ndarray
     true_k_b: np.ndarray
     true_crossing_ns: np.ndarray
+
+    def events(self) -> list[MaintenanceEvent]:
+        """The surveys as the events a history bag carries."""
+        return [MaintenanceEvent(int(t), KIND_SURVEY, self.wavelength_m, self.amplitude_m[k])
+                for k, t in enumerate(self.stamp_ns.tolist())]
 
     @property
     def true_grinding_ns(self) -> int:
@@ -55,7 +61,7 @@ def simulate_surveys(site: Site, values: Mapping[str, Any], passes: PassTable, k
     """Surveys every ``every_days`` [day] from the first pass's day (the first one then, on the
     freshly ground rail) to the last pass, of the true rail under ``passes`` (time order)."""
     truth = true_estimator(site, values, k_b_factor)
-    ok = with_class_defaults(passes.take(rejection_reasons(passes, site) == ""), site)
+    ok = accepted_passes(passes, site)
     traj = truth.advance_history(ok)
     first, last = int(passes.stamp_ns.min()), int(passes.stamp_ns.max())
     day0 = first - first % NS_PER_DAY

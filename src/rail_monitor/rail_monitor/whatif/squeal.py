@@ -142,11 +142,11 @@ def friction_states(values: Mapping[str, Any], passes: PassTable) -> list[dict[s
     the mean level of the unstable ones [dB(A)], and the friction modifier's cut of the squealing
     passes' energy-mean level with the background [dB(A)] (NaN where none squeals)."""
     from rail_monitor.core.contact import contact_state
-    from rail_monitor.core.passes import FRICTION_NAMES, rejection_reasons, with_class_defaults
+    from rail_monitor.core.passes import FRICTION_NAMES, accepted_passes
     from rail_monitor.squeal.predict import predict
 
     site, cfg = site_from_values(values), squeal_config(values)
-    table = with_class_defaults(passes.take(rejection_reasons(passes, site) == ""), site)
+    table = accepted_passes(passes, site)
     out, cs = predict(cfg, site, table), contact_state(site, table)
     bg = 10.0 ** (cfg.background_level_dba / 10.0)
     rows = []
