@@ -61,7 +61,7 @@ def test_plan_prints_and_writes_the_programme(network, capsys):
     out = network / "programme.csv"
     assert main(["plan", str(network / "sites.yaml"), "--workers", "1", "--years", "3", "--capacity", "1",
                  "--csv", str(out), "--xlsx", str(network / "programme.xlsx"), "--plot",
-                 str(network / "timeline.png")]) == 0
+                 str(network / "timeline.png"), "--report", str(network / "report")]) == 0
     printed = capsys.readouterr().out
     assert "2 sites, 36 months" in printed and "curve_250" in printed and "curve_400" in printed
     assert re.search(r"plan: programme: [0-9]+ visits, expected cost [0-9]+", printed)
@@ -76,6 +76,15 @@ def test_plan_prints_and_writes_the_programme(network, capsys):
     book = pd.read_excel(network / "programme.xlsx", sheet_name=None)
     assert set(book) == {"programme", "sites"} and len(book["programme"]) == len(rows)
     assert (network / "timeline.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    page = (network / "report" / "index.html").read_text()
+    cost = re.search(r"plan: programme: ([0-9]+) visits, expected cost ([0-9]+)", printed)
+    fixed = re.search(r"plan: fixed ([0-9]+)-month cycle: [0-9]+ visits, expected cost ([0-9]+)", printed)
+    assert f"{cost[1]} grinding visits, expected cost {int(cost[2]):,}" in page     # the printed numbers
+    saving = re.search(rf"Against fixed {fixed[1]}-month cycle: .*? the programme (saves|costs) ([0-9,]+)", page)
+    saved = int(saving[2].replace(",", "")) * (1 if saving[1] == "saves" else -1)
+    assert abs(saved - (int(fixed[2]) - int(cost[2]))) <= 1                          # each rounded
+    assert "Risk left:" in page and "What to grind when" in page and page.count("<tr>") >= 1 + len(rows)
+    assert (network / "report" / "programme.pdf").read_bytes()[:5] == b"%PDF-"
 
 
 def test_bad_plan_input_is_one_line(network, capsys):
@@ -89,3 +98,24 @@ def test_bad_plan_input_is_one_line(network, capsys):
     assert main(["plan", str(network / "sites.yaml"), "--risk", "1.5"]) == 2
     err = capsys.readouterr().err
     assert "--risk in (0, 1)" in err and len(err.strip().splitlines()) == 1
+
+
+def test_plan_chooses_an_option_where_a_site_offers_it(network, capsys):
+    """curve_250 offering speed control and a friction modifier at 1 a year (against 500 a visit):
+    the ranking lists each option with its cycle and effects, the programme runs the modifier there
+    (it lengthens the cycle at almost no cost), and the CSV says so on each of its visits."""
+    from rail_monitor.cli.site import edited_site_text
+
+    text, _ = edited_site_text((network / "curve_250.yaml").read_text(), [
+        "economics.options=[grind, speed_control, friction_modifier]", "economics.applicator_cost_per_year=1"])
+    (network / "curve_250_options.yaml").write_text(text)
+    (network / "options.yaml").write_text("sites:\n  - site: curve_250_options.yaml\n    history: a.csv\n")
+    out = network / "options.csv"
+    assert main(["plan", str(network / "options.yaml"), "--workers", "1", "--csv", str(out)]) == 0
+    printed = capsys.readouterr().out
+    for name in ("grind", "speed_control", "friction_modifier"):
+        assert re.search(rf"option {name}: cycle [0-9]+-[0-9]+-[0-9]+ d", printed)
+    assert "squealing passes" in printed and "running time" in printed
+    assert "(friction_modifier from the first visit)" in printed
+    rows = list(csv.DictReader(out.open()))
+    assert rows and {r["option"] for r in rows} == {"friction_modifier"}

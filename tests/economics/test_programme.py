@@ -5,6 +5,7 @@ network whose truth is known, against grinding on a fixed cycle and when due."""
 from __future__ import annotations
 
 import itertools
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -12,11 +13,12 @@ from scipy import stats
 
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.economics import baselines
-from rail_monitor.economics.outlook import SiteOutlook
+from rail_monitor.economics.outlook import Option, SiteOutlook
 from rail_monitor.economics.programme import (
     Z90,
     Law,
     Rules,
+    first_month,
     months_of,
     plan,
     schedule_terms,
@@ -30,6 +32,14 @@ def _outlook(i: int, due: float, cycle: float, sd: float, cost: float = 500.0, l
              newest_days: float = 0.0) -> SiteOutlook:
     spread = np.exp(sd * Z90 * np.array([-1.0, 0.0, 1.0]))
     return SiteOutlook(f"s{i}", int(newest_days * NS_PER_DAY), due * spread, cycle * spread, cost, late, 500.0)
+
+
+def _with_options(o: SiteOutlook, speed_cost: float, applicator_cost: float) -> SiteOutlook:
+    """The site with speed control (cycle x1.4) and a friction modifier (x2.5, twice the ln-spread) offered."""
+    law = Law.through(o.cycle_days)
+    wide = np.exp(np.log(2.5 * o.cycle_days[1]) + 2 * law.sigma * Z90 * np.array([-1.0, 0.0, 1.0]))
+    return replace(o, options=(Option("grind", o.cycle_days), Option("speed_control", 1.4 * o.cycle_days, speed_cost),
+                               Option("friction_modifier", wide, applicator_cost)))
 
 
 def test_the_law_passes_through_the_forecast_quantiles():
@@ -47,11 +57,14 @@ def test_every_schedule_costs_what_its_visits_cost():
     """The vectorised candidates (schedules) against each one's months costed gap by gap (visit_risks,
     schedule_terms), to 1e-9 relative; a site already past due and one that never is, too."""
     rules = Rules(36, 40 * NS_PER_DAY)
-    for o in (_outlook(0, 200.0, 300.0, 0.3), _outlook(1, 10.0, 150.0, 0.5), _outlook(2, np.inf, np.inf, 0.3)):
+    for o in (_outlook(0, 200.0, 300.0, 0.3), _outlook(1, 10.0, 150.0, 0.5), _outlook(2, np.inf, np.inf, 0.3),
+              _with_options(_outlook(3, 200.0, 300.0, 0.3), 60.0, 400.0)):
         s = schedules(o, rules)
+        assert set(s.option) == set(range(len(o.choices())))
         for k in range(len(s.cost)):
-            risks = visit_risks(o, rules, months_of(int(s.first[k]), int(s.gap[k]), rules.months))
-            expected, charged = schedule_terms(o, risks, rules)
+            under = o.under(o.choices()[s.option[k]].name)
+            risks = visit_risks(under, rules, months_of(int(s.first[k]), int(s.gap[k]), rules.months))
+            expected, charged = schedule_terms(under, risks, rules, int(s.first[k]))
             assert s.expected[k] == pytest.approx(expected, rel=1e-9) and s.cost[k] == pytest.approx(charged, rel=1e-9)
             assert s.risk[k] == pytest.approx(risks.max(), rel=1e-9) and s.lates[k] == pytest.approx(risks.sum(),
                                                                                                      rel=1e-9)
@@ -60,7 +73,8 @@ def test_every_schedule_costs_what_its_visits_cost():
 def test_the_optimum_equals_exhaustive_search():
     """Three sites, one visit a month: the MILP's cost equals the least over every combination of
     their candidate schedules that keeps the capacity (searched by brute force)."""
-    sites = [_outlook(0, 60.0, 120.0, 0.25), _outlook(1, 70.0, 150.0, 0.3), _outlook(2, 65.0, 200.0, 0.2)]
+    sites = [_outlook(0, 60.0, 120.0, 0.25), _outlook(1, 70.0, 150.0, 0.3),
+             _with_options(_outlook(2, 65.0, 200.0, 0.2), 30.0, 300.0)]
     rules = Rules(8, 0, capacity=1)
     cands = [schedules(o, rules) for o in sites]
     best = np.inf
@@ -71,8 +85,8 @@ def test_the_optimum_equals_exhaustive_search():
             continue
         best = min(best, sum(c.cost[k] for c, k in zip(cands, pick, strict=True)))
     prog = plan(sites, rules)
-    charged = sum(schedule_terms(o, visit_risks(o, rules, v), rules)[1]
-                  for o, v in zip(sites, prog.visits, strict=True))
+    charged = sum(schedule_terms(o.under(c), visit_risks(o.under(c), rules, v), rules, first_month(v))[1]
+                  for o, v, c in zip(sites, prog.visits, prog.option, strict=True))
     assert charged == pytest.approx(best, rel=1e-9)
     assert np.bincount(np.concatenate(prog.visits)).max() <= 1
 
@@ -91,6 +105,24 @@ def test_capacity_budget_and_risk_limit_hold():
     assert held.risk.max() <= 0.1 + 1e-12
     loose = plan(sites, Rules(60, 0, risk_limit=0.5))
     assert loose.expected_cost.sum() < free.expected_cost.sum()
+
+
+def test_the_programme_takes_an_option_where_it_is_cheaper():
+    """Two sites alike (due in 100 days, a 300-day cycle; 500 a preventive visit) offering a
+    friction modifier that makes the cycle 2.5 times longer: at 100 a year (five years: 500, against
+    about three visits saved) the programme takes it; at 2,000 a year it does not, and speed control
+    (x1.4 at 60 a year) beats grinding alone. Each site's expected cost is its chosen schedule's,
+    running cost included, and the pair costs less than grinding alone."""
+    sites = [_with_options(_outlook(0, 100.0, 300.0, 0.2), 1e6, 100.0), _with_options(_outlook(1, 100.0, 300.0, 0.2),
+                                                                                      60.0, 2000.0)]
+    rules = Rules(60, 0)
+    prog = plan(sites, rules)
+    assert prog.option == ["friction_modifier", "speed_control"]
+    for o, v, opt, cost in zip(sites, prog.visits, prog.option, prog.expected_cost, strict=True):
+        assert cost == pytest.approx(schedule_terms(o.under(opt), visit_risks(o.under(opt), rules, v), rules,
+                                                    first_month(v))[0], rel=1e-9)
+    grind_only = plan([o.under("grind") for o in sites], rules)
+    assert prog.expected_cost.sum() < grind_only.expected_cost.sum()
 
 
 def _yearly(prog) -> np.ndarray:
@@ -118,3 +150,14 @@ def test_on_a_network_of_known_truth_the_programme_costs_least():
     _, late, n = out["programme"]
     assert late / n <= 0.1 + 3 * np.sqrt(0.1 * 0.9 / n)
     assert out["due"][1] / out["due"][2] > 0.3
+
+
+def test_a_realised_schedule_takes_each_grinds_own_cycle():
+    """Counted by hand (months of 30.44 days): due in 100 days, visits in months 2, 9 and 14 of 24.
+    Cycles 300 then 100 days: on time (day 61), on time (274 < 361), late (426 >= 374), and the
+    threshold passed again on day 726 before the horizon (730.5) owes one more: 2 on time, 2 late.
+    One cycle of 300 days throughout: only the one owed at the end is late."""
+    o, rules = _outlook(0, 100.0, 300.0, 0.2), Rules(24, 0)
+    visits = np.array([2, 9, 14])
+    assert baselines.realised(o, rules, visits, 100.0, [300.0, 100.0]) == (2 * 500.0 + 2 * 1500.0, 2)
+    assert baselines.realised(o, rules, visits, 100.0, 300.0) == (3 * 500.0 + 1500.0, 1)

@@ -214,10 +214,11 @@ def advice_problem(est: CorrugationEstimator, consequences: Consequences, pool: 
                          axle_weight=axle_w, mean=mean, cap=cap, limits=limits)
 
 
-def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor | None = None) -> SpeedAdvice:
+def advise(est: CorrugationEstimator, consequences: Consequences, pool: Executor | None = None,
+           problem: AdviceProblem | None = None) -> SpeedAdvice:
     """The plan for the kept passes (ValueError when there are none, or no plan fits the limits);
-    pool: as for advice_problem."""
-    p = advice_problem(est, consequences, pool)
+    pool: as for advice_problem; problem: the kept passes' advice_problem where the caller has it."""
+    p = problem or advice_problem(est, consequences, pool)
     plan = p.solve()
     g, lp, sq, current, pass_w, low, high = p.growth, p.noise, p.squeal, p.current, p.pass_weight, p.low, p.high
     now = plan_growth(g, p.axle_weight, current)

@@ -110,14 +110,18 @@ def run_site(job: SiteJob) -> SiteResult:
 
 def outlook_site(job: SiteJob) -> Any:
     """One site's grinding outlook (economics.outlook.SiteOutlook) from its history, surveys and
-    grinding events applied, or from its checkpoint (a task: imports inside, runs on a worker)."""
+    grinding events applied, or from its checkpoint, with the options its economics.options offer
+    priced (a task: imports inside, runs on a worker)."""
+    from rail_monitor.advice.consequences import Consequences
     from rail_monitor.bagio.reader import read_bag_events, read_passes
     from rail_monitor.core.passes import accepted_passes
     from rail_monitor.corrugation.estimator import CorrugationEstimator
+    from rail_monitor.economics.options import site_options
     from rail_monitor.economics.outlook import site_outlook
     from rail_monitor.engine import checkpoint
     from rail_monitor.engine.corrugation_site import advance_with_events
     from rail_monitor.engine.site_config import SiteConfig
+    from rail_monitor.noise.predict import RollingNoiseModel
     from rail_monitor.site_file import load_parameter_file
 
     cfg = SiteConfig.from_values(load_parameter_file(job.site))
@@ -129,7 +133,11 @@ def outlook_site(job: SiteJob) -> Any:
         advance_with_events(est, accepted_passes(passes, cfg.site), read_bag_events(job.history))
     if not est.total_pass_count:
         raise RailMonitorError(f"{job.checkpoint or job.history}: no valid pass of site {cfg.site.site_id}")
-    return site_outlook(est, cfg.economics)
+    options = ()
+    if cfg.economics.options != ["grind"]:
+        options = site_options(est, cfg.economics,
+                               Consequences(cfg.site, RollingNoiseModel(cfg.site, cfg.noise), cfg.squeal))
+    return site_outlook(est, cfg.economics, options)
 
 
 def _worker_name() -> str:

@@ -6,13 +6,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-
 from rail_monitor.core.errors import RailMonitorError
 from rail_monitor.core.text import printable
-from rail_monitor.core.timeutil import NS_PER_DAY, format_iso_ns, parse_iso_ns
-
-WIDE = 4.0  # a cycle's P90/P10 above which the printout says a survey would pay (ln-spread over 0.54)
+from rail_monitor.core.timeutil import iso_day, parse_iso_ns
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -34,6 +30,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--xlsx", metavar="PATH", help="write the programme and the ranking as a workbook")
     s.add_argument("--plot", metavar="PNG", help="save the programme's timeline: each site's due date P10-P90 and "
                    "its visits (the 40 due first)")
+    s.add_argument("--report", metavar="DIR", help="write a report for a manager into DIR: what to grind when, what "
+                   "it costs and saves against a fixed cycle and grinding when due, and the risk left (index.html "
+                   "and programme.pdf, with the timeline)")
     s.add_argument("--workers", type=int, default=0, help="worker processes reading the sites (default: one per "
                    "core)")
     s.add_argument("--scheduler", help="address of a running Dask scheduler instead of a local cluster")
@@ -43,7 +42,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(ns: argparse.Namespace) -> int:
     from rail_monitor.batch.sites import outlook_site, read_manifest, run_sites
     from rail_monitor.economics import baselines
-    from rail_monitor.economics.programme import MONTH_DAYS, Rules, plan
+    from rail_monitor.economics.outlook import WIDE
+    from rail_monitor.economics.programme import Rules, plan
+    from rail_monitor.report.programme_page import days_text
 
     if not 0 < ns.years <= 50 or not 0 < ns.risk < 1 or ns.capacity < 0 or ns.budget < 0 or ns.fixed_cycle_months < 0:
         raise RailMonitorError("--years must be in (0, 50], --risk in (0, 1), and --capacity, --budget and "
@@ -60,7 +61,7 @@ def run(ns: argparse.Namespace) -> int:
     every = ns.fixed_cycle_months or baselines.median_cycle_months(outlooks, rules)
 
     def month(m: int) -> str:
-        return format_iso_ns(int(start + m * MONTH_DAYS * NS_PER_DAY))[:10]
+        return iso_day(rules.month_ns(m))
 
     print(f"plan: {len(outlooks)} sites, {rules.months} months from {month(0)}; capacity "
           f"{ns.capacity or 'unlimited'} visits a month, budget {ns.budget or 'unlimited'} a year, risk limit "
@@ -68,13 +69,16 @@ def run(ns: argparse.Namespace) -> int:
     print(f"{'site':<20} {'due P10':>10} {'due P50':>10} {'due P90':>10} {'cycle P10-P50-P90 [d]':>22} "
           f"{'visit cost':>11} {'cost/year P10-P90':>19}")
     wide = []
-    for o in sorted(outlooks, key=lambda o: o.newest_ns / NS_PER_DAY + o.due_days[1]):
-        due = [_date(o.newest_ns, d) for d in o.due_days]
+    for o in sorted(outlooks, key=lambda o: o.due_day):
+        due = [iso_day(d) for d in o.due_ns()]
         lo, _, hi = o.cost_per_year()
-        cycle = "-".join(f"{d:.0f}" if np.isfinite(d) else "never" for d in o.cycle_days)
+        cycle = days_text(o.cycle_days)
         print(f"{printable(o.site_id)[:20]:<20} {due[0]:>10} {due[1]:>10} {due[2]:>10} {cycle:>22} "
               f"{o.visit_cost:>11.0f} {lo:>9.0f}-{hi:<9.0f}")
-        if o.cycle_days[2] > WIDE * o.cycle_days[0]:
+        for option in o.options if any(c.name != "grind" for c in o.options) else ():
+            print(f"    option {option.name}: cycle {days_text(option.cycle_days)} d, running cost "
+                  f"{option.cost_per_year:.0f} a year" + (f"; {option.effects}" if option.effects else ""))
+        if o.wide:
             wide.append(o.site_id)
     if wide:
         names = ", ".join(map(printable, wide))
@@ -83,15 +87,15 @@ def run(ns: argparse.Namespace) -> int:
               "narrows K_b's posterior, and so the forecast")
     print(f"plan: programme ({prog.status.split('(')[0].strip()}, {prog.seconds:.1f} s over {prog.schedules} "
           "candidate schedules):")
-    for site, visits, cost, risk in zip(prog.sites, prog.visits, prog.expected_cost, prog.risk, strict=True):
+    for site, visits, option, cost, risk in zip(prog.sites, prog.visits, prog.option, prog.expected_cost, prog.risk,
+                                                strict=True):
+        run = "" if option == "grind" or not len(visits) else f" ({option} from the first visit)"
         print(f"  {printable(site)[:20]:<20} {', '.join(month(int(m))[:7] for m in visits) or 'no visit':<40} "
-              f"expected cost {cost:.0f}, largest risk {100 * risk:.1f} %")
-    compared = {"programme": prog.visits, f"fixed {every}-month cycle": baselines.fixed_cycle(outlooks, rules, every),
-                "when due (forecast median)": baselines.when_due(outlooks, rules)}
-    for name, visits in compared.items():
-        cost, _, lates = baselines.expected(outlooks, rules, visits)
-        print(f"plan: {name}: {sum(len(v) for v in visits)} visits, expected cost {cost.sum():.0f}, "
-              f"{lates.sum():.2f} thresholds expected to pass before a visit")
+              f"expected cost {cost:.0f}, largest risk {100 * risk:.1f} %{run}")
+    runs = baselines.priced(outlooks, rules, prog, every)
+    for r in runs:
+        print(f"plan: {r.name}: {r.count} visits, expected cost {r.cost:.0f}, {r.lates:.2f} thresholds expected "
+              "to pass before a visit")
     if ns.csv or ns.xlsx:
         _write(ns, outlooks, prog, month)
     if ns.plot:
@@ -99,27 +103,27 @@ def run(ns: argparse.Namespace) -> int:
 
         programme_timeline(outlooks, prog, rules).savefig(ns.plot, dpi=110)
         print(f"plan: timeline saved to {printable(ns.plot)}")
+    if ns.report:
+        from rail_monitor.report.programme_page import write_programme_report
+
+        files = write_programme_report(Path(ns.report), outlooks, prog, rules, runs, wide)
+        print(f"plan: report for a manager written to {printable(files[-1])} and {printable(files[-2])}")
     return 0
-
-
-def _date(newest_ns: int, days: float) -> str:
-    from rail_monitor.corrugation.forecast import MAX_DATED_DAYS
-
-    return format_iso_ns(int(newest_ns + days * NS_PER_DAY))[:10] if days <= MAX_DATED_DAYS else "never"
 
 
 def _write(ns: argparse.Namespace, outlooks: list, prog, month) -> None:
     import pandas as pd
 
-    visits = pd.DataFrame([{"site_id": s, "visit": i + 1, "month_start": month(int(m)), "visit_cost": o.visit_cost}
-                           for o, s, v in zip(outlooks, prog.sites, prog.visits, strict=True)
-                           for i, m in enumerate(v)], columns=["site_id", "visit", "month_start", "visit_cost"])
-    ranking = pd.DataFrame([{"site_id": o.site_id, **{f"due_{p}": _date(o.newest_ns, d)
-                                                      for p, d in zip(("p10", "p50", "p90"), o.due_days, strict=True)},
+    columns = ["site_id", "visit", "month_start", "visit_cost", "option"]
+    visits = pd.DataFrame([(s, i + 1, month(int(m)), o.visit_cost, c)
+                           for o, s, v, c in zip(outlooks, prog.sites, prog.visits, prog.option, strict=True)
+                           for i, m in enumerate(v)], columns=columns)
+    ranking = pd.DataFrame([{"site_id": o.site_id, **{f"due_{p}": iso_day(d)
+                                                      for p, d in zip(("p10", "p50", "p90"), o.due_ns(), strict=True)},
                              **{f"cycle_{p}_days": d for p, d in zip(("p10", "p50", "p90"), o.cycle_days, strict=True)},
                              "visit_cost": o.visit_cost, "late_visit_cost": o.late_visit_cost,
-                             "expected_cost": c, "largest_risk": r}
-                            for o, c, r in zip(outlooks, prog.expected_cost, prog.risk, strict=True)])
+                             "option": opt, "expected_cost": c, "largest_risk": r}
+                            for o, opt, c, r in zip(outlooks, prog.option, prog.expected_cost, prog.risk, strict=True)])
     if ns.csv:
         visits.to_csv(ns.csv, index=False)
         print(f"plan: programme written to {printable(ns.csv)}")

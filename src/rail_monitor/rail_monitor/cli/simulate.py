@@ -168,9 +168,10 @@ def _network(ns: argparse.Namespace, values: dict) -> int:
             series = simulate_surveys(site, v, table, curve.k_b_factor, every, 1.0, int(v["simulator.seed"]) + 100)
             events = series.events()
         write_passes_bag(table, out / curve.site_id, site.site_id, events=events, applicators=applicator_events(cfg))
-        due, cycle = true_outlook_days(site, v, table, curve.k_b_factor)
+        due, cycles = true_outlook_days(site, v, table, curve.k_b_factor, seed=int(v["simulator.seed"]) + 200)
         rows.append({"site_id": curve.site_id, "k_b_factor": curve.k_b_factor, "curve_radius_m": site.curve_radius_m,
-                     "passes": len(table), "surveys": len(events), "true_due_days": due, "true_cycle_days": cycle})
+                     "passes": len(table), "surveys": len(events), "true_due_days": due,
+                     "true_cycle_days": " ".join(f"{c:.6g}" for c in cycles)})
     (out / "sites.yaml").write_text("sites:\n" + "".join(f"  - site: {r['site_id']}.yaml\n    history: {r['site_id']}\n"
                                                          for r in rows))
     with (out / "truth.csv").open("w", newline="") as fh:
@@ -178,5 +179,5 @@ def _network(ns: argparse.Namespace, values: dict) -> int:
         writer.writeheader()
         writer.writerows(rows)
     print(f"wrote {len(rows)} curves ({sum(r['passes'] for r in rows)} passes, surveys every {every:g} days) to {out}: "
-          f"sites.yaml for rail-monitor plan, truth.csv with each true rail's K_b factor, due date and cycle")
+          f"sites.yaml for rail-monitor plan, truth.csv with each true rail's K_b factor, due date and cycles")
     return 0

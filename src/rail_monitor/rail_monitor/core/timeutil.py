@@ -55,6 +55,11 @@ def format_iso_ns(ns: int) -> str:
     return datetime.fromtimestamp(sec, UTC).strftime("%Y-%m-%dT%H:%M:%S") + f".{frac:09d}Z"
 
 
+def iso_day(ns: int) -> str:
+    """ns since the epoch -> its UTC day 'YYYY-MM-DD' ('never' for 0: no date)."""
+    return format_iso_ns(ns)[:10] if ns else "never"
+
+
 def time_zone(name: str):
     """The IANA time zone called name (ConfigError with one line if none is)."""
     try:

@@ -60,10 +60,9 @@ class CorrugationEstimator:
         # use: what the next survey re-fits K_b against (rail_monitor.models.calibration).
         self.growth_by_state = np.zeros((4, *self.log_components.shape))
         self.calibration = calibration.prior(cfg.kb_prior_scale_sd, cfg.kb_prior_ratio_sd)
-        # Variance of each band's ln Z at the last survey or grinding [-].
-        self.survey_var = calibration.log_variance(cfg.survey_uncertainty_db)
+        self.survey_var = calibration.log_variance(cfg.survey_uncertainty_db)  # of ln Z, a surveyed band [-]
         self.post_grinding_var = np.full(len(self.bands), calibration.log_variance(cfg.post_grinding_uncertainty_db))
-        self.level_var = self.post_grinding_var.copy()
+        self.level_var = self.post_grinding_var.copy()  # of each band's ln Z at the last survey or grinding
         self.kept = KeptPasses()
         self.season = DailyGrowth(self.log_components.shape)  # the last year day by day (forecast interval)
         self.engine = "numpy"  # of the state's array kernels (batch: numba; models.engine.corrugation_kernels)
@@ -72,8 +71,7 @@ class CorrugationEstimator:
         # were split into calls (live backlogs, batch chunks).
         self._growth_before = RowQueue(np.zeros((0, *self.log_components.shape)))
         self._growth_total = np.zeros_like(self.log_components)
-        # Axles summed the same way (K,) and after the last; the kept passes' axles are the difference.
-        self._axles_before = RowQueue(np.zeros(0, np.int64))
+        self._axles_before = RowQueue(np.zeros(0, np.int64))  # axles summed the same way (K,), and after
         self._axle_total = 0
 
     # -- passes ---------------------------------------------------------------------------------
@@ -296,24 +294,28 @@ class CorrugationEstimator:
             out[f] = growth[k.friction == f + 1].sum(axis=0)
         return out / self._kept_axles
 
-    def forecast_interval(self, after_grinding: bool = False) -> ForecastInterval:
+    def forecast_interval(self, after_grinding: bool = False, dry_as_modifier: np.ndarray | None = None
+                          ) -> ForecastInterval:
         """P10, P50 and P90 of the days to threshold over the K_b posterior and the level variance
         of each band (:func:`.forecast.interval`): at the traffic and friction mix of the same
         season a year earlier where the history spans a year, else at the recent traffic.
         after_grinding: of a rail ground now to the configured post-grinding roughness (its
-        uncertainty ``post_grinding_uncertainty_db``), the grinding cycle a programme plans with."""
+        uncertainty ``post_grinding_uncertainty_db``), the grinding cycle a programme plans with;
+        dry_as_modifier: with a friction modifier where the rail was dry, the recent dry passes' growth
+        in that state (B, P) [1/axle pass of all kept passes] (:func:`.forecast.with_friction_modifier`)."""
         rate, axles = self.traffic()
         axles = axles if np.isfinite(axles) else self.site.mean_axles_per_train
         days_per_axle_pass = 1.0 / (rate * axles) if np.isfinite(rate) and rate > 0 else np.inf
-        season = self.season.profile(self.newest_ns)
+        recent, season = self.recent_growth_by_state(), self.season.profile(self.newest_ns)
+        if dry_as_modifier is not None:
+            recent, season = fcst.with_friction_modifier(recent, dry_as_modifier, season, self.k_b)
         if after_grinding:
             state, var = self.flat(self.post_grinding), self.post_grinding_var
             since = np.zeros_like(self.growth_by_state)
         else:
             state, since, var = self.log_components, self.growth_by_state, self.level_var
-        return fcst.interval(state, since, self.recent_growth_by_state(), self.calibration, np.sqrt(var),
-                             self.threshold, days_per_axle_pass, self.newest_ns,
-                             None if season is None else season * self.k_b[None, :, None, None])
+        return fcst.interval(state, since, recent, self.calibration, np.sqrt(var), self.threshold, days_per_axle_pass,
+                             self.newest_ns, None if season is None else season * self.k_b[None, :, None, None])
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic (see :func:`.forecast.traffic`)."""

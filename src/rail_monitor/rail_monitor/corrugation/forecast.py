@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from rail_monitor.core.friction import FRICTION_DRY, FRICTION_MODIFIER
 from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation.history import KeptPasses
 from rail_monitor.corrugation.records import Forecast, ForecastInterval
@@ -103,6 +104,27 @@ def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth
     due = np.array([newest_ns + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0 for d in first.tolist()], np.int64)
     return ForecastInterval(np.quantile(days, q, axis=0, method="inverted_cdf"), first, due,
                             "recent" if season is None else "season")
+
+
+def with_friction_modifier(growth_by_state: np.ndarray, dry_as_modifier: np.ndarray, season: np.ndarray | None,
+                           k_b: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """The recent growth per friction state (4, B, P) [1/axle pass] and the season's (S, 4, B, P,
+    per unit K_b) with a friction modifier applied where the rail was dry: the dry passes' growth
+    moves to the friction-modifier state as those passes give it there (dry_as_modifier (B, P), per
+    axle pass of all kept passes), so the interval draws it with the modifier's K_b posterior. The
+    season keeps no passes to recompute: its dry days move by the recent ratio of each component's
+    growth with the modifier to without, per unit K_b (1 where no recent pass was dry)."""
+    dry, fm = FRICTION_DRY - 1, FRICTION_MODIFIER - 1
+    growth = growth_by_state.copy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(growth[dry] != 0, dry_as_modifier * k_b[dry] / (growth[dry] * k_b[fm]), 1.0)
+    growth[fm] += dry_as_modifier
+    growth[dry] = 0.0
+    if season is not None:
+        season = season.copy()
+        season[:, fm] += season[:, dry] * ratio
+        season[:, dry] = 0.0
+    return growth, season
 
 
 def _seasonal_days(state: np.ndarray, scale: np.ndarray, season: np.ndarray, log_threshold: np.ndarray,

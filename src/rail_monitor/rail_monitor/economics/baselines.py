@@ -4,11 +4,21 @@ site when its forecast's median says; and what a schedule costs when the truth i
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 from rail_monitor.economics.outlook import SiteOutlook
-from rail_monitor.economics.programme import MONTH_DAYS, Law, Rules, offset_days, schedule_terms, visit_risks
+from rail_monitor.economics.programme import (
+    MONTH_DAYS,
+    Law,
+    Programme,
+    Rules,
+    first_month,
+    offset_days,
+    schedule_terms,
+    visit_risks,
+)
 
 
 def fixed_cycle(outlooks: Sequence[SiteOutlook], rules: Rules, every: int) -> list[np.ndarray]:
@@ -40,26 +50,58 @@ def when_due(outlooks: Sequence[SiteOutlook], rules: Rules) -> list[np.ndarray]:
 
 
 def expected(outlooks: Sequence[SiteOutlook], rules: Rules, visits: Sequence[np.ndarray]) -> tuple[np.ndarray, ...]:
-    """Per site: (expected cost, largest gap risk, expected thresholds passed first) of schedules."""
+    """Per site: (expected cost, largest gap risk, expected thresholds passed first) of schedules, each
+    outlook under the option its schedule runs (SiteOutlook.under)."""
     rows = []
     for o, v in zip(outlooks, visits, strict=True):
         risks = visit_risks(o, rules, v)
-        rows.append((schedule_terms(o, risks, rules)[0], risks.max(), risks.sum()))
+        rows.append((schedule_terms(o, risks, rules, first_month(v))[0], risks.max(), risks.sum()))
     return tuple(np.array(c) for c in zip(*rows, strict=True)) if rows else (np.zeros(0),) * 3
 
 
-def realised(o: SiteOutlook, rules: Rules, visits: np.ndarray, due_days: float, cycle_days: float) -> tuple[float, int]:
+def realised(o: SiteOutlook, rules: Rules, visits: np.ndarray, due_days: float,
+             cycle_days: float | Sequence[float]) -> tuple[float, int]:
     """(cost, thresholds passed first) of a schedule on a site whose true days to threshold now
-    and after a grind are known: a visit after the threshold is corrective; a threshold passed
-    between the last visit and the horizon owes a corrective visit, as in the plan."""
+    and after each grind are known (one cycle, or one per grind in turn, repeated): a visit after
+    the threshold is corrective; a threshold passed between the last visit and the horizon owes a
+    corrective visit, as in the plan."""
+    cycles = np.atleast_1d(np.asarray(cycle_days, float))
     cross = due_days - offset_days(o, rules)       # days from the start
     cost, late = 0.0, 0
-    for m in np.asarray(visits, float) * MONTH_DAYS:
+    for k, m in enumerate(np.asarray(visits, float) * MONTH_DAYS):
         passed = m >= cross
         cost += o.late_visit_cost if passed else o.visit_cost
         late += int(passed)
-        cross = m + cycle_days
+        cross = m + cycles[k % len(cycles)]
     if rules.months * MONTH_DAYS > cross:
         cost += o.late_visit_cost
         late += 1
     return cost, late
+
+
+@dataclass(frozen=True)
+class Priced:
+    """A way of running the network over the horizon, priced on the forecasts."""
+
+    name: str
+    visits: list[np.ndarray]   # months of each site's visits
+    cost: float                # expected cost [cost unit]
+    lates: float               # expected thresholds passed before a visit (or owed at the horizon) [-]
+
+    @property
+    def count(self) -> int:
+        return sum(len(v) for v in self.visits)
+
+
+def priced(outlooks: Sequence[SiteOutlook], rules: Rules, prog: Programme, every: int) -> list[Priced]:
+    """The programme (each site under its chosen option), a fixed cycle of ``every`` months and
+    grinding when due (both grinding only), each at its expected cost."""
+    grinding = [o.under("grind") for o in outlooks]
+    runs = [("programme", [o.under(c) for o, c in zip(outlooks, prog.option, strict=True)], prog.visits),
+            (f"fixed {every}-month cycle", grinding, fixed_cycle(outlooks, rules, every)),
+            ("when due (forecast median)", grinding, when_due(outlooks, rules))]
+    out = []
+    for name, under, visits in runs:
+        cost, _, lates = expected(under, rules, visits)
+        out.append(Priced(name, visits, float(cost.sum()), float(lates.sum())))
+    return out

@@ -17,6 +17,8 @@ from typing import Any
 from rail_monitor.core.errors import ConfigError
 from rail_monitor.core.params import ParamSpec, section_values
 
+OPTIONS = ("grind", "speed_control", "friction_modifier")
+
 ECONOMICS_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("grind_length_m", 500.0, "Length of track a visit grinds (the corrugated curve with its run-off) "
               "[m].", 1.0, 1.0e5),
@@ -31,6 +33,15 @@ ECONOMICS_SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("rail_cost_per_pass_m", 0.0, "Rail life one grinding pass consumes, per metre [cost unit/m]: the "
               "renewal cost per metre times the depth a pass removes over the head's wear allowance (0: not "
               "counted).", 0.0, 1.0e9),
+    ParamSpec("options", ["grind"], "What a programme may choose at this site: grind on its forecast, and "
+              "speed_control (the speed advice in force from its first visit) or friction_modifier (a trackside "
+              "applicator where the rail runs dry, from its first visit) where the site can take them.",
+              choices=OPTIONS),
+    ParamSpec("speed_control_cost_per_year", 0.0, "Running cost of holding the advised speeds: signage, driver "
+              "advice, timetable work [cost unit/year] (0: none counted).", 0.0, 1.0e12),
+    ParamSpec("applicator_cost_per_year", 0.0, "Running cost of a trackside friction-modifier applicator: the "
+              "unit over its life, product, refilling and maintenance [cost unit/year] (must be given to offer "
+              "friction_modifier).", 0.0, 1.0e12),
 )
 
 
@@ -44,6 +55,9 @@ class EconomicsConfig:
     cost_per_pass_m: float
     visit_cost: float
     rail_cost_per_pass_m: float
+    options: list[str]
+    speed_control_cost_per_year: float
+    applicator_cost_per_year: float
 
     def visit(self, late: bool = False) -> float:
         """Cost of one visit [cost unit]: preventive, or corrective (late)."""
@@ -57,4 +71,9 @@ def economics_config(values: Mapping[str, Any], prefix: str = "economics.") -> E
     if cfg.late_passes_per_grind < cfg.passes_per_grind:
         raise ConfigError(f"parameter '{prefix}late_passes_per_grind' is below '{prefix}passes_per_grind': a "
                           "corrective grind removes at least what a preventive one does")
+    if not cfg.options or len(set(cfg.options)) < len(cfg.options):
+        raise ConfigError(f"parameter '{prefix}options' must name each option at most once, and at least one")
+    if "friction_modifier" in cfg.options and cfg.applicator_cost_per_year == 0:
+        raise ConfigError(f"parameter '{prefix}options' offers friction_modifier: give "
+                          f"'{prefix}applicator_cost_per_year' (an applicator is never free)")
     return cfg

@@ -1,16 +1,31 @@
 """A site's grinding outlook: when it is due, how long a grind lasts, and what a visit costs,
-each with the forecast's uncertainty; the input of a network programme (economics.programme)."""
+each with the forecast's uncertainty, and the options a programme may choose there; the input of
+a network programme (economics.programme)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from rail_monitor.core.timeutil import NS_PER_DAY
 from rail_monitor.corrugation.estimator import CorrugationEstimator
+from rail_monitor.corrugation.forecast import MAX_DATED_DAYS
 from rail_monitor.economics.config import EconomicsConfig
 
 DAYS_PER_YEAR = 365.25
+WIDE = 4.0  # a cycle's P90/P10 above which a forecast is too wide to plan cheaply (ln-spread over 0.54)
+
+
+@dataclass(frozen=True)
+class Option:
+    """One way of running a site from its next visit: its grinding cycle P10, P50, P90 [day] with
+    the option in force, its running cost [cost unit/year], and what else it changes (one line)."""
+
+    name: str                  # economics.config.OPTIONS
+    cycle_days: np.ndarray
+    cost_per_year: float = 0.0
+    effects: str = ""
 
 
 @dataclass(frozen=True)
@@ -24,6 +39,44 @@ class SiteOutlook:
     visit_cost: float          # a preventive visit [cost unit]
     late_visit_cost: float     # a corrective visit, after a band passed its threshold [cost unit]
     length_m: float            # ground per visit [m]
+    options: tuple[Option, ...] = ()  # what a programme may choose (none given: grinding on the forecast)
+
+    @property
+    def due_day(self) -> float:
+        """The median due date in days since the epoch: the key of 'due first' [day]."""
+        return self.newest_ns / NS_PER_DAY + float(self.due_days[1])
+
+    @property
+    def wide(self) -> bool:
+        """Whether the cycle's P90 is over WIDE times its P10: holding a risk limit there takes visits
+        far more often than the median needs, and a roughness survey would pay."""
+        return bool(self.cycle_days[2] > WIDE * self.cycle_days[0])
+
+    def due_ns(self) -> np.ndarray:
+        """The due date's P10, P50, P90 [ns] (0: never, or past the forecast's dated horizon)."""
+        return np.array([self.newest_ns + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0
+                         for d in self.due_days.tolist()], np.int64)
+
+    def choices(self) -> tuple[Option, ...]:
+        """The options a programme may choose here."""
+        return self.options or (Option("grind", self.cycle_days),)
+
+    def under(self, name: str) -> SiteOutlook:
+        """The outlook with one option in force (its cycle, and no other choice); grind is always
+        there: it is what a fixed cycle or grinding when due runs."""
+        if name == "grind":
+            return replace(self, options=())
+        option = next((o for o in self.choices() if o.name == name), None)
+        if option is None:
+            raise ValueError(f"site {self.site_id} does not offer {name}")
+        return replace(self, cycle_days=option.cycle_days, options=(option,))
+
+    def running_cost(self, first_month: int, months: int) -> float:
+        """The chosen option's running cost from the first visit's month to the horizon [cost unit]
+        (the outlook under one option; none before any visit)."""
+        if first_month < 0 or len(self.choices()) != 1:
+            return 0.0
+        return self.choices()[0].cost_per_year * (months - first_month) / 12
 
     def cost_per_year(self) -> np.ndarray:
         """Preventive grinding's cost per year on the cycle, P10, P50, P90 [cost unit/year] (the
@@ -32,10 +85,10 @@ class SiteOutlook:
             return self.visit_cost * DAYS_PER_YEAR / self.cycle_days[::-1]
 
 
-def site_outlook(est: CorrugationEstimator, cfg: EconomicsConfig) -> SiteOutlook:
+def site_outlook(est: CorrugationEstimator, cfg: EconomicsConfig, options: tuple[Option, ...] = ()) -> SiteOutlook:
     """The outlook of a site's state (after its history, or resumed from its checkpoint): the
-    forecast's P10/P50/P90 now and after a grind now (CorrugationEstimator.forecast_interval), and
-    the visits' costs."""
+    forecast's P10/P50/P90 now and after a grind now (CorrugationEstimator.forecast_interval), the
+    visits' costs, and the options priced for it (economics.options.site_options)."""
     return SiteOutlook(est.site.site_id, int(est.newest_ns), est.forecast_interval().days.astype(float),
                        est.forecast_interval(after_grinding=True).days.astype(float), cfg.visit(),
-                       cfg.visit(late=True), cfg.grind_length_m)
+                       cfg.visit(late=True), cfg.grind_length_m, options)

@@ -51,6 +51,10 @@ class Rules:
     risk_limit: float = 0.1          # most chance a band passes its threshold before its visit [-]
     pull_forward: int = 6            # months a first visit may come before the due date's 0.1 % quantile
 
+    def month_ns(self, m: float) -> int:
+        """When programme month m begins [ns]."""
+        return int(self.start_ns + m * MONTH_DAYS * NS_PER_DAY)
+
 
 @dataclass(frozen=True)
 class Law:
@@ -88,6 +92,7 @@ class Schedules:
     lates: np.ndarray         # expected number of thresholds passed before a visit or the horizon (C,)
     first: np.ndarray         # first visit's month (C,) (-1: none)
     gap: np.ndarray           # months between visits (C,) (0: one visit, or none)
+    option: np.ndarray        # index into the site's choices() (C,)
 
 
 @dataclass(frozen=True)
@@ -96,6 +101,7 @@ class Programme:
 
     sites: list[str]
     visits: list[np.ndarray]        # months of each site's visits
+    option: list[str]               # the option each site runs from its first visit
     expected_cost: np.ndarray       # per site [cost unit]
     risk: np.ndarray                # per site: largest gap risk [-]
     lates: np.ndarray               # per site: expected thresholds passed first [-]
@@ -120,37 +126,49 @@ def visit_risks(o: SiteOutlook, rules: Rules, visits: np.ndarray) -> np.ndarray:
     return risks
 
 
-def schedule_terms(o: SiteOutlook, risks: np.ndarray, rules: Rules) -> tuple[float, float]:
-    """(expected cost, cost with the excess-risk charge) of a schedule from its gap risks."""
+def first_month(visits: np.ndarray) -> int:
+    """A schedule's first visit's month (-1: no visit)."""
+    return int(visits[0]) if len(visits) else -1
+
+
+def schedule_terms(o: SiteOutlook, risks: np.ndarray, rules: Rules, first: int = -1) -> tuple[float, float]:
+    """(expected cost, cost with the excess-risk charge) of a schedule from its gap risks, with
+    the running cost of the outlook's option from its first visit's month (-1: none)."""
     extra = o.late_visit_cost - o.visit_cost
-    expected = (len(risks) - 1) * o.visit_cost + float(risks[:-1].sum()) * extra + float(risks[-1]) * o.late_visit_cost
+    expected = ((len(risks) - 1) * o.visit_cost + float(risks[:-1].sum()) * extra + float(risks[-1]) * o.late_visit_cost
+                + o.running_cost(first, rules.months))
     excess = float(np.maximum(risks - rules.risk_limit, 0.0).sum())
     over = int((risks > rules.risk_limit).sum())
     return expected, expected + o.late_visit_cost * (RISK_WEIGHT * excess + OVER_LIMIT * over)
 
 
 def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
-    """The site's candidate schedules (see the module's docstring), vectorised over first months;
-    the first is no visit at all. Each equals schedule_terms over visit_risks of its months."""
-    due, cycle, shift = Law.through(o.due_days), Law.through(o.cycle_days), offset_days(o, rules)
-    m = rules.months
-    first, gap = [np.array([-1])], [np.array([0])]
+    """The site's candidate schedules (see the module's docstring) under each of its options in
+    turn, vectorised over first months; the first is no visit at all. Each equals schedule_terms
+    over visit_risks of its months, with the outlook under its option (SiteOutlook.under)."""
+    due, shift, m = Law.through(o.due_days), offset_days(o, rules), rules.months
+    first, gap, option = [np.array([-1])], [np.array([0])], [np.array([0])]
     visits, risks = [np.zeros(1)], [np.array([[0.0], [0.0], [due.before(shift + m * MONTH_DAYS)], [0.0]])]
+    running = [np.zeros(1)]
     if np.isfinite(due.mu):
         lo = max(0, int((due.quantile(EARLIEST) - shift) // MONTH_DAYS) - rules.pull_forward)
         hi = min(m - 1, max(0, int(np.ceil((due.quantile(max(GAP_RISKS)) - shift) / MONTH_DAYS))))
         firsts = np.arange(min(lo, hi), hi + 1)
         p_first = due.before(shift + firsts * MONTH_DAYS)
-        gaps = {max(1, int(cycle.quantile(r) // MONTH_DAYS)) for r in GAP_RISKS} if np.isfinite(cycle.mu) else set()
-        for g in sorted(gaps | {m}):       # a gap of m months: a single visit
-            n = 1 + (m - 1 - firsts) // g
-            tail = cycle.before((m - firsts - (n - 1) * g) * MONTH_DAYS)
-            p_gap = np.where(n > 1, cycle.before(g * MONTH_DAYS), 0.0)
-            first.append(firsts)
-            gap.append(np.full(len(firsts), g if g < m else 0))
-            visits.append(n)
-            # rows: first gap's risk, a repeat gap's, the tail's, and the repeats (a block is (4, C))
-            risks.append(np.stack([p_first, p_gap, tail, n - 1]))
+        for j, choice in enumerate(o.choices()):
+            cycle = Law.through(choice.cycle_days)
+            gaps = {max(1, int(cycle.quantile(r) // MONTH_DAYS)) for r in GAP_RISKS} if np.isfinite(cycle.mu) else set()
+            for g in sorted(gaps | {m}):       # a gap of m months: a single visit
+                n = 1 + (m - 1 - firsts) // g
+                tail = cycle.before((m - firsts - (n - 1) * g) * MONTH_DAYS)
+                p_gap = np.where(n > 1, cycle.before(g * MONTH_DAYS), 0.0)
+                first.append(firsts)
+                gap.append(np.full(len(firsts), g if g < m else 0))
+                option.append(np.full(len(firsts), j))
+                visits.append(n)
+                running.append(choice.cost_per_year * (m - firsts) / 12)
+                # rows: first gap's risk, a repeat gap's, the tail's, and the repeats (a block is (4, C))
+                risks.append(np.stack([p_first, p_gap, tail, n - 1]))
     extra, limit = o.late_visit_cost - o.visit_cost, rules.risk_limit
     p_first, p_gap, tail, repeats = (np.concatenate(row) for row in zip(*risks, strict=True))
     n = np.concatenate(visits)
@@ -158,10 +176,12 @@ def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
     excess = (np.maximum(p_first - limit, 0) + repeats * np.maximum(p_gap - limit, 0)
               + np.maximum(tail - limit, 0))
     over = (p_first > limit) + repeats * (p_gap > limit) + (tail > limit)
-    expected = n * o.visit_cost + (p_first + repeats * p_gap) * extra + tail * o.late_visit_cost
+    expected = (n * o.visit_cost + (p_first + repeats * p_gap) * extra + tail * o.late_visit_cost
+                + np.concatenate(running))
     risk = np.maximum(np.maximum(p_first, tail), p_gap)
     charged = expected + o.late_visit_cost * (RISK_WEIGHT * excess + OVER_LIMIT * over)
-    return Schedules(charged, expected, risk, lates, np.concatenate(first), np.concatenate(gap))
+    return Schedules(charged, expected, risk, lates, np.concatenate(first), np.concatenate(gap),
+                     np.concatenate(option))
 
 
 def months_of(first: int, gap: int, months: int) -> np.ndarray:
@@ -211,8 +231,10 @@ def plan(outlooks: Sequence[SiteOutlook], rules: Rules, time_limit_s: float = 60
     chosen = np.flatnonzero(res.x > 0.5)
     pick = chosen[np.argsort(col_site[chosen])]
     local = pick - np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    option = np.concatenate([s.option for s in per_site])
     return Programme([o.site_id for o in outlooks],
                      [months_of(int(first[c]), int(gap[c]), rules.months) for c in pick],
+                     [o.choices()[option[c]].name for o, c in zip(outlooks, pick, strict=True)],
                      np.array([s.expected[i] for s, i in zip(per_site, local, strict=True)]),
                      np.array([s.risk[i] for s, i in zip(per_site, local, strict=True)]),
                      np.array([s.lates[i] for s, i in zip(per_site, local, strict=True)]),

@@ -49,7 +49,7 @@ def _cell(key: str, v: Any) -> tuple[str, bool]:
     return printable(v), False
 
 
-def _html_table(rows: list[dict], limit: int | None = None) -> str:
+def html_table(rows: list[dict], limit: int | None = None) -> str:
     if not rows:
         return "<p>None.</p>"
     keys = list(rows[0])
@@ -63,7 +63,7 @@ def _html_table(rows: list[dict], limit: int | None = None) -> str:
     return f"<table><tr>{head}</tr>{''.join(body)}</table>{more}"
 
 
-def _text_table(rows: list[dict], limit: int | None = None) -> list[str]:
+def text_table(rows: list[dict], limit: int | None = None) -> list[str]:
     if not rows:
         return ["  none"]
     keys = list(rows[0])
@@ -206,21 +206,25 @@ def _write_csv(rows: list[dict], path: Path) -> None:
 def _pdf_text_pages(head, tables, lim, meta, run) -> list:
     lines = [f"rail_monitor report: {meta['site_id']}", f"generated {meta['generated_local']} by rail_monitor "
              f"{meta['software_version']}; times in {meta['time_zone']}", ""]
-    lines += [*_headline_lines(head, lim), "", "Per vehicle class:", *_text_table(tables["classes"])]
-    lines += ["", "Grinding outlook per band:", *_text_table(tables["outlook"], 8)]
+    lines += [*_headline_lines(head, lim), "", "Per vehicle class:", *text_table(tables["classes"])]
+    lines += ["", "Grinding outlook per band:", *text_table(tables["outlook"], 8)]
     if tables["friction"]:
-        lines += ["", "Friction modifier, squeal per friction state:", *_text_table(tables["friction"])]
+        lines += ["", "Friction modifier, squeal per friction state:", *text_table(tables["friction"])]
     if tables["applicator"]:
         lines += ["", "Friction modifier, before and after the applicator's start:",
-                  *_text_table(tables["applicator"])]
+                  *text_table(tables["applicator"])]
     if tables["advice"]:
-        lines += ["", "Speed advice per class (at its recent mean speed):", *_text_table(tables["advice"])]
+        lines += ["", "Speed advice per class (at its recent mean speed):", *text_table(tables["advice"])]
     lines += ["", f"Loudest squealing trains (of {len(tables['squealers'])}, all in squealing_trains.csv):"]
-    lines += _text_table(tables["squealers"], 15)
-    per_page = 58
+    lines += text_table(tables["squealers"], 15)
+    return text_pages(lines)
+
+
+def text_pages(lines: list[str], per_page: int = 58) -> list:
+    """Lines of monospaced text as A4 landscape figures, per_page lines each (a PDF's text pages)."""
     pages = []
     for k in range(0, len(lines), per_page):
-        fig = report_plots.plt.figure(figsize=(11.69, 8.27))  # A4 landscape
+        fig = report_plots.plt.figure(figsize=(11.69, 8.27))
         fig.text(0.03, 0.97, "\n".join(lines[k:k + per_page]), family="monospace", fontsize=6.3, va="top")
         pages.append(fig)
     return pages
@@ -264,29 +268,29 @@ def _html(run, values, head, tables, lim, figures, meta, listen=()) -> str:
         caption, stem = figs[name]
         return f'<figure><img src="{stem}.png" alt="{e(caption)}"><figcaption>{e(caption)}</figcaption></figure>'
 
-    friction = (f"<h2>Friction modifier: squeal per friction state</h2>{_html_table(tables['friction'])}"
+    friction = (f"<h2>Friction modifier: squeal per friction state</h2>{html_table(tables['friction'])}"
                 "<p class=\"meta\">Friction states compared, not before and after an applicator's start (the "
                 "bag holds no such event). The cut is the model's, on the squealing passes of each state; "
                 "Eadie &amp; Santoro (2006) measured 6.3-22.8 dB(A) at transit curves.</p>"
                 if tables["friction"] else "")
     if tables["applicator"]:
         friction = (f"<h2>Friction modifier: squeal before and after the applicator's start</h2>"
-                    f"{_html_table(tables['applicator'])}<p class=\"meta\">Every pass before the applicator's first "
+                    f"{html_table(tables['applicator'])}<p class=\"meta\">Every pass before the applicator's first "
                     "start against every pass after it (to its next stop), whatever friction state each records. "
                     "Levels are energy means over all passes of a side (a quiet pass at the model's background) "
                     "and over its loudest passes, as many as squealed before the start; Eadie &amp; Santoro "
                     "(2006) measured cuts of 6.3-22.8 dB(A) at transit curves.</p>")
     measured = (f"<h2>Measured noise: wheel-defect suspects (repeat offenders)</h2>"
-                f"{_html_table(tables['offenders'], 25)}{fig('measured')}" if "measured" in figs else "")
+                f"{html_table(tables['offenders'], 25)}{fig('measured')}" if "measured" in figs else "")
     if tables["squeal_angles"]:
         measured += (f"<h2>Measured squeal against the model, by angle of attack</h2>"
-                     f"{_html_table(tables['squeal_angles'])}<h2>Repeat squealers</h2>"
-                     f"{_html_table(tables['repeat_squealers'], 25)}")
+                     f"{html_table(tables['squeal_angles'])}<h2>Repeat squealers</h2>"
+                     f"{html_table(tables['repeat_squealers'], 25)}")
     if tables["squeal_fits"]:
-        measured += (f"<h2>The squeal model fitted to the measured squeal</h2>{_html_table(tables['squeal_fits'])}"
+        measured += (f"<h2>The squeal model fitted to the measured squeal</h2>{html_table(tables['squeal_fits'])}"
                      "<p class=\"meta\">Each friction state's latest fit (squeal.fit_days windows); the passes "
                      "after it are predicted on its P50 curve.</p>" + fig("squeal_fits"))
-    advice = (f"<h2>Speed advice per class</h2>{_html_table(tables['advice'])}<p class=\"meta\">Shares of each "
+    advice = (f"<h2>Speed advice per class</h2>{html_table(tables['advice'])}<p class=\"meta\">Shares of each "
               "class's trains per speed band at its recent mean speed, cutting the peak corrugation growth "
               "without raising the mean noise by more than the limit or the squealing share.</p>"
               if tables["advice"] else "")
@@ -300,21 +304,21 @@ speeds in km/h.
 Also as <a href="report.pdf">PDF</a>; every squealing pass in <a href="squealing_trains.csv">squealing_trains.csv</a>;
 the numbers in <a href="summary.json">summary.json</a>.</p>
 <h2>Headline</h2><ul class="head">{lines}</ul>
-<h2>Per vehicle class</h2>{_html_table(tables['classes'])}
-<h2>Noise against the limit</h2>{_html_table(tables['noise'])}
-<h2>Grinding outlook per band</h2>{_html_table(tables['outlook'], 8)}
+<h2>Per vehicle class</h2>{html_table(tables['classes'])}
+<h2>Noise against the limit</h2>{html_table(tables['noise'])}
+<h2>Grinding outlook per band</h2>{html_table(tables['outlook'], 8)}
 <p class="meta">Dates at the recent traffic; the range is the spread of weekly traffic only (the growth
 coefficient's own uncertainty is not included). The band the model forecasts first uses its full
 forecast, the others the fastest growth rate of the band.</p>
 {fig('timeline')}
 {friction}
-<h2>Squealing trains (loudest first)</h2>{_html_table(tables['squealers'], 25)}
+<h2>Squealing trains (loudest first)</h2>{html_table(tables['squealers'], 25)}
 {measured}
 {_listen_html(list(listen))}
 <h1>Appendix for engineers</h1>
 {fig('corrugation')}{fig('noise')}{fig('squeal')}{advice}{fig('speeds')}
-<h2>Alerts (raise and clear events)</h2>{_html_table(alerts)}
+<h2>Alerts (raise and clear events)</h2>{html_table(alerts)}
 <h2>Site parameters</h2><p class="meta">As in the site file{': ' + e(meta['site_file']) if meta['site_file'] else ''};
-every other parameter at its default.</p>{_html_table(params)}
+every other parameter at its default.</p>{html_table(params)}
 </body></html>
 """

@@ -22,7 +22,7 @@ MOST_ROWS = 40  # sites drawn (the earliest due); the CSV holds them all
 
 def programme_timeline(outlooks: Sequence[SiteOutlook], prog: Programme, rules: Rules) -> Figure:
     """The timeline of the programme's first MOST_ROWS sites by due date (dates in UTC)."""
-    order = sorted(range(len(outlooks)), key=lambda i: outlooks[i].newest_ns / NS_PER_DAY + outlooks[i].due_days[1])
+    order = sorted(range(len(outlooks)), key=lambda i: outlooks[i].due_day)
     order = order[:MOST_ROWS]
     fig, ax = plt.subplots(figsize=(10, 1.6 + 0.28 * len(order)), layout="constrained")
     end = rules.start_ns + rules.months * MONTH_DAYS * NS_PER_DAY
