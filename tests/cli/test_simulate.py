@@ -54,6 +54,8 @@ def test_a_network_of_curves_with_its_manifest_and_truth(tmp_path, capsys):
         assert len(read_bag_passes(job.history)) == int(row["passes"]) > 0
         assert len(read_bag_events(job.history)) == int(row["surveys"]) == 3
         assert 0.3 <= float(row["k_b_factor"]) <= 3.0
+        by_state = np.array(row["k_b_by_friction"].split(), float)
+        assert len(by_state) == 4 and np.all(by_state > 0) and np.ptp(np.log(by_state)) > 0  # each state its own
         cycles = np.array(row["true_cycle_days"].split(), float)
         assert float(row["true_due_days"]) > 0 and len(set(cycles)) == 12 and np.all(cycles > 0)
     assert main(args) == 2

@@ -140,6 +140,7 @@ def _network(ns: argparse.Namespace, values: dict) -> int:
     from rail_monitor.cli.site import edited_site_text
     from rail_monitor.core.simulator_params import simulator_config
     from rail_monitor.core.site import site_from_values
+    from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.simulation.network import network_sites, true_outlook_days
     from rail_monitor.simulation.simulator import applicator_events, simulate
     from rail_monitor.simulation.surveys import simulate_surveys
@@ -157,7 +158,9 @@ def _network(ns: argparse.Namespace, values: dict) -> int:
     base = site_file(ns.site).read_text()
     extra = [f"simulator.days={values['simulator.days']}"]
     rows = []
-    for curve in network_sites(ns.network, int(values["simulator.seed"]), values["simulator.trains_per_hour"]):
+    ratio_sd = corrugation_config(values).kb_prior_ratio_sd
+    for curve in network_sites(ns.network, int(values["simulator.seed"]), values["simulator.trains_per_hour"],
+                               ratio_sd):
         text, _ = edited_site_text(base, [*curve.changes, *extra])
         (out / f"{curve.site_id}.yaml").write_text(text)
         v = load_parameter_file(out / f"{curve.site_id}.yaml")
@@ -165,11 +168,13 @@ def _network(ns: argparse.Namespace, values: dict) -> int:
         table = simulate(site, cfg)
         events = []
         if every > 0:
-            series = simulate_surveys(site, v, table, curve.k_b_factor, every, 1.0, int(v["simulator.seed"]) + 100)
+            series = simulate_surveys(site, v, table, curve.k_b_factors, every, 1.0, int(v["simulator.seed"]) + 100)
             events = series.events()
         write_passes_bag(table, out / curve.site_id, site.site_id, events=events, applicators=applicator_events(cfg))
-        due, cycles = true_outlook_days(site, v, table, curve.k_b_factor, seed=int(v["simulator.seed"]) + 200)
-        rows.append({"site_id": curve.site_id, "k_b_factor": curve.k_b_factor, "curve_radius_m": site.curve_radius_m,
+        due, cycles = true_outlook_days(site, v, table, curve.k_b_factors, seed=int(v["simulator.seed"]) + 200)
+        rows.append({"site_id": curve.site_id, "k_b_factor": curve.k_b_factor,
+                     "k_b_by_friction": " ".join(f"{f:g}" for f in curve.k_b_factors),
+                     "curve_radius_m": site.curve_radius_m,
                      "passes": len(table), "surveys": len(events), "true_due_days": due,
                      "true_cycle_days": " ".join(f"{c:.6g}" for c in cycles)})
     (out / "sites.yaml").write_text("sites:\n" + "".join(f"  - site: {r['site_id']}.yaml\n    history: {r['site_id']}\n"

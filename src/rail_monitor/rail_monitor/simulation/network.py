@@ -57,18 +57,22 @@ def true_days(outlooks: list[SiteOutlook], seed: int) -> tuple[np.ndarray, np.nd
 @dataclass(frozen=True)
 class NetworkSite:
     """One curve of a simulated network: the edits of the base site file (NAME=VALUE) that make it,
-    and its true rail's K_b over the configured one."""
+    and its true rail's K_b over the configured one: common to every friction state, and per state
+    (that factor times each state's own, FRICTION_* order)."""
 
     site_id: str
     changes: list[str]
     k_b_factor: float
+    k_b_factors: tuple[float, ...]
 
 
-def network_sites(n: int, seed: int, trains_per_hour: Sequence[float]) -> list[NetworkSite]:
+def network_sites(n: int, seed: int, trains_per_hour: Sequence[float], ratio_sd: float = 0.0) -> list[NetworkSite]:
     """n curves: radius log-uniform in 150-1,200 m, the base timetable scaled by 0.5-2, a wet
     fraction of 0.05-0.35, and a true K_b off the configured one by a log-normal factor (ln-sd 0.5,
-    kept within 0.3-3): what the site's surveys must find."""
+    kept within 0.3-3), each friction state's further by its own (ln-sd ratio_sd: the K_b prior's
+    kb_prior_ratio_sd draws truths as the forecast assumes them): what the site's surveys must find."""
     rng = np.random.default_rng(seed)
+    ratios = np.exp(ratio_sd * np.random.default_rng([seed, 1]).standard_normal((n, 4)))
     out = []
     for i in range(n):
         radius = float(np.exp(rng.uniform(np.log(150.0), np.log(1200.0))))
@@ -78,11 +82,11 @@ def network_sites(n: int, seed: int, trains_per_hour: Sequence[float]) -> list[N
         out.append(NetworkSite(site_id, [f"site_id={site_id}", f"curve_radius_m={radius:.0f}",
                                          f"simulator.trains_per_hour=[{', '.join(f'{x:g}' for x in profile)}]",
                                          f"simulator.wet_fraction={wet:.3f}", f"simulator.seed={seed * 1000 + i}"],
-                               round(factor, 3)))
+                               round(factor, 3), tuple(np.round(factor * ratios[i], 4).tolist())))
     return out
 
 
-def true_outlook_days(site: Site, values: Mapping[str, Any], passes: PassTable, k_b_factor: float,
+def true_outlook_days(site: Site, values: Mapping[str, Any], passes: PassTable, k_b_factor: float | Sequence[float],
                       grinds: int = TRUE_GRINDS, seed: int = 0) -> tuple[float, np.ndarray]:
     """The true rail's days to its threshold after the passes, and its cycle after each of the next
     ``grinds`` grinds, at the recent traffic (CorrugationEstimator.forecast of the true K_b: what a

@@ -9,7 +9,7 @@ its threshold. No rclpy: the simulate command and the tests call it.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,15 +48,17 @@ class SurveySeries:
         return int(crossed.min()) if len(crossed) else 0
 
 
-def true_estimator(site: Site, values: Mapping[str, Any], k_b_factor: float) -> CorrugationEstimator:
-    """A state of the site whose K_b is the configured one times k_b_factor."""
+def true_estimator(site: Site, values: Mapping[str, Any], k_b_factor: float | Sequence[float]) -> CorrugationEstimator:
+    """A state of the site whose K_b is the configured one times k_b_factor (one for every friction
+    state, or one per state in FRICTION_* order)."""
     cfg = corrugation_config(values)
-    scaled = {f"corrugation.k_b.{name}": float(k) * k_b_factor
-              for name, k in zip(K_B_DEFAULTS, cfg.k_b.tolist(), strict=True)}
+    factors = np.broadcast_to(np.asarray(k_b_factor, float), cfg.k_b.shape)
+    scaled = {f"corrugation.k_b.{name}": float(k * f)
+              for name, k, f in zip(K_B_DEFAULTS, cfg.k_b.tolist(), factors.tolist(), strict=True)}
     return CorrugationEstimator(site, corrugation_config({**values, **scaled}))
 
 
-def simulate_surveys(site: Site, values: Mapping[str, Any], passes: PassTable, k_b_factor: float,
+def simulate_surveys(site: Site, values: Mapping[str, Any], passes: PassTable, k_b_factor: float | Sequence[float],
                      every_days: float, uncertainty_db: float, seed: int) -> SurveySeries:
     """Surveys every ``every_days`` [day] from the first pass's day (the first one then, on the
     freshly ground rail) to the last pass, of the true rail under ``passes`` (time order)."""
