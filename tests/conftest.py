@@ -150,6 +150,16 @@ def tmpfs(tmp_path: Path):
         subprocess.run(["umount", "-l", str(disk)], capture_output=True)
 
 
+def executable(name: str) -> str:
+    """Resolve an executable the way `ros2 run rail_monitor <name>` does: ament index -> prefix/lib/pkg."""
+    from ament_index_python.packages import get_package_prefix, get_resource
+
+    get_resource("packages", "rail_monitor")  # raises LookupError if the package is not registered
+    path = Path(get_package_prefix("rail_monitor")) / "lib" / "rail_monitor" / name
+    assert path.is_file() and os.access(path, os.X_OK), path
+    return str(path)
+
+
 def run_cmd(*args: str, timeout: float = 120.0, **kw) -> subprocess.CompletedProcess:
     """Run a workspace executable (PATH set by ros2_ws/run) and capture its output."""
     env = {**os.environ, **kw.pop("env", {})}

@@ -52,6 +52,7 @@ setup(
             "wayside_monitor = rail_monitor.nodes.wayside_monitor:main",
             "noise_station = rail_monitor.nodes.noise_station:main",
             "site_engine = rail_monitor.nodes.site_engine:main",
+            "grinding_planner = rail_monitor.nodes.grinding_planner:main",
             "rail-monitor = rail_monitor.cli:main",
         ],
     },

@@ -119,3 +119,38 @@ def test_plan_chooses_an_option_where_a_site_offers_it(network, capsys):
     assert "(friction_modifier from the first visit)" in printed
     rows = list(csv.DictReader(out.open()))
     assert rows and {r["option"] for r in rows} == {"friction_modifier"}
+
+
+def test_replan_re_plans_on_each_outlook_of_the_histories(tmp_path, capsys):
+    """plan --replan on a simulated network of three curves surveyed every five days: one row per
+    outlook the sites' engines made (each survey applied while passes were taken), in stamp order,
+    the last the programme of every site's newest outlook (economics.replan.replay, the planner node's
+    re-plans); each outlook is the one its site's batch run records."""
+    from rail_monitor.bagio.reader import read_messages
+    from rail_monitor.batch.sites import outlook_history
+    from rail_monitor.economics.replan import Replanner, replay
+    from rail_monitor.messages.economics_fields import outlook_from_msg
+
+    net = tmp_path / "net"
+    assert main(["simulate", "--network", "3", "--days", "30", "--surveys-every-days", "5", "--out", str(net)]) == 0
+    out = tmp_path / "replans.csv"
+    assert main(["plan", str(net / "sites.yaml"), "--workers", "1", "--years", "2", "--replan", str(out)]) == 0
+    assert "re-plans, one per site outlook" in capsys.readouterr().out
+    rows = list(csv.DictReader(out.open()))
+    jobs = read_manifest(net / "sites.yaml", checkpoints=True)
+    histories = [outlook_history(j)[1] for j in jobs]
+    assert len(rows) == sum(map(len, histories)) and all(len(h) >= 4 for h in histories)
+    assert [r["made"] for r in rows] == sorted(r["made"] for r in rows)
+    replans = replay([x for h in histories for x in h], Replanner(2.0))
+    assert float(rows[-1]["expected_cost"]) == pytest.approx(replans[-1].programme.expected_cost.sum(), rel=1e-9)
+    assert int(rows[-1]["sites_planned"]) == 3 and rows[0]["sites_planned"] == "1"
+    # the batch run of a site records the same outlooks on grinding/outlook
+    job = jobs[0]
+    assert main(["batch", str(job.history), "--site", str(job.site), "--output", str(tmp_path / "bag"),
+                 "--no-report"]) == 0
+    recorded = read_messages(tmp_path / "bag", ["rail_msgs/msg/GrindingOutlook"])["rail_msgs/msg/GrindingOutlook"]
+    assert len(recorded) == len(histories[0])
+    for msg, (stamp, o) in zip(recorded, histories[0], strict=True):
+        got_stamp, got = outlook_from_msg(msg)
+        assert got_stamp == stamp and got.newest_ns == o.newest_ns
+        np.testing.assert_array_equal(got.due_days, o.due_days)

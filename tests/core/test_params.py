@@ -60,7 +60,8 @@ def _values_classes():
             (n.ReplayerParams, n.REPLAYER_SPECS, ()), (n.ModeParams, n.MODE_SPECS, ()),
             (n.RecorderParams, n.RECORDER_SPECS, ()), (n.MonitorParams, (*n.MONITOR_SPECS, n.SOURCE), ()),
             (n.StampParams, n.STAMP_SPECS, ()), (n.FoxgloveParams, n.FOXGLOVE_SPECS, ()),
-            (n.EstimatorParams, n.ESTIMATOR_SPECS, ()), (EconomicsConfig, ECONOMICS_SPECS, ())]
+            (n.EstimatorParams, n.ESTIMATOR_SPECS, ()), (EconomicsConfig, ECONOMICS_SPECS, ()),
+            (n.PlannerParams, n.PLANNER_SPECS, ())]
 
 
 def test_every_values_class_has_one_typed_field_per_spec():
@@ -77,4 +78,4 @@ def test_every_values_class_has_one_typed_field_per_spec():
         got = [(f.name, f.type if isinstance(f.type, str) else f.type.__name__) for f in dataclasses.fields(klass)]
         assert got == want, klass.__name__
         assert klass.__dataclass_params__.frozen, klass.__name__
-    assert len(classes) == 15
+    assert len(classes) == 16

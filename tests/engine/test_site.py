@@ -148,8 +148,9 @@ def _assert_same_result(got, whole) -> None:
 def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(site_values, sample_passes):
     """A history's surveys and grinding events (one at a stamp two passes share, one refused as not
     newer, one matching no band, one after the last accepted pass): applied before the first pass stamped
-    later, they give the state of an estimator advanced and surveyed by hand in that order, and
-    random chunk boundaries give the one call's outputs bit for bit."""
+    later, they give the state of an estimator advanced and surveyed by hand in that order, each one
+    applied while passes are taken makes the grinding outlook of the state it leaves, and random chunk
+    boundaries give the one call's outputs bit for bit."""
     import numpy as np
 
     from rail_monitor.batch.run import run_models
@@ -158,6 +159,8 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
     from rail_monitor.corrugation.config import corrugation_config
     from rail_monitor.corrugation.estimator import CorrugationEstimator
     from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_SURVEY, MaintenanceEvent, apply_event
+    from rail_monitor.economics.config import economics_config
+    from rail_monitor.economics.outlook import site_outlook
     from rail_monitor.engine.result import SiteOutputs
 
     history = _hostile_history(sample_passes)
@@ -181,7 +184,7 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
     # by hand: the accepted passes up to each event's stamp, then the event
     sent = history.take(np.isin(history.stamp_ns, whole.passes.stamp_ns))
     accepted = with_class_defaults(whole.passes.take(rejection_reasons(whole.passes, est.site) == ""), est.site)
-    refused = 0
+    refused, made = 0, []
     for e in sorted(events, key=lambda e: e.stamp_ns):
         n = int(np.argmax(accepted.stamp_ns > e.stamp_ns)) if (accepted.stamp_ns > e.stamp_ns).any() else len(accepted)
         est.advance(accepted.take(slice(0, n)))
@@ -190,7 +193,16 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
             apply_event(est, e)
         except ValueError:
             refused += 1
+            continue
+        if (history.stamp_ns > e.stamp_ns).any():  # one after every pass given is applied at the end: no outlook
+            made.append((e.stamp_ns, site_outlook(est, economics_config(site_values))))
     assert len(sent) and refused == 2
+    # each event applied while passes were taken made the grinding outlook of the state it left
+    assert [e.stamp_ns for e, _ in whole.outlooks] == [t for t, _ in made] and len(made) == 5
+    for (_, a), (_, b) in zip(whole.outlooks, made, strict=True):
+        assert a.newest_ns == b.newest_ns
+        np.testing.assert_array_equal(a.due_days, b.due_days)
+        np.testing.assert_array_equal(a.cycle_days, b.cycle_days)
     np.testing.assert_array_equal(est.log_components, whole.estimator.log_components)
     np.testing.assert_array_equal(est.k_b, whole.estimator.k_b)
 
@@ -201,6 +213,10 @@ def test_surveys_and_grinding_apply_before_the_first_later_pass_in_any_chunking(
         _assert_same_result(got, whole)
         assert sum(run.events_refused.values()) == 2
         assert [e.stamp_ns for e in got.events + run.trailing_events] == [e.stamp_ns for e in whole.events]
+        assert [(e.stamp_ns, o.newest_ns) for e, o in got.outlooks] == [(e.stamp_ns, o.newest_ns)
+                                                                        for e, o in whole.outlooks]
+        for (_, a), (_, b) in zip(got.outlooks, whole.outlooks, strict=True):
+            np.testing.assert_array_equal(a.due_days, b.due_days)
         np.testing.assert_array_equal(run.estimator.log_components, whole.estimator.log_components)
 
 

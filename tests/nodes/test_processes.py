@@ -11,22 +11,14 @@ import time
 from pathlib import Path
 
 import yaml
-from ament_index_python.packages import get_package_prefix, get_resource
+from ament_index_python.packages import get_package_prefix
 from rosbags.highlevel import AnyReader
 
 from rail_monitor.bagio.reader import read_bag_passes, salvage_mcap
 
-from conftest import SAMPLE, TOP, run_cmd, wait_until
+from conftest import SAMPLE, TOP, executable, run_cmd, wait_until
 
 FIVE_DAYS = str(5 * 86400.0)
-
-
-def _exe(name: str) -> str:
-    """Resolve an executable the way `ros2 run rail_monitor <name>` does: ament index -> prefix/lib/pkg."""
-    get_resource("packages", "rail_monitor")  # raises LookupError if the package is not registered
-    path = Path(get_package_prefix("rail_monitor")) / "lib" / "rail_monitor" / name
-    assert path.is_file() and os.access(path, os.X_OK), path
-    return str(path)
 
 
 def _expected_slice() -> int:
@@ -35,22 +27,22 @@ def _expected_slice() -> int:
 
 
 def _start_recorder(out: Path, *extra: str) -> subprocess.Popen:
-    p = subprocess.Popen([_exe("mcap_recorder"), "--ros-args", "-p", f"output:={out}", "-r", "__ns:=/site",
+    p = subprocess.Popen([executable("mcap_recorder"), "--ros-args", "-p", f"output:={out}", "-r", "__ns:=/site",
                           "-p", "flush_period_s:=0.2", *extra],
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=TOP)
     return p
 
 
 def _replay(*extra: str) -> subprocess.CompletedProcess:
-    return run_cmd(_exe("pass_replayer"), "--ros-args", "-r", "__ns:=/site", "-p", f"source:={SAMPLE}",
+    return run_cmd(executable("pass_replayer"), "--ros-args", "-r", "__ns:=/site", "-p", f"source:={SAMPLE}",
                    "-p", f"end_offset_s:={FIVE_DAYS}", "-p", "wait_for_subscribers:=1", "-p", "progress:=false",
                    *extra, timeout=120)
 
 
 def test_ament_index_resolves_every_executable():
     for name in ("pass_replayer", "pass_simulator", "mcap_recorder", "wayside_monitor", "rail-monitor"):
-        _exe(name)
-    r = run_cmd(_exe("rail-monitor"), "replay", "--help")
+        executable(name)
+    r = run_cmd(executable("rail-monitor"), "replay", "--help")
     assert r.returncode == 0
     # --help shows each node parameter with its unit, range and default
     assert "default: 0.0 [rate]" in r.stdout and "[s]" in r.stdout and "[0, 1e+09]" in r.stdout
@@ -119,7 +111,7 @@ def test_replayer_with_unusable_csv_exits_nonzero_naming_the_line(tmp_path: Path
     bad = tmp_path / "bad.csv"
     bad.write_text("time_utc,train_id,vehicle_class,vehicle_count,speed_mps,angle_of_attack_rad,friction_state\n"
                    "2026-09-01T05:00:00Z,T1,emu,3,nineteen,0.005,dry\n", encoding="utf-8")
-    r = run_cmd(_exe("pass_replayer"), "--ros-args", "-p", f"source:={bad}", timeout=60)
+    r = run_cmd(executable("pass_replayer"), "--ros-args", "-p", f"source:={bad}", timeout=60)
     assert r.returncode == 2 and "Traceback" not in r.stderr
     assert "line 2: column 'speed_mps'" in r.stderr
 
@@ -188,7 +180,7 @@ def test_a_signal_mid_replay_stops_the_source_and_the_graph_cleanly(tmp_path):
          tmp_path / "bag"),
     ]
     for argv, sig, bag in cases:
-        p = subprocess.Popen([_exe(argv[0]), *argv[1:]], cwd=TOP, text=True, stdout=subprocess.PIPE,
+        p = subprocess.Popen([executable(argv[0]), *argv[1:]], cwd=TOP, text=True, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE)
         lines: list[str] = []
         reader = threading.Thread(target=lines.extend, args=(p.stderr,), daemon=True)
@@ -212,7 +204,7 @@ def test_a_model_node_started_bare_reads_the_shipped_site():
     """No --params-file: a model node says so and reads the shipped site file (all three classes),
     as the command line does; before, it knew only the default 'emu' and rejected every other
     pass (issue 24: 1,653 DMU and freight passes)."""
-    p = subprocess.Popen([_exe("squeal_risk_model"), "--ros-args", "-r", "__ns:=/bare"], stdout=subprocess.PIPE,
+    p = subprocess.Popen([executable("squeal_risk_model"), "--ros-args", "-r", "__ns:=/bare"], stdout=subprocess.PIPE,
                          stderr=subprocess.STDOUT, text=True, cwd=TOP)
     lines = []
     try:

@@ -163,7 +163,7 @@ def _assert_equal_runs(live, batch) -> None:
 COMPARED = ("rail_msgs/msg/TrainPass", "rail_msgs/msg/SquealPrediction", "rail_msgs/msg/RollingNoise",
             "rail_msgs/msg/CorrugationState", "rail_msgs/msg/WaysideAlert", "rail_msgs/msg/NoiseResidual",
             "rail_msgs/msg/RoughnessSurvey", "rail_msgs/msg/MeasuredPassNoise", "rail_msgs/msg/IndirectRoughness",
-            "rail_msgs/msg/SquealCalibration")
+            "rail_msgs/msg/SquealCalibration", "rail_msgs/msg/GrindingOutlook")
 
 
 FORECAST_TIME_NS = 1_000_000  # a forecast time is float arithmetic over ~1e17 ns: equal within 1 ms
@@ -249,6 +249,12 @@ def test_every_output_topic_is_recorded_with_consistent_counts(runs):
     assert fits[-1] == result.trajectory.constants_at(len(result.trajectory) - 1).calibration_surveys > 2
     assert min(m.pass_count for m in states) == 1
     assert result.estimator.calibration_surveys == fits[-1] + 1  # the survey after the last pass, at the end
+    # each survey, grinding and observation applied while passes were taken made the site's grinding
+    # outlook (the survey after the last pass, applied at shutdown, none)
+    outlooks = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/GrindingOutlook"])["rail_msgs/msg/GrindingOutlook"]
+    made = sorted([e.stamp_ns for e in _events()[:3]] + [o.event.stamp_ns for o in result.observations if o.event])
+    assert [time_ns(m.header.stamp) for m in outlooks] == made and len(made) == 4
+    assert [m.event_kind for m in outlooks if time_ns(m.header.stamp) == _events()[1].stamp_ns] == [KIND_GRINDING]
     # measured noise: every good measurement gives a residual per model; the four bad ones none
     # (their reasons: tests/measured/test_residuals.py)
     residuals = read_messages(runs["tmp"] / "live", ["rail_msgs/msg/NoiseResidual"])["rail_msgs/msg/NoiseResidual"]

@@ -46,7 +46,7 @@ SECTIONS: tuple[tuple[str, tuple[ParamSpec, ...]], ...] = (
     *(("", specs) for specs in (node_params.PUBLISH_SPECS, node_params.REPLAYER_SPECS, node_params.MODE_SPECS,
                                 node_params.RECORDER_SPECS, node_params.MONITOR_SPECS, node_params.BATCH_SPECS,
                                 node_params.ESTIMATOR_SPECS, node_params.PREDICTOR_SPECS,
-                                node_params.FOXGLOVE_SPECS)),
+                                node_params.FOXGLOVE_SPECS, node_params.PLANNER_SPECS)),
 )
 # Parameters every rclpy node has, which a parameter file may set too.
 ROS_PARAMETERS = ("use_sim_time", "start_type_description_service")
@@ -162,6 +162,7 @@ REFERENCE_SECTIONS: tuple[tuple[str, str, tuple[ParamSpec, ...]], ...] = (
     ("Model nodes: batches of passes", "", node_params.BATCH_SPECS),
     ("corrugation_estimator and site_engine", "", node_params.ESTIMATOR_SPECS),
     ("rolling_noise_predictor", "", node_params.PREDICTOR_SPECS), ("foxglove_server", "", node_params.FOXGLOVE_SPECS),
+    ("grinding_planner", "", node_params.PLANNER_SPECS),
 )
 
 

@@ -92,6 +92,8 @@ class BatchBag:
         self.measured(result.measurements, result.residuals)
         for msgs in outputs.measured((), result.observations, self.frame, result.calibrations):
             self._write(msgs)
+        if result.outlooks:
+            self._write(outputs.outlooks(result.outlooks, self.frame))
 
     def _alerts(self, events: list[Alert]) -> None:
         for msgs in self._alert_stream.messages(events):

@@ -22,6 +22,7 @@ corrugation checkpoint) in place of ``history:``; each task returns the site's g
 
 from __future__ import annotations
 
+import functools
 import logging
 import os
 import time
@@ -112,12 +113,21 @@ def outlook_site(job: SiteJob) -> Any:
     """One site's grinding outlook (economics.outlook.SiteOutlook) from its history, surveys and
     grinding events applied, or from its checkpoint, with the options its economics.options offer
     priced (a task: imports inside, runs on a worker)."""
+    return _site_outlooks(job, False)[0]
+
+
+def outlook_history(job: SiteJob) -> Any:
+    """One site's outlook now (as outlook_site) and those its engine made on each survey, grinding
+    or indirect observation of its history, with their stamps [ns] (a checkpoint: none)."""
+    return _site_outlooks(job, True)
+
+
+def _site_outlooks(job: SiteJob, made: bool) -> tuple[Any, list[tuple[int, Any]]]:
     from rail_monitor.advice.consequences import Consequences
     from rail_monitor.bagio.reader import read_bag_events, read_passes
     from rail_monitor.core.passes import accepted_passes
     from rail_monitor.corrugation.estimator import CorrugationEstimator
-    from rail_monitor.economics.options import site_options
-    from rail_monitor.economics.outlook import site_outlook
+    from rail_monitor.economics.options import configured_outlook
     from rail_monitor.engine import checkpoint
     from rail_monitor.engine.corrugation_site import advance_with_events
     from rail_monitor.engine.site_config import SiteConfig
@@ -126,18 +136,22 @@ def outlook_site(job: SiteJob) -> Any:
 
     cfg = SiteConfig.from_values(load_parameter_file(job.site))
     est = CorrugationEstimator(cfg.site, cfg.corrugation)
+    consequences = functools.cache(lambda: Consequences(cfg.site, RollingNoiseModel(cfg.site, cfg.noise), cfg.squeal))
+
+    def outlook() -> Any:
+        return configured_outlook(est, cfg.economics, consequences)
+
+    history: list[tuple[int, Any]] = []
     if job.checkpoint is not None:
         checkpoint.load(est, job.checkpoint)
     else:
         passes = read_passes(job.history)
-        advance_with_events(est, accepted_passes(passes, cfg.site), read_bag_events(job.history))
+        step = advance_with_events(est, accepted_passes(passes, cfg.site), read_bag_events(job.history),
+                                   outlook if made else None)
+        history = [(e.stamp_ns, o) for e, o in step.outlooks]
     if not est.total_pass_count:
         raise RailMonitorError(f"{job.checkpoint or job.history}: no valid pass of site {cfg.site.site_id}")
-    options = ()
-    if cfg.economics.options != ["grind"]:
-        options = site_options(est, cfg.economics,
-                               Consequences(cfg.site, RollingNoiseModel(cfg.site, cfg.noise), cfg.squeal))
-    return site_outlook(est, cfg.economics, options)
+    return outlook(), history
 
 
 def _worker_name() -> str:

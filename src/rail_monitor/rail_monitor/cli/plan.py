@@ -33,6 +33,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--report", metavar="DIR", help="write a report for a manager into DIR: what to grind when, what "
                    "it costs and saves against a fixed cycle and grinding when due, and the risk left (index.html "
                    "and programme.pdf, with the timeline)")
+    s.add_argument("--replan", metavar="CSV", help="re-plan as the histories went: the programme solved again on "
+                   "each site's outlook made at each survey, grinding or indirect observation, in stamp order, as "
+                   "grinding_planner does live; one row per re-plan (histories only, not checkpoints)")
     s.add_argument("--workers", type=int, default=0, help="worker processes reading the sites (default: one per "
                    "core)")
     s.add_argument("--scheduler", help="address of a running Dask scheduler instead of a local cluster")
@@ -40,7 +43,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(ns: argparse.Namespace) -> int:
-    from rail_monitor.batch.sites import outlook_site, read_manifest, run_sites
+    from rail_monitor.batch.sites import outlook_history, outlook_site, read_manifest, run_sites
     from rail_monitor.economics import baselines
     from rail_monitor.economics.outlook import WIDE
     from rail_monitor.economics.programme import Rules, plan
@@ -49,14 +52,15 @@ def run(ns: argparse.Namespace) -> int:
     if not 0 < ns.years <= 50 or not 0 < ns.risk < 1 or ns.capacity < 0 or ns.budget < 0 or ns.fixed_cycle_months < 0:
         raise RailMonitorError("--years must be in (0, 50], --risk in (0, 1), and --capacity, --budget and "
                                "--fixed-cycle-months not negative")
-    outlooks = run_sites(read_manifest(ns.manifest, checkpoints=True), ns.workers, ns.scheduler or "",
-                         task=outlook_site)
+    results = run_sites(read_manifest(ns.manifest, checkpoints=True), ns.workers, ns.scheduler or "",
+                        task=outlook_history if ns.replan else outlook_site)
+    outlooks = [r[0] for r in results] if ns.replan else results
     ids = [o.site_id for o in outlooks]
     if len(set(ids)) != len(ids):
         twice = ", ".join(sorted({i for i in ids if ids.count(i) > 1}))
         raise RailMonitorError(f"{ns.manifest}: site ids repeat ({twice}): each site needs its own site_id")
     start = parse_iso_ns(ns.start) if ns.start else max(o.newest_ns for o in outlooks)
-    rules = Rules(max(1, round(12 * ns.years)), start, ns.capacity, ns.budget, ns.risk)
+    rules = Rules.over(ns.years, start, ns.capacity, ns.budget, ns.risk)
     prog = plan(outlooks, rules)
     every = ns.fixed_cycle_months or baselines.median_cycle_months(outlooks, rules)
 
@@ -108,7 +112,32 @@ def run(ns: argparse.Namespace) -> int:
 
         files = write_programme_report(Path(ns.report), outlooks, prog, rules, runs, wide)
         print(f"plan: report for a manager written to {printable(files[-1])} and {printable(files[-2])}")
+    if ns.replan:
+        _replan(ns, [made for _, made in results])
     return 0
+
+
+def _replan(ns: argparse.Namespace, histories: list) -> None:
+    import pandas as pd
+
+    from rail_monitor.economics.replan import Replanner, replay
+
+    planner = Replanner(ns.years, ns.capacity, ns.budget, ns.risk)
+    rows = []
+    for r in replay([x for made in histories for x in made], planner):
+        p, rules = r.programme, r.rules
+        firsts = [(int(v[0]), s) for s, v in zip(p.sites, p.visits, strict=True) if len(v)]
+        m, site = min(firsts) if firsts else (-1, "")
+        rows.append({"made": iso_day(r.stamp_ns), "site_id": r.site_id, "sites_planned": len(p.sites),
+                     "start": iso_day(rules.start_ns), "visits": sum(len(v) for v in p.visits),
+                     "expected_cost": float(p.expected_cost.sum()), "expected_late": float(p.lates.sum()),
+                     "next_visit_site": site, "next_visit_month": iso_day(rules.month_ns(m))[:7] if m >= 0 else "",
+                     "status": p.status})
+    pd.DataFrame(rows, columns=["made", "site_id", "sites_planned", "start", "visits", "expected_cost",
+                                "expected_late", "next_visit_site", "next_visit_month", "status"]).to_csv(
+        ns.replan, index=False)
+    print(f"plan: {len(rows)} re-plans, one per site outlook made in the histories, written to "
+          f"{printable(ns.replan)}")
 
 
 def _write(ns: argparse.Namespace, outlooks: list, prog, month) -> None:

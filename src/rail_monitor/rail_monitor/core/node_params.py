@@ -103,6 +103,21 @@ FOXGLOVE_SPECS: tuple[ParamSpec, ...] = (
 )
 
 
+# grinding_planner: a network's grinding programme, re-planned on each site's outlook.
+PLANNER_SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("years", 5.0, "The programme's horizon from the newest pass counted at any site [year].", 0.1, 50.0),
+    ParamSpec("capacity", 0, "Most site visits in a month (0: no limit) [-].", 0, 100000),
+    ParamSpec("budget_per_year", 0.0, "Most preventive grinding cost in a programme year (0: no limit) "
+              "[cost unit].", 0.0, 1.0e15),
+    ParamSpec("risk_limit", 0.1, "Most chance a site's worst band passes its threshold before its visit [-].",
+              0.001, 0.999),
+    ParamSpec("pull_forward_months", 6, "Months a first visit may come before the due date's 0.1 % quantile "
+              "[month].", 0, 120),
+    ParamSpec("topics", [""], "Outlook topics to plan on (absolute or relative to the namespace); empty: every "
+              "rail_msgs/GrindingOutlook topic, each site's grinding/outlook."),
+    DISCOVERY_PERIOD,
+)
+
 # wayside_monitor: the one-process graph.
 MONITOR_SPECS: tuple[ParamSpec, ...] = (
     STOP_TIMEOUT,
@@ -238,6 +253,19 @@ class StampParams:
 
     max_ahead_of_stream_s: float
     max_ahead_of_clock_s: float
+
+
+@dataclass(frozen=True)
+class PlannerParams:
+    """grinding_planner's parameters."""
+
+    years: float
+    capacity: int
+    budget_per_year: float
+    risk_limit: float
+    pull_forward_months: int
+    topics: list[str]
+    discovery_period_s: float
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,8 @@ running cost (economics.* site parameters), and its other effects.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from rail_monitor.advice.consequences import Consequences
@@ -30,7 +32,15 @@ from rail_monitor.core.friction import FRICTION_DRY, FRICTION_MODIFIER
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.history import COLUMNS, KeptPasses
 from rail_monitor.economics.config import EconomicsConfig
-from rail_monitor.economics.outlook import Option
+from rail_monitor.economics.outlook import Option, SiteOutlook, site_outlook
+
+
+def configured_outlook(est: CorrugationEstimator, cfg: EconomicsConfig,
+                       consequences: Callable[[], Consequences]) -> SiteOutlook:
+    """The site's outlook with the options its economics.options offer priced (grinding alone: none,
+    and consequences is not called)."""
+    options = site_options(est, cfg, consequences()) if cfg.options != ["grind"] else ()
+    return site_outlook(est, cfg, options)
 
 
 def site_options(est: CorrugationEstimator, cfg: EconomicsConfig, consequences: Consequences) -> tuple[Option, ...]:

@@ -51,6 +51,12 @@ class Rules:
     risk_limit: float = 0.1          # most chance a band passes its threshold before its visit [-]
     pull_forward: int = 6            # months a first visit may come before the due date's 0.1 % quantile
 
+    @classmethod
+    def over(cls, years: float, start_ns: int, capacity: int = 0, budget_per_year: float = 0.0,
+             risk_limit: float = 0.1, pull_forward: int = 6) -> Rules:
+        """The rules of a horizon of years [year] (whole months, at least one)."""
+        return cls(max(1, round(12 * years)), start_ns, capacity, budget_per_year, risk_limit, pull_forward)
+
     def month_ns(self, m: float) -> int:
         """When programme month m begins [ns]."""
         return int(self.start_ns + m * MONTH_DAYS * NS_PER_DAY)

@@ -13,7 +13,11 @@ same events before the same passes by construction:
 
 The owner feeds passes through :meth:`CorrugationSite.segments`, handling each segment (counting
 it, predicting on it, publishing) before the cut that follows it is applied; what was applied,
-refused and observed is reported through the hooks ``on_event`` and ``on_observation``.
+refused and observed is reported through the hooks ``on_event`` and ``on_observation``. With an
+``outlook`` maker, each event applied while passes are taken makes the site's grinding outlook
+(economics.outlook), kept in ``outlooks`` until the owner takes them (before on_event is called);
+the events applied by :meth:`CorrugationSite.finish` make none: they come at the end of a history
+or at shutdown, with nobody left to plan on them (the state, checkpointed, holds them).
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.corrugation.surveys import KIND_GRINDING, KIND_INDIRECT, MaintenanceEvent, apply_event, in_time_order
+from rail_monitor.economics.outlook import SiteOutlook
 from rail_monitor.measured.observer import IndirectObserver, Observation, next_cut
 from rail_monitor.models.calibration import KbPosterior
 
@@ -58,6 +63,9 @@ class CorrugationSite:
         self.late = 0                              # events taken after passes later than them were counted
         self.on_event: Callable[[MaintenanceEvent, KbPosterior | None, str], None] = _no_event
         self.on_observation: Callable[[Observation], None] = _no_observation
+        self.outlook: Callable[[], SiteOutlook] | None = None
+        self.outlooks: list[tuple[MaintenanceEvent, SiteOutlook]] = []  # made, not yet taken
+        self._finishing = False
 
     def advance(self, passes: PassTable) -> Trajectory:
         """Count the passes (valid, class defaults filled, no event due among them): the state and
@@ -110,6 +118,8 @@ class CorrugationSite:
         if self.observer is not None:
             self.observer.note(event)
         self.applied[EVENT_COUNT.get(event.kind, "surveys")] += 1
+        if self.outlook is not None and not self._finishing:
+            self.outlooks.append((event, self.outlook()))
         self.on_event(event, fit, "")
         return True
 
@@ -143,19 +153,30 @@ class CorrugationSite:
         """Apply the events later than every pass (at the end of a history, or at shutdown); those
         events, applied or not."""
         rest, self.pending = self.pending, []
-        for event in rest:
-            self.apply(event)
+        self._finishing = True
+        try:
+            for event in rest:
+                self.apply(event)
+        finally:
+            self._finishing = False
         return rest
 
+    def take_outlooks(self) -> list[tuple[MaintenanceEvent, SiteOutlook]]:
+        """The outlooks made since the last take, with their events."""
+        made, self.outlooks = self.outlooks, []
+        return made
 
-def advance_with_events(est: CorrugationEstimator, passes: PassTable, events: Sequence[MaintenanceEvent]
-                        ) -> dict[str, int]:
+
+def advance_with_events(est: CorrugationEstimator, passes: PassTable, events: Sequence[MaintenanceEvent],
+                        outlook: Callable[[], SiteOutlook] | None = None) -> CorrugationSite:
     """Advance est over passes (valid, class defaults filled, in stream order) with each event
     applied before the first pass stamped later than it (those after every pass at the end), as
-    the engine applies them; the events refused, by reason (a refused event changes nothing)."""
+    the engine applies them; the step, with the events refused by reason (``refused``: a refused
+    event changes nothing) and, given an outlook maker, the outlooks made (``outlooks``)."""
     site = CorrugationSite(est)
     site.pending = in_time_order(events)
+    site.outlook = outlook
     for part in site.segments(passes):
         est.advance(part)
     site.finish()
-    return dict(site.refused)
+    return site

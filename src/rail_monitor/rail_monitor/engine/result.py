@@ -17,6 +17,7 @@ from rail_monitor.core.site import Site
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.economics.outlook import SiteOutlook
 from rail_monitor.engine.squeal_site import Calibration
 from rail_monitor.measured.observer import Observation
 from rail_monitor.measured.records import Measurement
@@ -47,6 +48,7 @@ class SiteOutputs:
     residuals: list[Residual] = field(default_factory=list)        # measured minus predicted, in stamp order
     observations: list[Observation] = field(default_factory=list)  # indirect roughness windows closed
     calibrations: list[Calibration] = field(default_factory=list)  # the squeal model's fits made
+    outlooks: list[tuple[MaintenanceEvent, SiteOutlook]] = field(default_factory=list)  # made on each event applied
 
     @classmethod
     def merged(cls, parts: Sequence[SiteOutputs], held: list[Alert], advice: SpeedAdvice | None) -> SiteOutputs:
@@ -67,4 +69,5 @@ class SiteOutputs:
                    measurements=[m for p in parts for m in p.measurements],
                    residuals=[r for p in parts for r in p.residuals],
                    observations=[o for p in parts for o in p.observations],
-                   calibrations=[c for p in parts for c in p.calibrations])
+                   calibrations=[c for p in parts for c in p.calibrations],
+                   outlooks=[o for p in parts for o in p.outlooks])

@@ -9,8 +9,10 @@ backlog live), surveys and grinding (``corrugation.take``) and measured pass-bys
 (:meth:`SiteEngine.take_measurements`). Outputs: what the live graph publishes, pass for pass
 (:class:`rail_monitor.engine.result.SiteOutputs`): the squeal prediction of every accepted pass,
 the corrugation state after every counted pass, the rolling noise of every accepted pass on the
-state that includes it, the alert events, residuals and indirect roughness, and the speed advice
-on the final state (:meth:`SiteEngine.finish`). Any chunking gives one call's outputs.
+state that includes it, the alert events, residuals and indirect roughness, the grinding outlook
+made on each survey, grinding or indirect observation applied (economics.outlook, the input of a
+network's programme), and the speed advice on the final state (:meth:`SiteEngine.finish`). Any
+chunking gives one call's outputs.
 """
 
 from __future__ import annotations
@@ -34,6 +36,8 @@ from rail_monitor.core.timeutil import fits_time_msg, format_iso_ns
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.records import Trajectory
 from rail_monitor.corrugation.surveys import MaintenanceEvent, in_time_order
+from rail_monitor.economics.options import configured_outlook
+from rail_monitor.economics.outlook import SiteOutlook
 from rail_monitor.engine import checkpoint
 from rail_monitor.engine.corrugation_site import CorrugationSite
 from rail_monitor.engine.noise_chunks import noise_on_states, pool_of
@@ -138,6 +142,8 @@ class SiteEngine:
         self.corrugation.pending = in_time_order(events)
         self.corrugation.on_event = self._on_event
         self.corrugation.on_observation = self._on_observation
+        self.corrugation.outlook = self._outlook
+        self._consequences: Consequences | None = None
         self._parts: list[SiteOutputs] = []  # the segments of the chunk being fed
 
     def resume(self, path: str) -> tuple[Any, list[str]]:
@@ -202,8 +208,21 @@ class SiteEngine:
         """A survey or grinding of the history (applied or refused) goes with the segment before it;
         a window's own observation goes with it as an observation."""
         part = self._parts[-1] if self._parts else None
-        if part is not None and not (part.observations and part.observations[-1].event is event):
+        if part is None:  # taken on arrival between chunks (live): its outlook waits in corrugation.outlooks
+            return
+        if not (part.observations and part.observations[-1].event is event):
             part.events.append(event)
+        part.outlooks.extend(self.corrugation.take_outlooks())
+
+    def consequences(self) -> Consequences:
+        """What a pass's speed does besides corrugation: the engine's noise model and squeal parameters."""
+        if self._consequences is None:
+            self._consequences = Consequences(self.site, self.model, self.cfg.squeal)
+        return self._consequences
+
+    def _outlook(self) -> SiteOutlook:
+        """The site's grinding outlook now, with the options its economics.options offer."""
+        return configured_outlook(self.estimator, self.cfg.economics, self.consequences)
 
     def _on_observation(self, obs: Observation) -> None:
         self._parts[-1].observations.append(obs)
@@ -311,7 +330,7 @@ class SiteEngine:
         self.tracker.finish()
         held, self._held = self._held, []
         with pool_of(self.threads) as pool:
-            return held, advise_or_none(self.estimator, Consequences(self.site, self.model, self.cfg.squeal), pool)
+            return held, advise_or_none(self.estimator, self.consequences(), pool)
 
 
 def _alert_key(a: Alert) -> tuple[int, int, str, bool]:

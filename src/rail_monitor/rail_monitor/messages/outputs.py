@@ -8,7 +8,7 @@ manager's: each raise or clear on ``alerts``, then the standing set after it on
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -17,11 +17,14 @@ from rail_monitor.advice.plan import SpeedAdvice
 from rail_monitor.alerts.manager import Alert
 from rail_monitor.codec.cdr import serialize
 from rail_monitor.codec.cdr_from_columns import serialize_columns
+from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.economics.outlook import SiteOutlook
 from rail_monitor.engine.result import SiteOutputs
 from rail_monitor.engine.squeal_site import Calibration
 from rail_monitor.measured.observer import Observation
 from rail_monitor.measured.residuals import Residual
 from rail_monitor.messages import fields
+from rail_monitor.messages.economics_fields import grinding_outlook_fields
 from rail_monitor.messages.topics import GRAPH_TOPICS, OPTIONAL_TOPICS
 
 
@@ -66,6 +69,13 @@ def measured(residuals: Iterable[Residual], observations: Iterable[Observation],
               for o in observations),
             *(one("noise/squeal_calibration", fields.squeal_calibration_fields(c, frame), c.stamp_ns)
               for c in calibrations)]
+
+
+def outlooks(made: Sequence[tuple[MaintenanceEvent, SiteOutlook]], frame: str) -> Messages:
+    """The grinding outlook made on each event applied (stamped with the event)."""
+    t = typename("grinding/outlook")
+    return Messages("grinding/outlook", [serialize(t, grinding_outlook_fields(e, o, frame)) for e, o in made],
+                    [e.stamp_ns for e, _ in made])
 
 
 def advice(advised: SpeedAdvice, newest_ns: int, frame: str) -> Messages:

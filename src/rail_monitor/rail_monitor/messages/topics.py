@@ -87,4 +87,9 @@ OPTIONAL_TOPICS: dict[str, tuple[str, Qos]] = {
     "noise/squeal_calibration": ("rail_msgs/msg/SquealCalibration", STREAM),
     # A friction-modifier applicator's start or stop: a site event for the record (no model takes
     # it), latched so that a recorder that matches late still records it.
-    "friction_applicator": ("rail_msgs/msg/FrictionApplicator", STREAM)}
+    "friction_applicator": ("rail_msgs/msg/FrictionApplicator", STREAM),
+    # The site's grinding outlook, made on each survey, grinding or indirect observation applied;
+    # latched with depth: a planner started later takes every site's recent outlooks, the newest last.
+    "grinding/outlook": ("rail_msgs/msg/GrindingOutlook", STREAM)}
+# A network's grinding programme (grinding_planner, not a site's topic): the current one matters.
+PROGRAMME_TOPIC = ("grinding/programme", "rail_msgs/msg/GrindingProgramme", LATEST)

@@ -10,8 +10,9 @@ late); surveys queued behind a backlog of passes are taken first. With ``residua
 observation (rail_monitor.measured.observer; published on ``corrugation/indirect_roughness``,
 rail_msgs/IndirectRoughness). Publishes
 ``corrugation/state`` (rail_msgs/CorrugationState, per pass or at most every ``state_period_s``)
-and ``speed_advisory`` (rail_msgs/SpeedAdvisory, every ``advisory_period_s``), both latched;
-serves ``evaluate_speed_distribution``. With
+and ``speed_advisory`` (rail_msgs/SpeedAdvisory, every ``advisory_period_s``), both latched, and
+``grinding/outlook`` (rail_msgs/GrindingOutlook) on each survey, grinding or indirect observation
+applied; serves ``evaluate_speed_distribution``. With
 ``checkpoint_path`` set, the state is written atomically every ``checkpoint_every_passes``
 passes, after every survey and at shutdown (the executor copies it; a writer thread encodes and
 writes it, rail_monitor.engine.checkpoint.CheckpointWriter), and a restart resumes from it.
@@ -35,10 +36,13 @@ from rail_monitor.corrugation import surveys
 from rail_monitor.corrugation.config import CORRUGATION_SPECS, corrugation_config
 from rail_monitor.corrugation.estimator import CorrugationEstimator
 from rail_monitor.corrugation.surveys import MaintenanceEvent
+from rail_monitor.economics.config import ECONOMICS_SPECS, economics_config
+from rail_monitor.economics.options import configured_outlook
 from rail_monitor.engine import checkpoint
 from rail_monitor.engine.corrugation_site import CorrugationSite
 from rail_monitor.measured.config import RESIDUAL_SPECS, residual_config
 from rail_monitor.measured.observer import IndirectObserver, Observation
+from rail_monitor.messages.economics_fields import grinding_outlook_fields
 from rail_monitor.messages.event_fields import event_from_msg
 from rail_monitor.messages.fields import (
     PassHead,
@@ -57,6 +61,7 @@ from rail_monitor.noise.predict import RollingNoiseModel
 from rail_monitor.squeal.config import SQUEAL_SPECS, squeal_config
 from rail_msgs.msg import (
     CorrugationState,
+    GrindingOutlook,
     IndirectRoughness,
     MeasuredPassNoise,
     RoughnessSurvey,
@@ -66,9 +71,10 @@ from rail_msgs.msg import (
 class CorrugationEstimatorNode(PassConsumerNode):
     EXECUTABLE = "corrugation_estimator"
     # noise.* and squeal.*: what the speed advice weighs besides corrugation (rail_monitor.advice);
-    # residual.*: the indirect roughness taken as an observation.
+    # residual.*: the indirect roughness taken as an observation; economics.*: the grinding outlook.
     PARAMETERS = (*PassConsumerNode.PARAMETERS, ("", ESTIMATOR_SPECS), ("corrugation.", CORRUGATION_SPECS),
-                  ("noise.", NOISE_SPECS), ("squeal.", SQUEAL_SPECS), ("residual.", RESIDUAL_SPECS))
+                  ("noise.", NOISE_SPECS), ("squeal.", SQUEAL_SPECS), ("residual.", RESIDUAL_SPECS),
+                  ("economics.", ECONOMICS_SPECS))
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("corrugation_estimator", **kwargs)
@@ -77,6 +83,7 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.est = CorrugationEstimator(self.site, cfg)
         self._noise_cfg = noise_config(declare(self, NOISE_SPECS, prefix="noise."), prefix="")
         self._squeal_cfg = squeal_config(declare(self, SQUEAL_SPECS, prefix="squeal."), prefix="")
+        economics = economics_config(declare(self, ECONOMICS_SPECS, prefix="economics."), prefix="")
         self._consequences: Consequences | None = None
         self._noise_model: RollingNoiseModel | None = None
         residual_cfg = residual_config(declare(self, RESIDUAL_SPECS, prefix="residual."), prefix="")
@@ -86,6 +93,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
         self.corrugation = CorrugationSite(self.est, observer)
         self.corrugation.on_event = self._on_event
         self.corrugation.on_observation = self._on_observation
+        self.corrugation.outlook = lambda: configured_outlook(self.est, economics, self.consequences)
+        self.outlook_pub = self.create_publisher(GrindingOutlook, "grinding/outlook", STREAM_QOS)
         self.counts: Counter[str] = Counter()
         self.state_pub = self.create_publisher(CorrugationState, "corrugation/state", STATE_QOS)
         self.state_services = StateServices(self, self.est, self.params, self.consequences, self.sent,
@@ -179,6 +188,8 @@ class CorrugationEstimatorNode(PassConsumerNode):
         if fit is not None and event.kind == surveys.KIND_SURVEY:
             self.get_logger().info(f"survey re-fitted K_b: P50 {self.est.k_b.tolist()}, "
                                    f"P10 {self.est.k_b_p10.tolist()}, P90 {self.est.k_b_p90.tolist()}")
+        for made, outlook in self.corrugation.take_outlooks():
+            self.sent.publish(self.outlook_pub, grinding_outlook_fields(made, outlook, self.site.site_id))
         self.state_services.save()
 
     def close(self) -> None:

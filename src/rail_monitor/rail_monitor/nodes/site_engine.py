@@ -11,7 +11,9 @@ drift alerts, and with ``residual.indirect_days`` > 0 the indirect roughness win
 Publishes what the four model nodes of the separate-process layout publish, on the same topics
 with the same QoS: ``noise/squeal``, ``corrugation/state`` (every counted pass, or at most every
 ``state_period_s``), ``noise/rolling``, ``alerts`` and ``alerts/standing``, ``noise/residual``,
-``corrugation/indirect_roughness`` and ``speed_advisory`` (every ``advisory_period_s``). Serves
+``corrugation/indirect_roughness``, ``grinding/outlook`` (rail_msgs/GrindingOutlook, on each survey,
+grinding or indirect observation applied: the input of grinding_planner) and ``speed_advisory``
+(every ``advisory_period_s``). Serves
 ``evaluate_speed_distribution``; checkpoints the state as corrugation_estimator does
 (``checkpoint_path``). A pass older than one already taken is rejected with its reason (the engine
 takes passes in stamp order). Parameters: the site file's ``/**`` section and ``/**/site_engine``.
@@ -37,6 +39,7 @@ from rail_monitor.core.node_params import ESTIMATOR_SPECS, EstimatorParams
 from rail_monitor.core.params import values_of
 from rail_monitor.core.passes import PassTable
 from rail_monitor.corrugation.config import CORRUGATION_SPECS
+from rail_monitor.economics.config import ECONOMICS_SPECS
 from rail_monitor.engine.site import SiteEngine
 from rail_monitor.measured.config import RESIDUAL_SPECS
 from rail_monitor.measured.records import Measurement
@@ -60,9 +63,10 @@ from rail_monitor.squeal.config import SQUEAL_SPECS
 from rail_msgs.msg import MeasuredPassNoise, RoughnessSurvey
 
 MODEL_SECTIONS = (("corrugation.", CORRUGATION_SPECS), ("noise.", NOISE_SPECS), ("squeal.", SQUEAL_SPECS),
+                  ("economics.", ECONOMICS_SPECS),
                   ("residual.", RESIDUAL_SPECS), ("alerts.", ALERT_SPECS))
 PUBLISHED = ("noise/squeal", "corrugation/state", "noise/rolling", "alerts", "alerts/standing", "noise/residual",
-             "corrugation/indirect_roughness", "noise/squeal_calibration")
+             "corrugation/indirect_roughness", "noise/squeal_calibration", "grinding/outlook")
 
 
 class SiteEngineNode(PassConsumerNode):
@@ -79,7 +83,6 @@ class SiteEngineNode(PassConsumerNode):
         # numpy kernels (numba's import stays out of a live start-up); one thread: the executor's.
         self.engine = SiteEngine(values, threads=1, engine="numpy")
         self.engine.measured_live = True  # a station's measurement comes after its pass
-        self._consequences: Consequences | None = None
         # The indirect roughness only where its windows are kept (as corrugation_estimator offers it),
         # the squeal model's fits where it is fitted.
         offered = {"corrugation/indirect_roughness": self.engine.observer is not None,
@@ -107,9 +110,7 @@ class SiteEngineNode(PassConsumerNode):
 
     def consequences(self) -> Consequences:
         """The noise model and squeal parameters the advice weighs (the engine's)."""
-        if self._consequences is None:
-            self._consequences = Consequences(self.site, self.engine.model, self.engine.cfg.squeal)
-        return self._consequences
+        return self.engine.consequences()
 
     def publish_advisory(self) -> None:
         """The advice on the current state (also every advisory_period_s)."""
@@ -152,6 +153,7 @@ class SiteEngineNode(PassConsumerNode):
                 self._send(msgs)
             elif msgs.datas:
                 self.state_services.publish_state_if_due()
+        self._send(outputs.outlooks(result.outlooks, self.site.site_id))
         self._events()
         self._publish(result.alerts, result.residuals, result.observations, result.calibrations)
         self._settle()
@@ -194,6 +196,7 @@ class SiteEngineNode(PassConsumerNode):
     def _events(self) -> None:
         """Surveys and grinding applied since the last look: checkpointed; refused: logged."""
         corr = self.engine.corrugation
+        self._send(outputs.outlooks(corr.take_outlooks(), self.site.site_id))  # those applied on arrival
         applied, refused = sum(corr.applied.values()), sum(corr.refused.values())
         if refused > self._events_seen[1]:
             self.get_logger().warning(f"roughness survey rejected: {dict(corr.refused)}")

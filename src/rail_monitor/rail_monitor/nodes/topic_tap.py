@@ -54,14 +54,16 @@ class TopicTap:
     """Subscribe node to every wanted topic as it appears.
 
     topics: names (absolute or relative to the node's namespace); empty: every rail_msgs topic
-    and /diagnostics. on_topic(topic, typename, offered QoS) runs once per topic before its first
-    message; on_messages(topic, [CDR bytes]) per batch taken.
+    and /diagnostics; types: only topics of these types (empty: any). on_topic(topic, typename,
+    offered QoS) runs once per topic before its first message; on_messages(topic, [CDR bytes]) per
+    batch taken.
     """
 
     def __init__(self, node: Node, topics: list[str], period_s: float,
                  on_topic: Callable[[str, str, list[QoSProfile]], None],
-                 on_messages: Callable[[str, list[bytes]], None]) -> None:
+                 on_messages: Callable[[str, list[bytes]], None], types: tuple[str, ...] = ()) -> None:
         self.node = node
+        self._types = set(types)
         wanted = [t for t in topics if t]
         self._wanted = {node.resolve_topic_name(t) for t in wanted} if wanted else None
         self._on_topic, self._on_messages = on_topic, on_messages
@@ -94,9 +96,11 @@ class TopicTap:
                    for topic, types in node.get_topic_names_and_types())
 
     def _want(self, topic: str, types: list[str]) -> bool:
+        if self._types and not self._types.intersection(types):
+            return False
         if self._wanted is not None:
             return topic in self._wanted
-        return any(t.startswith(DEFAULT_TYPES_PREFIX) or t == DIAGNOSTICS_TYPE for t in types)
+        return bool(self._types) or any(t.startswith(DEFAULT_TYPES_PREFIX) or t == DIAGNOSTICS_TYPE for t in types)
 
     def discover(self) -> None:
         """Subscribe to every wanted topic that has appeared, with a QoS its publishers accept."""

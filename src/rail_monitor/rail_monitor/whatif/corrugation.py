@@ -74,7 +74,7 @@ def predict_corrugation(values: Mapping[str, Any], history: PassTable | None = N
     kernel_class = None
     if history is not None:
         ok = rejection_reasons(history, site) == ""
-        refused = advance_with_events(est, with_class_defaults(history.take(ok), site), events)
+        refused = dict(advance_with_events(est, with_class_defaults(history.take(ok), site), events).refused)
         where = f"site {site.site_id}, history {history_name} ({int(ok.sum())} passes, {int((~ok).sum())} rejected)"
         if not len(est.kept):
             raise RailMonitorError(f"{history_name}: no valid pass for site {site.site_id}")
