@@ -23,6 +23,7 @@ from rail_monitor.economics.programme import (
     plan,
     schedule_terms,
     schedules,
+    visit_overdue,
     visit_risks,
 )
 from rail_monitor.simulation.network import network_outlooks, true_days
@@ -55,7 +56,7 @@ def test_the_law_passes_through_the_forecast_quantiles():
 
 def test_every_schedule_costs_what_its_visits_cost():
     """The vectorised candidates (schedules) against each one's months costed gap by gap (visit_risks,
-    schedule_terms), to 1e-9 relative; a site already past due and one that never is, too."""
+    visit_overdue, schedule_terms), to 1e-9 relative; a site already past due and one that never is, too."""
     rules = Rules(36, 40 * NS_PER_DAY)
     for o in (_outlook(0, 200.0, 300.0, 0.3), _outlook(1, 10.0, 150.0, 0.5), _outlook(2, np.inf, np.inf, 0.3),
               _with_options(_outlook(3, 200.0, 300.0, 0.3), 60.0, 400.0)):
@@ -63,8 +64,10 @@ def test_every_schedule_costs_what_its_visits_cost():
         assert set(s.option) == set(range(len(o.choices())))
         for k in range(len(s.cost)):
             under = o.under(o.choices()[s.option[k]].name)
-            risks = visit_risks(under, rules, months_of(int(s.first[k]), int(s.gap[k]), rules.months))
-            expected, charged = schedule_terms(under, risks, rules, int(s.first[k]))
+            months = months_of(int(s.first[k]), int(s.gap[k]), rules.months)
+            risks = visit_risks(under, rules, months)
+            overdue = visit_overdue(under, rules, months)
+            expected, charged = schedule_terms(under, risks, overdue, rules, int(s.first[k]))
             assert s.expected[k] == pytest.approx(expected, rel=1e-9) and s.cost[k] == pytest.approx(charged, rel=1e-9)
             assert s.risk[k] == pytest.approx(risks.max(), rel=1e-9) and s.lates[k] == pytest.approx(risks.sum(),
                                                                                                      rel=1e-9)
@@ -85,8 +88,7 @@ def test_the_optimum_equals_exhaustive_search():
             continue
         best = min(best, sum(c.cost[k] for c, k in zip(cands, pick, strict=True)))
     prog = plan(sites, rules)
-    charged = sum(schedule_terms(o.under(c), visit_risks(o.under(c), rules, v), rules, first_month(v))[1]
-                  for o, v, c in zip(sites, prog.visits, prog.option, strict=True))
+    charged = sum(_terms(o.under(c), rules, v)[1] for o, v, c in zip(sites, prog.visits, prog.option, strict=True))
     assert charged == pytest.approx(best, rel=1e-9)
     assert np.bincount(np.concatenate(prog.visits)).max() <= 1
 
@@ -119,10 +121,13 @@ def test_the_programme_takes_an_option_where_it_is_cheaper():
     prog = plan(sites, rules)
     assert prog.option == ["friction_modifier", "speed_control"]
     for o, v, opt, cost in zip(sites, prog.visits, prog.option, prog.expected_cost, strict=True):
-        assert cost == pytest.approx(schedule_terms(o.under(opt), visit_risks(o.under(opt), rules, v), rules,
-                                                    first_month(v))[0], rel=1e-9)
+        assert cost == pytest.approx(_terms(o.under(opt), rules, v)[0], rel=1e-9)
     grind_only = plan([o.under("grind") for o in sites], rules)
     assert prog.expected_cost.sum() < grind_only.expected_cost.sum()
+
+
+def _terms(o: SiteOutlook, rules: Rules, v: np.ndarray) -> tuple[float, float]:
+    return schedule_terms(o, visit_risks(o, rules, v), visit_overdue(o, rules, v), rules, first_month(v))
 
 
 def _yearly(prog) -> np.ndarray:
@@ -155,9 +160,42 @@ def test_on_a_network_of_known_truth_the_programme_costs_least():
 def test_a_realised_schedule_takes_each_grinds_own_cycle():
     """Counted by hand (months of 30.44 days): due in 100 days, visits in months 2, 9 and 14 of 24.
     Cycles 300 then 100 days: on time (day 61), on time (274 < 361), late (426 >= 374), and the
-    threshold passed again on day 726 before the horizon (730.5) owes one more: 2 on time, 2 late.
-    One cycle of 300 days throughout: only the one owed at the end is late."""
+    threshold passed again on day 726 before the horizon (730.5) owes one more: 2 on time, 2 late,
+    each late one owing a further visit per median cycle (300 days) it came after the threshold (426 -
+    374 and 730.5 - 726 days). One cycle of 300 days throughout: only the one owed at the end is late."""
     o, rules = _outlook(0, 100.0, 300.0, 0.2), Rules(24, 0)
     visits = np.array([2, 9, 14])
-    assert baselines.realised(o, rules, visits, 100.0, [300.0, 100.0]) == (2 * 500.0 + 2 * 1500.0, 2)
-    assert baselines.realised(o, rules, visits, 100.0, 300.0) == (3 * 500.0 + 1500.0, 1)
+    m = 365.25 / 12
+    cost, late = baselines.realised(o, rules, visits, 100.0, [300.0, 100.0])
+    assert late == 2 and cost == pytest.approx(2 * 500.0 + 1500.0 * (2 + (14 * m - (9 * m + 100)) / 300.0
+                                                                     + (24 * m - (14 * m + 300)) / 300.0), rel=1e-12)
+    cost, late = baselines.realised(o, rules, visits, 100.0, 300.0)
+    assert late == 1 and cost == pytest.approx(3 * 500.0 + 1500.0 * (1 + (24 * m - (14 * m + 300)) / 300.0), rel=1e-12)
+
+
+def test_the_time_past_the_threshold_is_the_log_normal_s_partial_expectation():
+    """Law.past(d) = E[(d - T)+] = the integral of the CDF from 0 to d, against scipy's quadrature of
+    lognorm's CDF, to 1e-9 relative; 0 where the threshold never comes."""
+    from scipy import integrate
+
+    law = Law.through(np.array([120.0, 300.0, 750.0]))
+    ref = stats.lognorm(s=law.sigma, scale=np.exp(law.mu))
+    for d in (30.0, 300.0, 2000.0):
+        want = integrate.quad(ref.cdf, 0.0, d, limit=200, epsabs=0, epsrel=1e-12)[0]
+        assert float(law.past(d)) == pytest.approx(want, rel=1e-9)
+    assert float(Law.through(np.array([np.inf] * 3)).past(1e6)) == 0.0
+
+
+def test_a_site_past_its_threshold_is_visited_at_once():
+    """A site certainly past its threshold (due 100 days before the programme starts, ln-sd 0.05; cycle
+    150 days) beside one due in a year: the overdue site's first visit is in month 0, whatever the
+    horizon, because every month it waits costs a fifth of a corrective visit. Without that charge
+    (0.29.0) it was left unvisited over one year and five: one corrective visit owed at the horizon
+    looked cheaper than a cycle of visits, every schedule's first gap being as late as no visit's."""
+    sites = [_outlook(0, 60.0, 150.0, 0.05), _outlook(1, 365.0, 400.0, 0.2, newest_days=160.0)]
+    for months in (12, 60):
+        rules = Rules(months, 160 * NS_PER_DAY, capacity=1)
+        prog = plan(sites, rules)
+        assert int(prog.visits[0][0]) == 0 and len(prog.visits[0]) >= months * 30 // 150
+        s = schedules(sites[0], rules)
+        assert s.expected[0] > s.expected[np.argmin(s.cost)]  # no visit: the dearest to leave

@@ -16,7 +16,9 @@ from rail_monitor.economics.programme import (
     Rules,
     first_month,
     offset_days,
+    overdue_unit,
     schedule_terms,
+    visit_overdue,
     visit_risks,
 )
 
@@ -55,7 +57,8 @@ def expected(outlooks: Sequence[SiteOutlook], rules: Rules, visits: Sequence[np.
     rows = []
     for o, v in zip(outlooks, visits, strict=True):
         risks = visit_risks(o, rules, v)
-        rows.append((schedule_terms(o, risks, rules, first_month(v))[0], risks.max(), risks.sum()))
+        cost = schedule_terms(o, risks, visit_overdue(o, rules, v), rules, first_month(v))[0]
+        rows.append((cost, risks.max(), risks.sum()))
     return tuple(np.array(c) for c in zip(*rows, strict=True)) if rows else (np.zeros(0),) * 3
 
 
@@ -64,17 +67,19 @@ def realised(o: SiteOutlook, rules: Rules, visits: np.ndarray, due_days: float,
     """(cost, thresholds passed first) of a schedule on a site whose true days to threshold now
     and after each grind are known (one cycle, or one per grind in turn, repeated): a visit after
     the threshold is corrective; a threshold passed between the last visit and the horizon owes a
-    corrective visit, as in the plan."""
+    corrective visit, and the time past a threshold one more per overdue_unit of it, as in the plan."""
     cycles = np.atleast_1d(np.asarray(cycle_days, float))
     cross = due_days - offset_days(o, rules)       # days from the start
+    unit = overdue_unit(o)  # time past the threshold before the start (cross < 0) is no schedule's doing
     cost, late = 0.0, 0
     for k, m in enumerate(np.asarray(visits, float) * MONTH_DAYS):
         passed = m >= cross
-        cost += o.late_visit_cost if passed else o.visit_cost
+        cost += o.late_visit_cost * (1.0 + (m - max(cross, 0.0)) / unit) if passed else o.visit_cost
         late += int(passed)
         cross = m + cycles[k % len(cycles)]
-    if rules.months * MONTH_DAYS > cross:
-        cost += o.late_visit_cost
+    end = rules.months * MONTH_DAYS
+    if end > cross:
+        cost += o.late_visit_cost * (1.0 + (end - max(cross, 0.0)) / unit)
         late += 1
     return cost, late
 

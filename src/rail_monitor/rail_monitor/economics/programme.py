@@ -9,7 +9,10 @@ months before its due date's EARLIEST quantile up to its quantile max(GAP_RISKS)
 visits at a gap of one of the cycle's GAP_RISKS quantiles. A gap's risk is the chance the
 threshold comes first; a visit costs its preventive cost plus that risk times the corrective
 visit's extra; the span from the last visit to the horizon adds its risk times a corrective visit
-(one is then owed). A gap whose risk is above the limit is charged OVER_LIMIT corrective visits,
+(one is then owed). The time a rail spends past its threshold before its visit (or the horizon)
+owes one more corrective visit per median cycle of it (OVERDUE_UNIT): left corrugated, the rail
+roughens on, a cycle's growth in each cycle's time, and so leaving an overdue site unvisited, or
+visiting it late, is never free. A gap whose risk is above the limit is charged OVER_LIMIT corrective visits,
 and RISK_WEIGHT more per unit of excess, so the limit holds wherever capacity and budget allow it
 and the problem is never infeasible. Choosing one schedule per site is a set partition, solved by
 scipy.optimize.milp (HiGHS branch and cut, to a 1 % gap): already a dependency, and its LP
@@ -84,6 +87,18 @@ class Law:
         with np.errstate(divide="ignore"):
             return special.ndtr((np.log(days) - self.mu) / self.sigma)
 
+    def past(self, days: np.ndarray | float) -> np.ndarray:
+        """Expected days past the threshold within days, E[(days - T)+] [day] (0 where it never comes):
+        days*Phi(z) - exp(mu + sigma^2/2)*Phi(z - sigma), z = (ln days - mu)/sigma, the log-normal's
+        partial expectation."""
+        days = np.maximum(np.asarray(days, float), 0.0)
+        if not np.isfinite(self.mu):
+            return np.zeros_like(days)
+        with np.errstate(divide="ignore"):
+            z = (np.log(days) - self.mu) / self.sigma
+        return np.maximum(days * special.ndtr(z) - np.exp(self.mu + self.sigma ** 2 / 2) * special.ndtr(z - self.sigma),
+                          0.0)
+
     def quantile(self, p: float) -> float:
         return float(np.exp(self.mu + self.sigma * special.ndtri(p)))
 
@@ -132,17 +147,35 @@ def visit_risks(o: SiteOutlook, rules: Rules, visits: np.ndarray) -> np.ndarray:
     return risks
 
 
+def overdue_unit(o: SiteOutlook) -> float:
+    """Days past the threshold that owe one more corrective visit: the cycle's median [day]."""
+    return max(float(o.cycle_days[1]), SHORTEST_DAYS)
+
+
+def visit_overdue(o: SiteOutlook, rules: Rules, visits: np.ndarray) -> np.ndarray:
+    """Expected time past the threshold in each gap of a schedule, within the horizon, in units of
+    overdue_unit (the corrective visits it owes beyond the first) [-]."""
+    due, cycle, shift = Law.through(o.due_days), Law.through(o.cycle_days), offset_days(o, rules)
+    visits = np.asarray(visits, float)
+    ends = np.append(visits, rules.months) * MONTH_DAYS
+    past = cycle.past(ends - np.concatenate([[0.0], visits * MONTH_DAYS]))
+    past[0] = due.past(shift + ends[0]) - due.past(max(shift, 0.0))  # before the start: no schedule's doing
+    return past / overdue_unit(o)
+
+
 def first_month(visits: np.ndarray) -> int:
     """A schedule's first visit's month (-1: no visit)."""
     return int(visits[0]) if len(visits) else -1
 
 
-def schedule_terms(o: SiteOutlook, risks: np.ndarray, rules: Rules, first: int = -1) -> tuple[float, float]:
-    """(expected cost, cost with the excess-risk charge) of a schedule from its gap risks, with
-    the running cost of the outlook's option from its first visit's month (-1: none)."""
+def schedule_terms(o: SiteOutlook, risks: np.ndarray, overdue: np.ndarray, rules: Rules,
+                   first: int = -1) -> tuple[float, float]:
+    """(expected cost, cost with the excess-risk charge) of a schedule from its gap risks and time
+    past the threshold (visit_risks, visit_overdue), with the running cost of the outlook's option
+    from its first visit's month (-1: none)."""
     extra = o.late_visit_cost - o.visit_cost
     expected = ((len(risks) - 1) * o.visit_cost + float(risks[:-1].sum()) * extra + float(risks[-1]) * o.late_visit_cost
-                + o.running_cost(first, rules.months))
+                + float(overdue.sum()) * o.late_visit_cost + o.running_cost(first, rules.months))
     excess = float(np.maximum(risks - rules.risk_limit, 0.0).sum())
     over = int((risks > rules.risk_limit).sum())
     return expected, expected + o.late_visit_cost * (RISK_WEIGHT * excess + OVER_LIMIT * over)
@@ -151,23 +184,30 @@ def schedule_terms(o: SiteOutlook, risks: np.ndarray, rules: Rules, first: int =
 def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
     """The site's candidate schedules (see the module's docstring) under each of its options in
     turn, vectorised over first months; the first is no visit at all. Each equals schedule_terms
-    over visit_risks of its months, with the outlook under its option (SiteOutlook.under)."""
+    over visit_risks and visit_overdue of its months, with the outlook under its option
+    (SiteOutlook.under)."""
     due, shift, m = Law.through(o.due_days), offset_days(o, rules), rules.months
     first, gap, option = [np.array([-1])], [np.array([0])], [np.array([0])]
+    before_start = due.past(max(shift, 0.0))
     visits, risks = [np.zeros(1)], [np.array([[0.0], [0.0], [due.before(shift + m * MONTH_DAYS)], [0.0]])]
+    unit = overdue_unit(o.under(o.choices()[0].name))  # no visit: reckoned under the first choice
+    overdue = [np.array([(due.past(shift + m * MONTH_DAYS) - before_start) / unit])]
     running = [np.zeros(1)]
     if np.isfinite(due.mu):
         lo = max(0, int((due.quantile(EARLIEST) - shift) // MONTH_DAYS) - rules.pull_forward)
         hi = min(m - 1, max(0, int(np.ceil((due.quantile(max(GAP_RISKS)) - shift) / MONTH_DAYS))))
         firsts = np.arange(min(lo, hi), hi + 1)
         p_first = due.before(shift + firsts * MONTH_DAYS)
+        past_first = due.past(shift + firsts * MONTH_DAYS) - before_start
         for j, choice in enumerate(o.choices()):
-            cycle = Law.through(choice.cycle_days)
+            cycle, unit = Law.through(choice.cycle_days), overdue_unit(o.under(choice.name))
             gaps = {max(1, int(cycle.quantile(r) // MONTH_DAYS)) for r in GAP_RISKS} if np.isfinite(cycle.mu) else set()
             for g in sorted(gaps | {m}):       # a gap of m months: a single visit
                 n = 1 + (m - 1 - firsts) // g
                 tail = cycle.before((m - firsts - (n - 1) * g) * MONTH_DAYS)
                 p_gap = np.where(n > 1, cycle.before(g * MONTH_DAYS), 0.0)
+                overdue.append((past_first + (n - 1) * cycle.past(g * MONTH_DAYS)
+                                + cycle.past((m - firsts - (n - 1) * g) * MONTH_DAYS)) / unit)
                 first.append(firsts)
                 gap.append(np.full(len(firsts), g if g < m else 0))
                 option.append(np.full(len(firsts), j))
@@ -183,7 +223,7 @@ def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
               + np.maximum(tail - limit, 0))
     over = (p_first > limit) + repeats * (p_gap > limit) + (tail > limit)
     expected = (n * o.visit_cost + (p_first + repeats * p_gap) * extra + tail * o.late_visit_cost
-                + np.concatenate(running))
+                + np.concatenate(overdue) * o.late_visit_cost + np.concatenate(running))
     risk = np.maximum(np.maximum(p_first, tail), p_gap)
     charged = expected + o.late_visit_cost * (RISK_WEIGHT * excess + OVER_LIMIT * over)
     return Schedules(charged, expected, risk, lates, np.concatenate(first), np.concatenate(gap),
