@@ -36,6 +36,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     s.add_argument("--replan", metavar="CSV", help="re-plan as the histories went: the programme solved again on "
                    "each site's outlook made at each survey, grinding or indirect observation, in stamp order, as "
                    "grinding_planner does live; one row per re-plan (histories only, not checkpoints)")
+    s.add_argument("--time-limit", type=float, default=60.0, help="longest a solve may take [s]; at the limit the "
+                   "best programme found is taken, its status saying so (a capacity that binds makes it hard)")
     s.add_argument("--workers", type=int, default=0, help="worker processes reading the sites (default: one per "
                    "core)")
     s.add_argument("--scheduler", help="address of a running Dask scheduler instead of a local cluster")
@@ -49,9 +51,10 @@ def run(ns: argparse.Namespace) -> int:
     from rail_monitor.economics.programme import Rules, plan
     from rail_monitor.report.programme_page import days_text
 
-    if not 0 < ns.years <= 50 or not 0 < ns.risk < 1 or ns.capacity < 0 or ns.budget < 0 or ns.fixed_cycle_months < 0:
-        raise RailMonitorError("--years must be in (0, 50], --risk in (0, 1), and --capacity, --budget and "
-                               "--fixed-cycle-months not negative")
+    if (not 0 < ns.years <= 50 or not 0 < ns.risk < 1 or ns.capacity < 0 or ns.budget < 0 or ns.fixed_cycle_months < 0
+            or not ns.time_limit > 0):
+        raise RailMonitorError("--years must be in (0, 50], --risk in (0, 1), --time-limit above 0, and --capacity, "
+                               "--budget and --fixed-cycle-months not negative")
     results = run_sites(read_manifest(ns.manifest, checkpoints=True), ns.workers, ns.scheduler or "",
                         task=outlook_history if ns.replan else outlook_site)
     outlooks = [r[0] for r in results] if ns.replan else results
@@ -61,7 +64,7 @@ def run(ns: argparse.Namespace) -> int:
         raise RailMonitorError(f"{ns.manifest}: site ids repeat ({twice}): each site needs its own site_id")
     start = parse_iso_ns(ns.start) if ns.start else max(o.newest_ns for o in outlooks)
     rules = Rules.over(ns.years, start, ns.capacity, ns.budget, ns.risk)
-    prog = plan(outlooks, rules)
+    prog = plan(outlooks, rules, ns.time_limit)
     every = ns.fixed_cycle_months or baselines.median_cycle_months(outlooks, rules)
 
     def month(m: int) -> str:
@@ -122,7 +125,7 @@ def _replan(ns: argparse.Namespace, histories: list) -> None:
 
     from rail_monitor.economics.replan import Replanner, replay
 
-    planner = Replanner(ns.years, ns.capacity, ns.budget, ns.risk)
+    planner = Replanner(ns.years, ns.capacity, ns.budget, ns.risk, time_limit_s=ns.time_limit)
     rows = []
     for r in replay([x for made in histories for x in made], planner):
         p, rules = r.programme, r.rules

@@ -113,6 +113,8 @@ PLANNER_SPECS: tuple[ParamSpec, ...] = (
               0.001, 0.999),
     ParamSpec("pull_forward_months", 6, "Months a first visit may come before the due date's 0.1 % quantile "
               "[month].", 0, 120),
+    ParamSpec("time_limit_s", 10.0, "Longest a re-plan's solve may take; at the limit the best programme found is "
+              "published, its status saying so (a capacity that binds makes the solve hard) [s].", 0.1, 3600.0),
     ParamSpec("topics", [""], "Outlook topics to plan on (absolute or relative to the namespace); empty: every "
               "rail_msgs/GrindingOutlook topic, each site's grinding/outlook."),
     DISCOVERY_PERIOD,
@@ -264,6 +266,7 @@ class PlannerParams:
     budget_per_year: float
     risk_limit: float
     pull_forward_months: int
+    time_limit_s: float
     topics: list[str]
     discovery_period_s: float
 

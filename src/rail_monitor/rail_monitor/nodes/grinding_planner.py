@@ -5,11 +5,11 @@ by its site_engine or corrugation_estimator on each survey, grinding or indirect
 applied), or the ``topics`` named, and re-plans the programme over the newest outlook of every
 site heard (rail_monitor.economics.replan: the months to visit each site over ``years`` at least
 expected cost, each gap's risk held to ``risk_limit``, within ``capacity`` visits a month and
-``budget_per_year``). Publishes each programme on ``grinding/programme``
-(rail_msgs/GrindingProgramme, latched: a late subscriber gets the current one). An outlook older
-than one already taken from its site changes nothing; one that cannot be read or planned is
-counted on /diagnostics and the programme stays as it was. ``rail-monitor plan --replan`` runs
-the same re-plans over the sites' histories.
+``budget_per_year``; each solve stopped at ``time_limit_s`` with the best programme found).
+Publishes each programme on ``grinding/programme`` (rail_msgs/GrindingProgramme, latched: a late
+subscriber gets the current one). An outlook older than one already taken from its site changes
+nothing; one that cannot be read or planned is counted on /diagnostics and the programme stays as
+it was. ``rail-monitor plan --replan`` runs the same re-plans over the sites' histories.
 """
 
 from __future__ import annotations
@@ -43,7 +43,8 @@ class GrindingPlanner(TapNode):
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         c = self.cfg
-        self.planner = Replanner(c.years, c.capacity, c.budget_per_year, c.risk_limit, c.pull_forward_months)
+        self.planner = Replanner(c.years, c.capacity, c.budget_per_year, c.risk_limit, c.pull_forward_months,
+                                 c.time_limit_s)
         topic, typename, qos = PROGRAMME_TOPIC
         self.pub = self.create_publisher(message_class(typename), topic, profile(qos))
         self.sent = Sent()
