@@ -5,6 +5,8 @@ visit later, and a survey that finds the rail rougher brings it forward."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from rail_monitor.economics.outlook import SiteOutlook
@@ -57,12 +59,25 @@ def test_every_re_plan_is_the_programme_of_the_newest_outlooks_in_any_arrival_or
         assert per_month.max() <= 2 and p.risk.max() <= rules.risk_limit + 1e-12
 
 
-def test_an_outlook_older_than_its_site_s_newest_changes_nothing():
+def test_an_outlook_older_than_its_site_s_newest_or_unplannable_changes_nothing():
+    """An older outlook is passed over; one with NaN or unordered days, or a corrective visit cheaper
+    than a preventive one, is refused in one line, and the next good one is planned on as before."""
+    import pytest
+
     planner = Replanner(years=2.0)
     first = planner.take(T0 + 10 * DAY, _outlook("a", 10, 400.0))
     assert first is not None
     assert planner.take(T0 + 5 * DAY, _outlook("a", 5, 30.0)) is None
     assert planner.latest["a"][0] == T0 + 10 * DAY and planner.latest["a"][1].due_days[1] == 400.0
+    bad = [replace(_outlook("a", 20, 300.0), due_days=np.array([np.nan, 1.0, 2.0])),
+           replace(_outlook("b", 20, 300.0), cycle_days=np.array([300.0, 200.0, 900.0])),
+           replace(_outlook("b", 20, 300.0), late_visit_cost=100.0)]
+    for o in bad:
+        with pytest.raises(ValueError, match="refused: its"):
+            planner.take(T0 + 20 * DAY, o)
+    assert list(planner.latest) == ["a"] and planner.latest["a"][0] == T0 + 10 * DAY
+    again = planner.take(T0 + 30 * DAY, _outlook("b", 30, 200.0))
+    assert [o.site_id for o in again.outlooks] == ["a", "b"]
 
 
 def test_a_grinding_moves_its_site_s_visit_later_and_a_rough_survey_brings_it_forward():

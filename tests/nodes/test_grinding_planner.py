@@ -1,13 +1,14 @@
 """grinding_planner (issue 57): a separate process that finds every site's grinding/outlook topic as
 it appears and publishes the network's programme, re-planned on each outlook, over real DDS. Its
 programmes are those of economics.replan over the same outlooks (what ``rail-monitor plan --replan``
-runs in batch); an outlook older than its site's newest and bytes that are no outlook change
-nothing, are counted on /diagnostics, and leave the node planning."""
+runs in batch); an outlook older than its site's newest, one with NaN days and bytes that are no
+outlook change nothing, are counted on /diagnostics, and leave the node planning."""
 
 from __future__ import annotations
 
 import signal
 import subprocess
+from dataclasses import replace
 
 import numpy as np
 import rclpy
@@ -58,11 +59,15 @@ def test_the_planner_process_re_plans_on_each_site_s_outlook(ros_context):
             old_event, old = _outlook("a", 10, 5.0)     # older than a's newest: no re-plan
             pubs["a"].publish(to_msg(GrindingOutlook, grinding_outlook_fields(old_event, old, "a")))
             pubs["b"].publish(b"\x00\x01\x00\x00\x07")  # no outlook at all
+            nan_event, nan = _outlook("b", 35, 20.0)     # days no forecast gives
+            nan = replace(nan, due_days=np.array([np.nan, 20.0, 40.0]))
+            pubs["b"].publish(to_msg(GrindingOutlook, grinding_outlook_fields(nan_event, nan, "b")))
             event, o = _outlook("b", 40, 20.0)
             sent.append((event, o))
             pubs["b"].publish(to_msg(GrindingOutlook, grinding_outlook_fields(event, o, "b")))
             assert wait_until(lambda: len(got) == 4, timeout_s=60)
             assert wait_until(lambda: any(d.get("re-plans") == "4" and d.get("outlook refused: CdrError") == "1"
+                                          and d.get("outlook refused: ValueError") == "1"
                                           and d.get("outlooks older than their site's newest") == "1"
                                           for d in diagnostics), timeout_s=10), diagnostics[-1:]
     finally:

@@ -57,6 +57,19 @@ class SiteOutlook:
         return np.array([self.newest_ns + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0
                          for d in self.due_days.tolist()], np.int64)
 
+    def problem(self) -> str:
+        """Why a programme cannot be planned on this outlook ('' if it can): days must be ordered
+        quantiles, none negative or NaN (inf: never); costs finite, none negative, a corrective visit
+        not cheaper than a preventive one."""
+        days = [self.due_days, self.cycle_days, *(o.cycle_days for o in self.options)]
+        if any(np.shape(d) != (3,) or np.isnan(d).any() or (d < 0).any() or (d[1:] < d[:-1]).any() for d in days):
+            return "its days are not three ordered quantiles of 0 or more"
+        costs = np.array([self.visit_cost, self.late_visit_cost, self.length_m,
+                          *(o.cost_per_year for o in self.options)])
+        if not np.isfinite(costs).all() or (costs < 0).any() or self.late_visit_cost < self.visit_cost:
+            return "its costs are not finite and 0 or more, a corrective visit at least a preventive one"
+        return ""
+
     def choices(self) -> tuple[Option, ...]:
         """The options a programme may choose here."""
         return self.options or (Option("grind", self.cycle_days),)

@@ -45,7 +45,11 @@ class Replanner:
 
     def take(self, stamp_ns: int, outlook: SiteOutlook) -> Replan | None:
         """The programme re-planned with this outlook, made at stamp_ns [ns]; None where the site
-        has a newer one already (an outlook that arrives late changes nothing)."""
+        has a newer one already (an outlook that arrives late changes nothing). An outlook that
+        cannot be planned on raises ValueError, and one whose solve fails re-raises; either leaves
+        the newest outlooks as they were."""
+        if why := outlook.problem():
+            raise ValueError(f"outlook of site {outlook.site_id!r} refused: {why}")
         held = self.latest.get(outlook.site_id)
         if held is not None and held[0] > stamp_ns:
             return None
@@ -53,8 +57,15 @@ class Replanner:
         outlooks = [o for _, o in self.latest.values()]
         rules = Rules.over(self.years, max(o.newest_ns for o in outlooks), self.capacity, self.budget_per_year,
                            self.risk_limit, self.pull_forward)
-        return Replan(stamp_ns, outlook.site_id, rules, outlooks, [s for s, _ in self.latest.values()],
-                      plan(outlooks, rules, self.time_limit_s))
+        try:
+            programme = plan(outlooks, rules, self.time_limit_s)
+        except Exception:
+            if held is None:
+                del self.latest[outlook.site_id]
+            else:
+                self.latest[outlook.site_id] = held
+            raise
+        return Replan(stamp_ns, outlook.site_id, rules, outlooks, [s for s, _ in self.latest.values()], programme)
 
 
 def replay(outlooks: Iterable[tuple[int, SiteOutlook]], planner: Replanner) -> list[Replan]:
