@@ -70,7 +70,7 @@ def realised(o: SiteOutlook, rules: Rules, visits: np.ndarray, due_days: float,
     corrective visit, and the time past a threshold one more per overdue_unit of it, as in the plan."""
     cycles = np.atleast_1d(np.asarray(cycle_days, float))
     cross = due_days - offset_days(o, rules)       # days from the start
-    unit = overdue_unit(o)  # time past the threshold before the start (cross < 0) is no schedule's doing
+    unit = overdue_unit(o.cycle_days)  # time past the threshold before the start (cross < 0) is no schedule's doing
     cost, late = 0.0, 0
     for k, m in enumerate(np.asarray(visits, float) * MONTH_DAYS):
         passed = m >= cross

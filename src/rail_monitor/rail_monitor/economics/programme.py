@@ -136,31 +136,33 @@ def offset_days(o: SiteOutlook, rules: Rules) -> float:
     return (rules.start_ns - o.newest_ns) / NS_PER_DAY
 
 
+def _gaps(o: SiteOutlook, rules: Rules, visits: np.ndarray) -> tuple[Law, Law, float, np.ndarray]:
+    """A schedule's laws (due date, cycle), the days from the newest pass to the start, and its gaps'
+    ends [day from the start]: to each visit in turn, then from the last to the horizon."""
+    return (Law.through(o.due_days), Law.through(o.cycle_days), offset_days(o, rules),
+            np.append(np.asarray(visits, float), rules.months) * MONTH_DAYS)
+
+
 def visit_risks(o: SiteOutlook, rules: Rules, visits: np.ndarray) -> np.ndarray:
     """Risk of each gap of a schedule: to each visit in turn, then from the last to the horizon [-]."""
-    due, cycle, shift = Law.through(o.due_days), Law.through(o.cycle_days), offset_days(o, rules)
-    visits = np.asarray(visits, float)
-    ends = np.append(visits, rules.months) * MONTH_DAYS
-    starts = np.concatenate([[0.0], visits * MONTH_DAYS])
-    risks = cycle.before(ends - starts)
+    due, cycle, shift, ends = _gaps(o, rules, visits)
+    risks = cycle.before(np.diff(ends, prepend=0.0))
     risks[0] = due.before(shift + ends[0])
     return risks
 
 
-def overdue_unit(o: SiteOutlook) -> float:
+def overdue_unit(cycle_days: np.ndarray) -> float:
     """Days past the threshold that owe one more corrective visit: the cycle's median [day]."""
-    return max(float(o.cycle_days[1]), SHORTEST_DAYS)
+    return max(float(cycle_days[1]), SHORTEST_DAYS)
 
 
 def visit_overdue(o: SiteOutlook, rules: Rules, visits: np.ndarray) -> np.ndarray:
     """Expected time past the threshold in each gap of a schedule, within the horizon, in units of
     overdue_unit (the corrective visits it owes beyond the first) [-]."""
-    due, cycle, shift = Law.through(o.due_days), Law.through(o.cycle_days), offset_days(o, rules)
-    visits = np.asarray(visits, float)
-    ends = np.append(visits, rules.months) * MONTH_DAYS
-    past = cycle.past(ends - np.concatenate([[0.0], visits * MONTH_DAYS]))
+    due, cycle, shift, ends = _gaps(o, rules, visits)
+    past = cycle.past(np.diff(ends, prepend=0.0))
     past[0] = due.past(shift + ends[0]) - due.past(max(shift, 0.0))  # before the start: no schedule's doing
-    return past / overdue_unit(o)
+    return past / overdue_unit(o.cycle_days)
 
 
 def first_month(visits: np.ndarray) -> int:
@@ -190,7 +192,7 @@ def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
     first, gap, option = [np.array([-1])], [np.array([0])], [np.array([0])]
     before_start = due.past(max(shift, 0.0))
     visits, risks = [np.zeros(1)], [np.array([[0.0], [0.0], [due.before(shift + m * MONTH_DAYS)], [0.0]])]
-    unit = overdue_unit(o.under(o.choices()[0].name))  # no visit: reckoned under the first choice
+    unit = overdue_unit(o.choices()[0].cycle_days)  # no visit: reckoned under the first choice
     overdue = [np.array([(due.past(shift + m * MONTH_DAYS) - before_start) / unit])]
     running = [np.zeros(1)]
     if np.isfinite(due.mu):
@@ -200,7 +202,7 @@ def schedules(o: SiteOutlook, rules: Rules) -> Schedules:
         p_first = due.before(shift + firsts * MONTH_DAYS)
         past_first = due.past(shift + firsts * MONTH_DAYS) - before_start
         for j, choice in enumerate(o.choices()):
-            cycle, unit = Law.through(choice.cycle_days), overdue_unit(o.under(choice.name))
+            cycle, unit = Law.through(choice.cycle_days), overdue_unit(choice.cycle_days)
             gaps = {max(1, int(cycle.quantile(r) // MONTH_DAYS)) for r in GAP_RISKS} if np.isfinite(cycle.mu) else set()
             for g in sorted(gaps | {m}):       # a gap of m months: a single visit
                 n = 1 + (m - 1 - firsts) // g
