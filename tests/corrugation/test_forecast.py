@@ -106,7 +106,7 @@ def test_interval_collapses_to_the_forecast_without_uncertainty(site_, tables):
     wide = est.forecast_interval()
     assert wide.days[0] < point < wide.days[2]
     est.calibration = dataclasses.replace(est.calibration, cov=1e-18 * np.eye(4))
-    est.level_var = np.zeros(len(est.bands))
+    est.level_cov = np.zeros((len(est.bands), len(est.bands)))
     narrow = est.forecast_interval()
     np.testing.assert_allclose(narrow.days, point, rtol=1e-6)
     from scipy.stats import norm

@@ -84,7 +84,7 @@ def _recent(est):
 
     rate, axles = est.traffic()
     return fcst.interval(est.log_components, est.growth_by_state, est.recent_growth_by_state(), est.calibration,
-                         np.sqrt(est.level_var), est.threshold, 1.0 / (rate * axles), est.newest_ns)
+                         est.level_cov, est.level_kb_cov, est.threshold, 1.0 / (rate * axles), est.newest_ns)
 
 
 def test_the_daily_growth_survives_a_checkpoint(site_, tables, tmp_path):
@@ -100,3 +100,68 @@ def test_the_daily_growth_survives_a_checkpoint(site_, tables, tmp_path):
     np.testing.assert_array_equal(back.season.growth, est.season.growth)
     assert (back.season.first_day, back.season.passes.tolist()) == (est.season.first_day, est.season.passes.tolist())
     np.testing.assert_array_equal(back.forecast_interval().days, est.forecast_interval().days)
+
+
+def _managed_year(first_modified_day: int, days: int = SEASON_DAYS):
+    """A year of daily growth per unit K_b (days, 4, 2, 3) with each state's growth per pass fixed:
+    every day 20 passes on a dry or modified rail and 4 wet ones; before first_modified_day all 20
+    dry, from it 3 dry and 17 under the modifier (a share of 0.85)."""
+    per_pass = np.array([3.0, 1.0, 0.4, 0.2])[:, None, None] * np.array([[1.0, 2.0, 0.5], [0.3, 1.5, 1.0]]) * 1e-6
+    passes = np.zeros((days, 4), np.int64)
+    passes[:, 1] = 4
+    passes[:, 0] = np.where(np.arange(days) < first_modified_day, 20, 3)
+    passes[:, 2] = 20 - passes[:, 0]
+    return passes[:, :, None, None] * per_pass, passes
+
+
+def test_a_year_shared_as_its_own_days_is_unchanged():
+    from rail_monitor.corrugation.season import managed_as_recent
+
+    growth, passes = _managed_year(0)
+    np.testing.assert_allclose(managed_as_recent(growth, passes, 0.85), growth, rtol=1e-12, atol=0)
+
+
+def test_a_year_whose_applicator_started_within_it_is_shared_as_the_recent_passes():
+    # Known answer: each state's growth per pass is the same every day, so the year in which the
+    # modifier started on day 120, shared at the recent share (0.85), is the year with the modifier
+    # from its first day, to rounding; and a recent share of 0 (the applicator stopped) gives the
+    # all-dry year. Wet days are kept as they were.
+    from rail_monitor.corrugation.season import managed_as_recent, modifier_share
+
+    started, passes = _managed_year(120)
+    always, _ = _managed_year(0)
+    never, _ = _managed_year(SEASON_DAYS)
+    np.testing.assert_allclose(managed_as_recent(started, passes, 0.85), always, rtol=1e-12, atol=0)
+    np.testing.assert_allclose(managed_as_recent(started, passes, 0.0), never, rtol=1e-12, atol=0)
+    assert modifier_share(np.array([1, 1, 1, 3, 2, 4, 3, 3, 3, 3])) == pytest.approx(5 / 8)
+    assert modifier_share(np.array([2, 4])) is None
+
+
+def test_the_forecast_follows_the_friction_management_of_the_recent_passes(site_, tables):
+    # Two histories of the same 400 days of passes: one with the applicator on from the start, one
+    # from day 120 (dry rail before it). The grinding cycle of the second (a rail ground now), its
+    # season shared as its recent passes are, is within 5 % of the first's at P50; taken as it was
+    # (the dry days repeated) it is shorter by more than that.
+    rng = np.random.default_rng(11)
+    n = 2400
+    passes = _passes(site_, rng.normal(19.0, 1.0, n), friction=np.ones(n, np.int64))
+    passes.stamp_ns = passes.stamp_ns[0] + np.arange(n, dtype=np.int64) * (NS_PER_DAY // 6)
+    day = np.arange(n) // 6
+    weather = rng.random(n)
+    modified = rng.random(n) < 0.85
+    always = np.where(weather < 0.15, 2, np.where(modified, 3, 1))
+    late = np.where(day < 120, np.where(weather < 0.15, 2, 1), always)
+    p50 = {}
+    for name, friction in (("always", always), ("late", late)):
+        est = _estimator(site_, tables)
+        passes.friction_state = friction
+        est.advance(passes)
+        fc = est.forecast_interval(after_grinding=True)
+        assert fc.basis == "season"
+        p50[name] = fc.days[1]
+        if name == "late":
+            as_was = est.season.profile
+            est.season.profile = lambda newest_ns, share=None, f=as_was: f(newest_ns)
+            p50["as it was"] = est.forecast_interval(after_grinding=True).days[1]
+    assert p50["late"] == pytest.approx(p50["always"], rel=0.05)
+    assert p50["as it was"] < 0.95 * p50["always"]

@@ -29,7 +29,10 @@ def test_two_surveys_refit_k_b(site_, tables):
     np.testing.assert_allclose(fit.k_b(est.cfg.k_b), est.k_b, rtol=1e-12)
     p10, p90 = est.k_b_p10, est.k_b_p90
     assert np.all(p10 < est.k_b) and np.all(est.k_b < p90)
-    np.testing.assert_allclose(est.amplitude, truth.amplitude, rtol=0.002)  # the model's prediction now fits
+    # the model's prediction now fits: each level is the joint posterior's, which leaves a band about
+    # half (its level variance over that plus the survey's) of what the fitted K_b's first-order
+    # growth law does not explain; within 0.3 %
+    np.testing.assert_allclose(est.amplitude, truth.amplitude, rtol=0.003)
     with pytest.raises(ValueError, match="no survey wavelength"):
         surveys.apply_survey(est, [5.0], [1e-6])
     with pytest.raises(ValueError, match="positive"):
@@ -48,7 +51,7 @@ def test_survey_level_is_the_kalman_update(site_, tables):
     measured = est.amplitude * 2.0
     surveys.apply_survey(est, est.bands, measured)
     np.testing.assert_allclose(est.log_amplitude - before, 0.9 * np.log(2.0), rtol=1e-12)
-    np.testing.assert_allclose(est.level_var, 0.9 * (np.log(10) / 20) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(np.diag(est.level_cov), 0.9 * (np.log(10) / 20) ** 2, rtol=1e-12)
     assert not est.growth_by_state.any()
 
 
@@ -73,20 +76,21 @@ def test_grinding_resets_the_state(site_, tables):
     assert (est.pass_count, est.axle_pass_count, est.total_pass_count, est.last_grinding_ns) == (0, 0, 100, 123 * 10**9)
     surveys.apply_grinding(est, 124 * 10**9, est.bands[:3], [1e-7, 2e-7, 3e-7])
     np.testing.assert_allclose(est.amplitude[:3], [1e-7, 2e-7, 3e-7], rtol=1e-12)
-    np.testing.assert_allclose(est.level_var[:3], (np.log(10) / 20) ** 2, rtol=1e-12)
-    np.testing.assert_allclose(est.level_var[3:], (3 * np.log(10) / 20) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(np.diag(est.level_cov)[:3], (np.log(10) / 20) ** 2, rtol=1e-12)
+    np.testing.assert_allclose(np.diag(est.level_cov)[3:], (3 * np.log(10) / 20) ** 2, rtol=1e-12)
 
 
 def test_events_apply_in_stamp_order_and_a_refused_one_changes_nothing(site_, tables):
     est = _estimator(site_, tables)
     est.advance(_passes(site_, np.full(50, 19.0)))
-    before = (est.log_components.copy(), est.level_var.copy(), est.survey_log_amplitude.copy(), est.last_survey_ns)
+    before = (est.log_components.copy(), est.level_cov.copy(), est.level_kb_cov.copy(), est.survey_log_amplitude.copy(),
+              est.last_survey_ns)
     bad_grinding = surveys.MaintenanceEvent(10**18, surveys.KIND_GRINDING, np.array([9.0]), np.array([1e-6]))
     for event, why in ((bad_grinding, "no survey wavelength"),
                        (surveys.MaintenanceEvent(10**18, 7, est.bands, est.post_grinding), "unknown kind")):
         with pytest.raises(ValueError, match=why):
             surveys.apply_event(est, event)
-        after = (est.log_components, est.level_var, est.survey_log_amplitude, est.last_survey_ns)
+        after = (est.log_components, est.level_cov, est.level_kb_cov, est.survey_log_amplitude, est.last_survey_ns)
         for a, b in zip(before, after, strict=True):
             np.testing.assert_array_equal(a, b)
     surveys.apply_event(est, surveys.MaintenanceEvent(10**18, surveys.KIND_GRINDING, np.zeros(0), np.zeros(0)))

@@ -31,7 +31,7 @@ def test_checkpoint_round_trip_and_refusals(site_, tables, tmp_path):
     checkpoint.save(est, path)
     again = _estimator(site_, tables)
     checkpoint.load(again, path)
-    for name in ("growth_by_state", "level_var"):
+    for name in ("growth_by_state", "level_cov", "level_kb_cov"):
         np.testing.assert_array_equal(getattr(again, name), getattr(est, name))
     np.testing.assert_array_equal(again.calibration.cov, est.calibration.cov)
     np.testing.assert_allclose(again.calibration.mean, est.calibration.mean, atol=1e-15)
@@ -143,6 +143,33 @@ def test_a_version_2_checkpoint_resumes_with_its_passes_in_partial_slip(site_, t
     np.testing.assert_array_equal(again.log_components, est.log_components)
     assert not again.kept.regime.any() and np.all(again.kept.load == site_.vehicle("emu").wheel_load_n)
     np.testing.assert_allclose(again.recent_growth(), est.recent_growth(), rtol=1e-12)
+
+
+def test_a_version_5_checkpoint_resumes_with_its_levels_uncorrelated_and_no_season(site_, tables, tmp_path):
+    # Version 5 (0.30.0) kept each band's level variance alone and the daily passes of all friction
+    # states together: read as the levels' diagonal, uncorrelated with K_b, and as no season (the
+    # forecast follows the recent window until a year has passed), the rest as it was.
+    est = _estimator(site_, tables)
+    est.advance(_passes(site_, [19.0] * 150))
+    surveys.apply_survey(est, est.bands, est.amplitude * 1.1)
+    est.advance(_passes(site_, [19.0] * 150, start_s=100_000, prefix="U"))
+    surveys.apply_survey(est, est.bands, est.amplitude * 1.1, est.newest_ns)
+    assert np.any(est.level_kb_cov != 0) and np.any(est.level_cov != np.diag(np.diag(est.level_cov)))
+    path = tmp_path / "v5.npz"
+    checkpoint.save(est, path)
+    with np.load(path, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files if k not in ("level_cov", "level_kb_cov")}
+    data["level_var"] = np.diag(est.level_cov)
+    data["season_passes"] = data["season_passes"].sum(axis=1)
+    data["meta"] = np.array(json.dumps({**json.loads(str(data["meta"])), "version": 5}))
+    with open(path, "wb") as fh:
+        np.savez(fh, **data)
+    again = _estimator(site_, tables)
+    checkpoint.load(again, path)
+    np.testing.assert_array_equal(again.level_cov, np.diag(np.diag(est.level_cov)))
+    assert not again.level_kb_cov.any() and len(again.season.passes) == 0
+    np.testing.assert_array_equal(again.calibration.cov, est.calibration.cov)
+    np.testing.assert_array_equal(again.log_components, est.log_components)
 
 
 def test_the_writer_writes_the_newest_state_off_the_callers_thread(site_, tables, tmp_path):

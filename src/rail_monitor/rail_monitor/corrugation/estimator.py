@@ -27,7 +27,7 @@ from rail_monitor.corrugation.config import CorrugationConfig
 from rail_monitor.corrugation.growth import GrowthTables
 from rail_monitor.corrugation.history import KeptPasses, RowQueue, dropped
 from rail_monitor.corrugation.records import Forecast, ForecastInterval, StateSnapshot, Trajectory
-from rail_monitor.corrugation.season import DailyGrowth
+from rail_monitor.corrugation.season import DailyGrowth, modifier_share
 from rail_monitor.models import calibration
 from rail_monitor.models import corrugation_bands as cbands
 from rail_monitor.models import corrugation_state as cstate
@@ -62,7 +62,8 @@ class CorrugationEstimator:
         self.calibration = calibration.prior(cfg.kb_prior_scale_sd, cfg.kb_prior_ratio_sd)
         self.survey_var = calibration.log_variance(cfg.survey_uncertainty_db)  # of ln Z, a surveyed band [-]
         self.post_grinding_var = np.full(len(self.bands), calibration.log_variance(cfg.post_grinding_uncertainty_db))
-        self.level_var = self.post_grinding_var.copy()  # of each band's ln Z at the last survey or grinding
+        # Covariance of each band's ln Z at the last survey or grinding (B, B), and with u (B, 4)
+        self.level_cov, self.level_kb_cov = np.diag(self.post_grinding_var), np.zeros((len(self.bands), 4))
         self.kept = KeptPasses()
         self.season = DailyGrowth(self.log_components.shape)  # the last year day by day (forecast interval)
         self.engine = "numpy"  # of the state's array kernels (batch: numba; models.engine.corrugation_kernels)
@@ -296,9 +297,9 @@ class CorrugationEstimator:
 
     def forecast_interval(self, after_grinding: bool = False, dry_as_modifier: np.ndarray | None = None
                           ) -> ForecastInterval:
-        """P10, P50 and P90 of the days to threshold over the K_b posterior and the level variance
-        of each band (:func:`.forecast.interval`): at the traffic and friction mix of the same
-        season a year earlier where the history spans a year, else at the recent traffic.
+        """P10, P50 and P90 of the days to threshold over the K_b posterior and the bands' levels
+        (:func:`.forecast.interval`): at the traffic and weather of the same season a year earlier,
+        the modifier's share as recent (:meth:`.season.DailyGrowth.profile`), else the recent traffic.
         after_grinding: of a rail ground now to the configured post-grinding roughness (its
         uncertainty ``post_grinding_uncertainty_db``), the grinding cycle a programme plans with;
         dry_as_modifier: with a friction modifier where the rail was dry, the recent dry passes' growth
@@ -306,16 +307,19 @@ class CorrugationEstimator:
         rate, axles = self.traffic()
         axles = axles if np.isfinite(axles) else self.site.mean_axles_per_train
         days_per_axle_pass = 1.0 / (rate * axles) if np.isfinite(rate) and rate > 0 else np.inf
-        recent, season = self.recent_growth_by_state(), self.season.profile(self.newest_ns)
+        recent = self.recent_growth_by_state()
+        season = self.season.profile(self.newest_ns, modifier_share(self.kept.friction))
         if dry_as_modifier is not None:
             recent, season = fcst.with_friction_modifier(recent, dry_as_modifier, season, self.k_b)
         if after_grinding:
-            state, var = self.flat(self.post_grinding), self.post_grinding_var
-            since = np.zeros_like(self.growth_by_state)
+            state, since = self.flat(self.post_grinding), np.zeros_like(self.growth_by_state)
+            level_cov, cross = np.diag(self.post_grinding_var), np.zeros_like(self.level_kb_cov)
         else:
-            state, since, var = self.log_components, self.growth_by_state, self.level_var
-        return fcst.interval(state, since, recent, self.calibration, np.sqrt(var), self.threshold, days_per_axle_pass,
-                             self.newest_ns, None if season is None else season * self.k_b[None, :, None, None])
+            state, since, level_cov, cross = (self.log_components, self.growth_by_state, self.level_cov,
+                                              self.level_kb_cov)
+        season = None if season is None else season * self.k_b[None, :, None, None]
+        return fcst.interval(state, since, recent, self.calibration, level_cov, cross, self.threshold,
+                             days_per_axle_pass, self.newest_ns, season)
 
     def traffic(self) -> tuple[float, float]:
         """Recent traffic (see :func:`.forecast.traffic`)."""

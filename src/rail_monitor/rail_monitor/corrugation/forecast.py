@@ -71,17 +71,18 @@ def traffic(kept: KeptPasses, min_traffic_days: float) -> tuple[float, float]:
 
 
 def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth_by_state: np.ndarray,
-             posterior: calibration.KbPosterior, level_sd: np.ndarray, threshold: np.ndarray,
+             posterior: calibration.KbPosterior, level_cov: np.ndarray, cross: np.ndarray, threshold: np.ndarray,
              days_per_axle_pass: float, newest_ns: int, season: np.ndarray | None = None) -> ForecastInterval:
     """P10, P50 and P90 of the days to threshold, per band and of the first band, over the
     uncertainty of K_b and of the present roughness.
 
     ln Z (B, P) [ln m]; the log growth since the last survey per friction state (4, B, P), computed
     at the posterior median; the recent growth per friction state (4, B, P) [1/axle pass]; the
-    standard deviation of each band's ln Z at the last survey (level_sd (B,) [-]); thresholds (B,)
-    [m]; days per axle pass at the recent traffic. Each of INTERVAL_DRAWS fixed draws takes ln K_b from the posterior
-    (both growths scale with exp(delta_f), first order in K_b) and an independent error of each
-    band's level, and is forecast as the state is; the quantiles are those of the draws (so the
+    covariance of the bands' ln Z at the last survey (level_cov (B, B) [-]) and with ln K_b (cross
+    (B, 4)); thresholds (B,) [m]; days per axle pass at the recent traffic. Each of INTERVAL_DRAWS
+    fixed draws takes ln K_b and each band's level error jointly from that covariance and the
+    posterior's (both growths scale with exp(delta_f), first order in K_b), and is forecast as the
+    state is; the quantiles are those of the draws (so the
     same state gives the same interval in every process). The traffic and its friction mix are
     the recent window's, or with season (the log growth per day and friction state of the year
     before the newest pass, (365, 4, B, P), at the posterior median) that year's repeated: day j
@@ -89,8 +90,10 @@ def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth
     year's mean per day.
     """
     rng = np.random.Generator(np.random.PCG64(INTERVAL_SEED))
-    delta = rng.standard_normal((INTERVAL_DRAWS, len(posterior.mean))) @ np.linalg.cholesky(posterior.cov).T
-    level = level_sd * rng.standard_normal((INTERVAL_DRAWS, len(threshold)))
+    bands = len(threshold)
+    draws = rng.standard_normal((INTERVAL_DRAWS, bands + len(posterior.mean))) @ _root(
+        np.block([[level_cov, cross], [cross.T, posterior.cov]])).T
+    level, delta = draws[:, :bands], draws[:, bands:]
     state = log_components + np.einsum("df,fbp->dbp", np.expm1(delta), growth_since_survey) + level[:, :, None]
     if season is not None:
         days = _seasonal_days(state, np.exp(delta), season, np.log(threshold))
@@ -104,6 +107,16 @@ def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth
     due = np.array([newest_ns + int(d * NS_PER_DAY) if d <= MAX_DATED_DAYS else 0 for d in first.tolist()], np.int64)
     return ForecastInterval(np.quantile(days, q, axis=0, method="inverted_cdf"), first, due,
                             "recent" if season is None else "season")
+
+
+def _root(cov: np.ndarray) -> np.ndarray:
+    """A matrix R with R R^T = cov: its Cholesky factor, or for a covariance only semi-definite (a
+    level known exactly) the eigenvectors scaled by the roots of their non-negative eigenvalues."""
+    try:
+        return np.linalg.cholesky(cov)
+    except np.linalg.LinAlgError:
+        w, v = np.linalg.eigh(cov)
+        return v * np.sqrt(np.clip(w, 0.0, None))
 
 
 def with_friction_modifier(growth_by_state: np.ndarray, dry_as_modifier: np.ndarray, season: np.ndarray | None,

@@ -1,11 +1,12 @@
 """Measured roughness surveys and grinding events applied to a corrugation state.
 
-A survey re-fits K_b per friction state from the growth since the last survey: a Bayesian update
-of ln K_b (:mod:`rail_monitor.models.calibration`; docs/models.md, "Calibration") against the
-state's growth since then, split by friction state. The state then follows the fitted K_b (its
-growth since the last survey re-scaled), and each measured band's level is the Kalman update of
-the model's prediction by the survey (each weighed by its variance; a band keeps its components'
-shape). Each band's level variance is kept: it weighs the next fit and the forecast interval.
+A survey re-fits K_b per friction state and the bands' levels together: a Bayesian update of ln
+K_b and of each band's level at the last survey (:func:`rail_monitor.models.calibration.joint_update`;
+docs/models.md, "Calibration") against the state's growth since then, split by friction state. The
+state then follows the fitted K_b (its growth since the last survey re-scaled) and the updated
+levels (a band keeps its components' shape). The levels' covariance, with each other and with
+K_b, is kept: it weighs the next survey and the forecast interval; a grinding resets the levels
+and their correlation with K_b.
 
 Order: an event (survey or grinding) applies to the state after every pass stamped at or before
 it, and before the first pass stamped later (:func:`split_before`), in batch, in a replay and live
@@ -92,8 +93,9 @@ def match_bands(bands: np.ndarray, wavelength: np.ndarray, amplitude: np.ndarray
 def apply_survey(est: CorrugationEstimator, wavelength: np.ndarray, amplitude: np.ndarray,
                  stamp_ns: int = 0, log_variance: np.ndarray | None = None) -> calibration.KbPosterior | None:
     """Take a measured roughness survey (wavelengths [m], r.m.s. amplitudes [m]): re-fit K_b from
-    the growth since the last survey, then update the state's level of the measured bands. Returns
-    the posterior of K_b after the fit, or None without one (no growth since the last survey).
+    the growth since the last survey together with every band's level. Returns the posterior of K_b
+    after the fit, or None where the survey cannot inform it (no growth since the last survey and
+    no measured level correlated with K_b).
     log_variance: each band's variance of ln amplitude [-] (an indirect observation; default the
     site's survey uncertainty), which also leaves the last survey's spectrum as it was."""
     z, matched = match_bands(est.bands, wavelength, amplitude)
@@ -101,29 +103,24 @@ def apply_survey(est: CorrugationEstimator, wavelength: np.ndarray, amplitude: n
     noise_var = est.survey_var
     if log_variance is not None:
         noise_var = match_bands(est.bands, wavelength, log_variance)[0][matched]
-    fit = None
     growth = est.growth_by_state
-    if np.any(growth[:, matched] != 0.0):
-        start = est.log_components[matched] - growth[:, matched].sum(axis=0)
-        sigma = np.sqrt(noise_var + est.level_var[matched])
-        fit, delta = calibration.update(est.calibration, start, growth[:, matched], measured, sigma)
-        growth = growth * np.exp(delta)[:, None, None]
-        est.log_components += np.einsum("f,fbp->bp", np.expm1(delta), est.growth_by_state)
-        est.calibration = fit
-        est.set_k_b(fit.k_b(est.cfg.k_b))
-    # Kalman update of each band's ln Z: the model's prediction (its level's variance and the
-    # growth's, from K_b) weighed against the survey's.
-    level, jac, _ = calibration.band_level_jacobian(est.log_components, growth)
-    predicted_var = est.level_var + np.einsum("bf,fg,bg->b", jac, est.calibration.cov, jac)
-    gain = predicted_var[matched] / (predicted_var[matched] + noise_var)
-    est.log_components[matched] += (gain * (measured - level[matched]))[:, None]
-    est.level_var = predicted_var
-    est.level_var[matched] = gain * noise_var
+    # a survey informs K_b through the growth since the last one, or through a measured level that
+    # earlier surveys left correlated with it; else the posterior stays as it was
+    informed = bool(np.any(growth[:, matched] != 0.0) or np.any(est.level_kb_cov[matched] != 0.0))
+    start = est.log_components - growth.sum(axis=0)
+    fit = calibration.joint_update(est.calibration, est.level_cov, est.level_kb_cov, start, growth, matched,
+                                   measured, noise_var)
+    delta = fit.delta if informed else np.zeros_like(fit.delta)
+    est.log_components = start + fit.shift[:, None] + np.einsum("f,fbp->bp", np.exp(delta), growth)
+    est.level_cov, est.level_kb_cov = fit.level_cov, fit.cross
+    if informed:
+        est.calibration = fit.posterior
+        est.set_k_b(fit.posterior.k_b(est.cfg.k_b))
     if log_variance is None:
         est.survey_log_amplitude = np.where(matched, np.log(np.where(matched, z, 1.0)), np.nan)
     est.growth_by_state[:] = 0.0
     est.last_survey_ns = max(est.last_survey_ns, int(stamp_ns))
-    return fit
+    return fit.posterior if informed else None
 
 
 def apply_grinding(est: CorrugationEstimator, stamp_ns: int, wavelength: np.ndarray | None = None,
@@ -138,8 +135,9 @@ def apply_grinding(est: CorrugationEstimator, stamp_ns: int, wavelength: np.ndar
     est.survey_log_amplitude = np.where(matched, np.log(rms), np.nan)
     est.log_components = est.flat(rms)
     est.growth_by_state[:] = 0.0
-    est.level_var = est.post_grinding_var.copy()
-    est.level_var[matched] = est.survey_var
+    level_var = est.post_grinding_var.copy()
+    level_var[matched] = est.survey_var
+    est.level_cov, est.level_kb_cov = np.diag(level_var), np.zeros_like(est.level_kb_cov)
     est.grinding_amplitude = rms
     est.pass_count = est.axle_pass_count = 0
     est.last_grinding_ns = int(stamp_ns)

@@ -4,7 +4,8 @@ previous good file.
 The file is a numpy .npz (zip members with CRCs): a JSON ``meta`` record (version, site, counts,
 times), the band centres, ln Z of every component, K_b, the last survey and the post-grinding
 amplitudes, the calibration (growth since the last survey per friction state, the covariance of
-ln K_b, each band's level variance), the last year's growth per day and the kept passes' columns;
+ln K_b, the bands' levels' covariance with each other and with ln K_b), the last year's growth and
+passes per day and friction state, and the kept passes' columns;
 with an indirect roughness observer (rail_monitor.measured.observer), its open window's fit too
 (optional arrays ``indirect_*``: a file without them resumes with the window empty); with the
 squeal model's fit (rail_monitor.engine.squeal_site), its grids, posteriors and passes (optional
@@ -36,14 +37,16 @@ if TYPE_CHECKING:  # the observer's module imports the noise model: not needed t
     from rail_monitor.engine.squeal_site import SquealSite
     from rail_monitor.measured.observer import IndirectObserver
 
-VERSION = 5
+VERSION = 6
 # 1: before grinding_amplitude (read as the post-grinding default); 1-2: before the contact regime
 # (their kept passes read as in partial slip, at their class's nominal load, as they were counted);
 # 1-3: before the calibration (read as the prior about their K_b, no growth since the last survey,
 # each band's level known to the post-grinding uncertainty); 1-4: before the daily growth of the
-# last year (read as none: the forecast interval uses the recent window until a year has passed).
-READABLE_VERSIONS = (1, 2, 3, 4, 5)
-CALIBRATION_ARRAYS = ("growth_by_state", "calibration_cov", "level_var")
+# last year (read as none: the forecast interval uses the recent window until a year has passed);
+# 4-5: before the levels' covariance (read as each band's variance alone, uncorrelated with K_b);
+# 5: before the daily passes per friction state (the daily growth read as none, as 1-4).
+READABLE_VERSIONS = (1, 2, 3, 4, 5, 6)
+CALIBRATION_ARRAYS = ("growth_by_state", "calibration_cov", "level_cov", "level_kb_cov")
 SEASON_ARRAYS = ("season_growth", "season_passes", "season_first_day")
 CONTACT_COLUMNS = ("regime", "load", "creepage")
 _COUNTS = ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns", "last_survey_ns")
@@ -74,7 +77,7 @@ def snapshot(est: CorrugationEstimator, observer: IndirectObserver | None = None
     arrays = dict(meta=np.array(json.dumps(meta)), bands=est.bands, log_components=est.log_components,
                   k_b=est.k_b, survey_log_amplitude=est.survey_log_amplitude,
                   grinding_amplitude=est.grinding_amplitude, growth_by_state=est.growth_by_state,
-                  calibration_cov=est.calibration.cov, level_var=est.level_var,
+                  calibration_cov=est.calibration.cov, level_cov=est.level_cov, level_kb_cov=est.level_kb_cov,
                   calibration_mean=est.calibration.mean, season_growth=est.season.growth,
                   season_passes=est.season.passes, season_first_day=np.array(est.season.first_day),
                   **{f"recent_{n}": getattr(est.kept, n) for n in COLUMNS},
@@ -186,10 +189,11 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
             data = {k: z[k] for k in z.files}  # zip member CRCs are checked as each is read
         meta = json.loads(str(data["meta"]))
         version = meta.get("version") if isinstance(meta, dict) else None
-        wanted = COLUMNS if version in (3, 4, VERSION) else tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
+        wanted = COLUMNS if version in (3, 4, 5, VERSION) else tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
+        calibrated = CALIBRATION_ARRAYS if version == VERSION else ("growth_by_state", "calibration_cov", "level_var")
         missing = {"bands", "log_components", "k_b", "survey_log_amplitude", *(f"recent_{n}" for n in wanted),
-                   *(CALIBRATION_ARRAYS if version in (4, VERSION) else ()),
-                   *(SEASON_ARRAYS if version == VERSION else ())} - set(data)
+                   *(calibrated if version in (4, 5, VERSION) else ()),
+                   *(SEASON_ARRAYS if version in (5, VERSION) else ())} - set(data)
         if missing:
             raise KeyError(f"arrays missing: {', '.join(sorted(missing))}")
     except FileNotFoundError:
@@ -271,11 +275,11 @@ def _state(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarray]) -
         raise ValueError("kept passes hold an unknown class, friction state, regime, speed, load or creepage")
     calibrated = _calibration(est, meta, data, k_b)
     season = DailyGrowth(est.log_components.shape)
-    if "season_growth" in data:  # version 5
+    if "season_growth" in data and meta.get("version") == VERSION:
         season.growth = np.asarray(data["season_growth"], float)
         season.passes = np.asarray(data["season_passes"]).astype(np.int64, casting="same_kind")
         season.first_day = int(data["season_first_day"])
-        if season.growth.shape != (len(season.passes), 4, *est.log_components.shape) \
+        if season.growth.shape != (len(season.passes), 4, *est.log_components.shape) or season.passes.ndim != 2 \
                 or not np.all(np.isfinite(season.growth)) or np.any(season.passes < 0):
             raise ValueError("season arrays have the wrong shape, are not finite or count negative passes")
     counts = {key: int(meta[key]) for key in _COUNTS}
@@ -294,19 +298,25 @@ def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarr
     if "calibration_mean" in data and np.allclose(data["calibration_mean"], mean, rtol=1e-9, atol=1e-12):
         mean = np.asarray(data["calibration_mean"], float)  # the bits, so a resumed fit equals an unbroken one
     if "calibration_cov" not in data:
-        return {"growth_by_state": np.zeros_like(est.growth_by_state), "level_var": est.post_grinding_var.copy(),
-                "calibration": replace(est.calibration, mean=mean)}
+        return {"growth_by_state": np.zeros_like(est.growth_by_state), "level_cov": np.diag(est.post_grinding_var),
+                "level_kb_cov": np.zeros_like(est.level_kb_cov), "calibration": replace(est.calibration, mean=mean)}
     growth = np.asarray(data["growth_by_state"], float)
     cov = np.asarray(data["calibration_cov"], float)
-    level_var = np.asarray(data["level_var"], float)
+    if "level_cov" in data:
+        level_cov, cross = np.asarray(data["level_cov"], float), np.asarray(data["level_kb_cov"], float)
+    else:  # versions 4-5
+        level_cov, cross = np.diag(np.asarray(data["level_var"], float)), np.zeros_like(est.level_kb_cov)
     fits = int(meta.get("calibration_fits", 0))
-    if growth.shape != est.growth_by_state.shape or cov.shape != (4, 4) or level_var.shape != est.bands.shape:
+    if growth.shape != est.growth_by_state.shape or cov.shape != (4, 4) or cross.shape != est.level_kb_cov.shape \
+            or level_cov.shape != est.level_cov.shape:
         raise ValueError("calibration arrays have the wrong shape")
-    if not (np.all(np.isfinite(growth)) and np.all(np.isfinite(level_var)) and np.all(level_var >= 0)
-            and np.allclose(cov, cov.T) and fits >= 0):
-        raise ValueError("calibration arrays not finite, variances negative or covariance not symmetric")
+    joint = np.block([[level_cov, cross], [cross.T, cov]])
+    if not (np.all(np.isfinite(growth)) and np.all(np.isfinite(joint)) and np.allclose(joint, joint.T) and fits >= 0):
+        raise ValueError("calibration arrays not finite or covariances not symmetric")
     np.linalg.cholesky(cov)  # LinAlgError (a ValueError) unless positive definite
-    return {"growth_by_state": growth, "level_var": level_var,
+    if np.linalg.eigvalsh(joint)[0] < -1e-12 * max(1.0, float(np.abs(joint).max())):
+        raise ValueError("the levels' and K_b's covariance is not positive semi-definite")
+    return {"growth_by_state": growth, "level_cov": level_cov, "level_kb_cov": cross,
             "calibration": calibration.KbPosterior(mean, cov, fits)}
 
 

@@ -13,11 +13,19 @@ by delta scales G_f by exp(delta_f), so the model's band level is
     yhat_b(delta) = ln sqrt(sum_p exp(2 (C_bp + sum_f exp(delta_f) G_f,bp)))
 
 with C the components at t1 (UQ seminar paper eqs. 1-2; the band r.m.s. is the energy sum of its
-components). The posterior mode maximises the Gaussian likelihood (variance sigma_b^2 per band:
-the survey's plus the state's at t1) times the prior, found by Gauss-Newton; its Laplace
-covariance is the inverse Hessian of the negative log posterior at the mode (J^T W J + P^-1 less
-the residuals' curvature; W = diag 1/sigma_b^2; e.g. Gelman et al., Bayesian Data Analysis, 3rd
-ed., CRC 2013, sec. 4.1 and 13.3). Each survey's posterior is the next one's prior.
+components). C itself is known only to the state's uncertainty at t1, which the earlier surveys
+left correlated with u: the unknowns of a survey are therefore z = (a, delta), a_b the error of
+band b's level at t1 (C_b shifted by a_b moves yhat_b by a_b exactly), with the joint Gaussian
+prior the last survey left. The posterior mode maximises the Gaussian likelihood of the measured
+bands (the survey's variance per band) times that prior, found by Gauss-Newton; its Laplace
+covariance is the inverse Hessian of the negative log posterior at the mode (H^T W H + P^-1 less
+the residuals' curvature in delta; e.g. Gelman et al., Bayesian Data Analysis, 3rd ed., CRC 2013,
+sec. 4.1 and 13.3). The levels after the survey (a + yhat(delta)) and u are carried forward with
+their joint covariance, so each survey's posterior is the next one's prior: the state augmented
+with the parameter, as an iterated extended Kalman filter (Gelb, Applied Optimal Estimation, MIT
+Press 1974, sec. 6.1 and 9.2). Had the levels been carried without their correlation with u, each
+survey would weigh only its own growth against two noisy levels, and a rail surveyed often would
+keep a K_b posterior several times wider than its surveys support.
 """
 
 from __future__ import annotations
@@ -145,59 +153,89 @@ def _curvature(scaled: np.ndarray, weight: np.ndarray, jac: np.ndarray) -> np.nd
     return second + jac[:, :, None] * np.eye(jac.shape[1])
 
 
-def update(post: KbPosterior, start: np.ndarray, growth: np.ndarray, measured: np.ndarray,
-           sigma: np.ndarray | float) -> tuple[KbPosterior, np.ndarray]:
-    """The posterior after one survey, by Gauss-Newton on the log posterior, and its change of u.
+@dataclass(frozen=True)
+class SurveyFit:
+    """A survey's joint posterior: of u (posterior, its change delta (4,)), of the bands' levels at
+    the last survey (their change shift (B,) [-]), and of the levels after it (level_cov (B, B)
+    and their covariance with u, cross (B, 4))."""
 
-    The survey's band levels against the model's (the module's yhat_b(delta)); the mode's Laplace
-    covariance is the inverse Hessian of the negative log posterior there.
+    posterior: KbPosterior
+    delta: np.ndarray
+    shift: np.ndarray
+    level_cov: np.ndarray
+    cross: np.ndarray
+
+
+def joint_update(post: KbPosterior, level_cov: np.ndarray, cross: np.ndarray, start: np.ndarray,
+                 growth: np.ndarray, matched: np.ndarray, measured: np.ndarray, noise_var: np.ndarray | float
+                 ) -> SurveyFit:
+    """The joint posterior of the bands' levels and u after one survey (the module's z = (a, delta)).
 
     Parameters
     ----------
     post : KbPosterior
         The posterior of u so far [-], whose median K_b the growth was computed with.
+    level_cov : ndarray
+        Covariance of every band's ln Z at the last survey or grinding [-] (B, B).
+    cross : ndarray
+        Their covariance with u [-] (B, 4).
     start : ndarray
-        ln Z of the components of the surveyed bands at the last survey or grinding [ln m] (B, P).
+        ln Z of the components at the last survey or grinding [ln m] (B, P).
     growth : ndarray
         Their log growth since then per friction state [-] (4, B, P).
+    matched : ndarray
+        The bands the survey measured (B,) bool.
     measured : ndarray
-        Their surveyed ln Z [ln m] (B,).
-    sigma : ndarray or float
-        Standard deviation of each band's measured minus predicted ln Z [-] (B,) or scalar.
+        Their surveyed ln Z [ln m] (M,).
+    noise_var : ndarray or float
+        Variance of each measured band's ln Z [-] (M,) or scalar.
 
     Returns
     -------
-    tuple
-        The posterior (KbPosterior) and delta, its change of u [-] (4,).
+    SurveyFit
+        The posterior of u, the change of u and of the levels at the last survey, and the
+        covariance of the levels after the survey, with each other and with u.
 
     References
     ----------
     .. [1] A. Gelman, J. B. Carlin, H. S. Stern, D. B. Dunson, A. Vehtari and D. B. Rubin, *Bayesian
        Data Analysis*, 3rd ed., CRC Press, Boca Raton, 2013, sections 4.1 and 13.3 (the normal
        approximation at the mode).
-    .. [2] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
+    .. [2] A. Gelb (ed.), *Applied Optimal Estimation*, MIT Press, Cambridge MA, 1974, sections 6.1
+       and 9.2 (the iterated extended Kalman filter; parameters as augmented states).
+    .. [3] Rail Mechanics Group, The University of Queensland, "A smorgasbord of railway dynamic and
        acoustic phenomena", seminar paper, section 2.1, eqs. 1-2.
     """
-    p_inv = np.linalg.inv(post.cov)
-    w = np.broadcast_to(1.0 / np.asarray(sigma, float) ** 2, np.shape(measured))
-    delta = np.zeros(len(post.mean))
+    bands, states = start.shape[0], len(post.mean)
+    sel = np.flatnonzero(matched)
+    p_inv = np.linalg.inv(np.block([[level_cov, cross], [cross.T, post.cov]]))
+    w = np.broadcast_to(1.0 / np.asarray(noise_var, float), sel.shape)
+    h = np.zeros((len(sel), bands + states))
+    h[np.arange(len(sel)), sel] = 1.0
+    z = np.zeros(bands + states)
     for _ in range(_MAX_ITERATIONS):
-        scaled, comp = _scaled(start, growth, np.exp(delta))
+        scaled, comp = _scaled(start, growth, np.exp(z[bands:]))
         level, jac, _ = band_level_jacobian(comp, scaled)
-        info = (jac.T * w) @ jac + p_inv
-        gradient = (jac.T * w) @ (measured - level) - p_inv @ delta
-        step = np.linalg.solve(info, gradient)
-        delta = delta + step
+        h[:, bands:] = jac[sel]
+        info = (h.T * w) @ h + p_inv
+        step = np.linalg.solve(info, (h.T * w) @ (measured - level[sel] - z[sel]) - p_inv @ z)
+        z = z + step
         if np.max(np.abs(step)) < _STEP_TOLERANCE:
             break
-    scaled, comp = _scaled(start, growth, np.exp(delta))
+    scaled, comp = _scaled(start, growth, np.exp(z[bands:]))
     level, jac, weight = band_level_jacobian(comp, scaled)
-    hessian = (jac.T * w) @ jac + p_inv - np.einsum("b,bfg->fg", w * (measured - level),
-                                                     _curvature(scaled, weight, jac))
+    h[:, bands:] = jac[sel]
+    info = (h.T * w) @ h + p_inv
+    hessian = info.copy()
+    residual = w * (measured - level[sel] - z[sel])
+    hessian[bands:, bands:] -= np.einsum("b,bfg->fg", residual, _curvature(scaled, weight, jac)[sel])
     try:
         np.linalg.cholesky(hessian)
         cov = np.linalg.inv(hessian)
     except np.linalg.LinAlgError:  # not positive definite (far from a mode): Gauss-Newton's
-        cov = np.linalg.inv((jac.T * w) @ jac + p_inv)
-    return KbPosterior(post.mean + delta, 0.5 * (cov + cov.T), post.fits + 1), delta
-
+        cov = np.linalg.inv(info)
+    cov = 0.5 * (cov + cov.T)
+    after = np.hstack([np.eye(bands), jac])  # d(level after)/dz: a + yhat(delta)
+    level_cov = after @ cov @ after.T
+    return SurveyFit(KbPosterior(post.mean + z[bands:], cov[bands:, bands:], post.fits + 1), z[bands:], z[:bands],
+                     0.5 * (level_cov + level_cov.T), after @ cov[:, bands:])
