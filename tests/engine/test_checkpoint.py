@@ -172,6 +172,34 @@ def test_a_version_5_checkpoint_resumes_with_its_levels_uncorrelated_and_no_seas
     np.testing.assert_array_equal(again.log_components, est.log_components)
 
 
+@pytest.mark.parametrize("name, bad", [
+    ("level_cov", lambda a: np.where(np.eye(len(a), dtype=bool), np.nan, a)),           # not finite
+    ("level_cov", lambda a: a - 2.0 * np.diag(np.diag(a))),                               # negative variances
+    ("level_kb_cov", lambda a: a[:-1]),                                                    # wrong shape
+    ("level_kb_cov", lambda a: a + 1.0),                                                   # not a covariance
+    ("season_passes", lambda a: a.sum(axis=1)),                                            # one count a day
+])
+def test_a_checkpoint_whose_covariances_or_season_are_not_a_state_is_refused(site_, tables, tmp_path, name, bad):
+    # One line, CorruptCheckpoint, and the estimator left as it was.
+    est = _estimator(site_, tables)
+    est.advance(_passes(site_, [19.0] * 150))
+    surveys.apply_survey(est, est.bands, est.amplitude * 1.1)
+    path = tmp_path / "c.npz"
+    checkpoint.save(est, path)
+    with np.load(path, allow_pickle=False) as z:
+        data = {k: z[k] for k in z.files}
+    data[name] = bad(data[name])
+    with open(path, "wb") as fh:
+        np.savez(fh, **data)
+    fresh = _estimator(site_, tables)
+    before = (fresh.level_cov.copy(), fresh.level_kb_cov.copy(), fresh.log_components.copy())
+    with pytest.raises(CorruptCheckpoint) as info:
+        checkpoint.load(fresh, path)
+    assert "\n" not in str(info.value)
+    for a, b in zip(before, (fresh.level_cov, fresh.level_kb_cov, fresh.log_components), strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_the_writer_writes_the_newest_state_off_the_callers_thread(site_, tables, tmp_path):
     """CheckpointWriter: each write on its own thread, the newest submitted state the one on disk
     after flush (one still waiting is replaced, and counted), a failure counted and reported
