@@ -87,8 +87,8 @@ def managed_as_recent(growth: np.ndarray, passes: np.ndarray, share: float) -> n
     Each day keeps its passes per friction state (passes (S, 4)) and each state's growth per pass.
     A day without passes in one of the two states takes that state's growth per pass from the other
     state's, in the ratio of the two over the year. The wet and contaminated days are the weather's
-    and are kept. Shared as the day itself was, a day is unchanged but for rounding; a year in
-    which neither state grew, or in which the ratio a day needs is not known, is returned unchanged.
+    and are kept. Shared as the day itself was, a day is unchanged but for rounding. A year without
+    passes in one of the two states, where a day would need their ratio, is returned unchanged.
     """
     d, m = FRICTION_DRY - 1, FRICTION_MODIFIER - 1
     n_d, n_m = passes[:, d].astype(float), passes[:, m].astype(float)
