@@ -12,8 +12,8 @@ into the corrugation amplitude it implies (:func:`~rail_monitor.measured.indirec
 and taken by the estimator as a survey with that per-band uncertainty: a re-fit of K_b and a
 Kalman update of the levels (:mod:`rail_monitor.corrugation.surveys`). Taken on a rail that has
 had no survey since its last grinding: where surveys come, they calibrate and the windows are
-published beside them (the sequential fit keeps no covariance between the levels and K_b, so a
-survey after a weak observation's partial level update over-fits K_b; docs/models.md).
+published beside them (up to 0.30.0 the levels were carried without their covariance with K_b,
+so a survey after a weak observation's partial level update over-fitted K_b; docs/models.md).
 
 A measurement is paired once its pass is counted, in stamp order, and must arrive before the
 first pass after its window's end (a replay sends each after its pass and before the next); one
