@@ -184,7 +184,7 @@ def joint_update(post: KbPosterior, level_cov: np.ndarray, cross: np.ndarray, st
     growth : ndarray
         Their log growth since then per friction state [-] (4, B, P).
     matched : ndarray
-        The bands the survey measured (B,) bool.
+        The bands the survey measured [-] (B,), bool.
     measured : ndarray
         Their surveyed ln Z [ln m] (M,).
     noise_var : ndarray or float
