@@ -29,6 +29,14 @@ def _objective(post, level_cov, cross, start, growth, matched, measured, sigma):
     return f
 
 
+def _hessian(f, z, h=1e-4):
+    """The Hessian of f at z by central differences."""
+    eye = np.eye(len(z))
+    return np.array([[(f(z + h * (eye[i] + eye[j])) - f(z + h * (eye[i] - eye[j]))
+                       - f(z - h * (eye[i] - eye[j])) + f(z - h * (eye[i] + eye[j]))) / (4 * h * h)
+                      for j in range(len(z))] for i in range(len(z))])
+
+
 def _prior_levels(seed: int, bands: int = 6):
     """A joint prior of the levels and u as an earlier survey leaves it: levels correlated with
     each other and with u."""
@@ -52,15 +60,13 @@ def test_joint_update_is_the_posterior_mode_and_its_laplace_covariance():
     ref = minimize(f, np.zeros(10), method="BFGS", options={"gtol": 1e-10})
     np.testing.assert_allclose(np.concatenate([fit.shift, fit.delta]), ref.x, atol=1e-5)
     np.testing.assert_allclose(fit.posterior.mean, post.mean + fit.delta)
-    z, h, eye = ref.x, 1e-4, np.eye(10)
-    hess = np.array([[(f(z + h * (eye[i] + eye[j])) - f(z + h * (eye[i] - eye[j]))
-                       - f(z - h * (eye[i] - eye[j])) + f(z - h * (eye[i] + eye[j]))) / (4 * h * h)
-                      for j in range(10)] for i in range(10)])
-    cov = np.linalg.inv(hess)
+    z = ref.x
+    cov = np.linalg.inv(_hessian(f, z))
     np.testing.assert_allclose(fit.posterior.cov, cov[6:, 6:], rtol=1e-3)
 
     def after(z):
         return z[:6] + band_log_amplitude(start + np.einsum("f,fbp->bp", np.exp(z[6:]), growth))
+    h, eye = 1e-4, np.eye(10)
     jac = np.array([(after(z + h * eye[i]) - after(z - h * eye[i])) / (2 * h) for i in range(10)]).T
     np.testing.assert_allclose(fit.level_cov, jac @ cov @ jac.T, rtol=1e-3)
     np.testing.assert_allclose(fit.cross, jac @ cov[:, 6:], rtol=1e-3, atol=1e-9)
@@ -125,11 +131,8 @@ def test_surveys_taken_one_by_one_give_the_posterior_of_all_of_them_at_once():
         r = (measured - np.array(paths)) / np.sqrt(noise_var)
         return 0.5 * np.sum(r * r) + 0.5 * z @ p_inv @ z
     ref = minimize(f, np.zeros(10), method="BFGS", options={"gtol": 1e-9})
-    z, h, eye = ref.x, 1e-4, np.eye(10)
-    hess = np.array([[(f(z + h * (eye[i] + eye[j])) - f(z + h * (eye[i] - eye[j]))
-                       - f(z - h * (eye[i] - eye[j])) + f(z - h * (eye[i] + eye[j]))) / (4 * h * h)
-                      for j in range(10)] for i in range(10)])
-    batch_sd = np.sqrt(np.diag(np.linalg.inv(hess))[6:])
+    z = ref.x
+    batch_sd = np.sqrt(np.diag(np.linalg.inv(_hessian(f, z)))[6:])
     post = _sequential(start, step, measured, level_var, noise_var)
     assert np.all(np.abs(post.mean - z[6:]) < batch_sd)
     np.testing.assert_allclose(np.sqrt(np.diag(post.cov)), batch_sd, rtol=0.3)

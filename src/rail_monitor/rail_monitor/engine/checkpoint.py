@@ -47,6 +47,7 @@ VERSION = 6
 # 5: before the daily passes per friction state (the daily growth read as none, as 1-4).
 READABLE_VERSIONS = (1, 2, 3, 4, 5, 6)
 CALIBRATION_ARRAYS = ("growth_by_state", "calibration_cov", "level_cov", "level_kb_cov")
+CALIBRATION_ARRAYS_4 = ("growth_by_state", "calibration_cov", "level_var")  # versions 4-5
 SEASON_ARRAYS = ("season_growth", "season_passes", "season_first_day")
 CONTACT_COLUMNS = ("regime", "load", "creepage")
 _COUNTS = ("pass_count", "axle_pass_count", "total_pass_count", "last_grinding_ns", "newest_ns", "last_survey_ns")
@@ -190,7 +191,7 @@ def _read(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
         meta = json.loads(str(data["meta"]))
         version = meta.get("version") if isinstance(meta, dict) else None
         wanted = COLUMNS if version in (3, 4, 5, VERSION) else tuple(n for n in COLUMNS if n not in CONTACT_COLUMNS)
-        calibrated = CALIBRATION_ARRAYS if version == VERSION else ("growth_by_state", "calibration_cov", "level_var")
+        calibrated = CALIBRATION_ARRAYS if version == VERSION else CALIBRATION_ARRAYS_4
         missing = {"bands", "log_components", "k_b", "survey_log_amplitude", *(f"recent_{n}" for n in wanted),
                    *(calibrated if version in (4, 5, VERSION) else ()),
                    *(SEASON_ARRAYS if version in (5, VERSION) else ())} - set(data)
