@@ -92,7 +92,7 @@ def interval(log_components: np.ndarray, growth_since_survey: np.ndarray, growth
     rng = np.random.Generator(np.random.PCG64(INTERVAL_SEED))
     bands = len(threshold)
     draws = rng.standard_normal((INTERVAL_DRAWS, bands + len(posterior.mean))) @ _root(
-        np.block([[level_cov, cross], [cross.T, posterior.cov]])).T
+        calibration.joint_cov(level_cov, cross, posterior.cov)).T
     level, delta = draws[:, :bands], draws[:, bands:]
     state = log_components + np.einsum("df,fbp->dbp", np.expm1(delta), growth_since_survey) + level[:, :, None]
     if season is not None:

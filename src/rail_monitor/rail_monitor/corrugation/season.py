@@ -93,20 +93,21 @@ def managed_as_recent(growth: np.ndarray, passes: np.ndarray, share: float) -> n
     d, m = FRICTION_DRY - 1, FRICTION_MODIFIER - 1
     n_d, n_m = passes[:, d].astype(float), passes[:, m].astype(float)
     need_m, need_d = (n_m == 0) & (n_d > 0) & (share > 0), (n_d == 0) & (n_m > 0) & (share < 1)
-    if need_m.any() or need_d.any():
-        if not (n_d.sum() and n_m.sum()):
-            return growth
-        mean_d, mean_m = growth[:, d].sum(axis=0) / n_d.sum(), growth[:, m].sum(axis=0) / n_m.sum()
-    per_d = np.divide(growth[:, d], n_d[:, None, None], out=np.zeros_like(growth[:, d]), where=n_d[:, None, None] > 0)
-    per_m = np.divide(growth[:, m], n_m[:, None, None], out=np.zeros_like(growth[:, m]), where=n_m[:, None, None] > 0)
-    if need_m.any():
-        ratio = np.divide(mean_m, mean_d, out=np.zeros_like(mean_m), where=mean_d != 0)
-        per_m[need_m] = per_d[need_m] * ratio
-    if need_d.any():
-        ratio = np.divide(mean_d, mean_m, out=np.zeros_like(mean_d), where=mean_m != 0)
-        per_d[need_d] = per_m[need_d] * ratio
+    if (need_m.any() or need_d.any()) and not (n_d.sum() and n_m.sum()):
+        return growth
+    per_d, per_m = _per_pass(growth[:, d], n_d), _per_pass(growth[:, m], n_m)
+    year_d, year_m = _per_pass(growth[:, d].sum(axis=0), n_d.sum()), _per_pass(growth[:, m].sum(axis=0), n_m.sum())
+    per_m[need_m] = per_d[need_m] * _per_pass(year_m, year_d)
+    per_d[need_d] = per_m[need_d] * _per_pass(year_d, year_m)
     out = growth.copy()
     managed = (n_d + n_m)[:, None, None]
     out[:, d] = managed * (1.0 - share) * per_d
     out[:, m] = managed * share * per_m
     return out
+
+
+def _per_pass(growth: np.ndarray, count: np.ndarray | float) -> np.ndarray:
+    """growth over count, per day where count is per day ((S, B, P) over (S,)); 0 where it is 0."""
+    count = np.asarray(count, float)
+    count = count.reshape(count.shape + (1,) * (np.ndim(growth) - count.ndim))
+    return np.divide(growth, count, out=np.zeros_like(growth), where=count != 0)

@@ -311,7 +311,7 @@ def _calibration(est: CorrugationEstimator, meta: dict, data: dict[str, np.ndarr
     if growth.shape != est.growth_by_state.shape or cov.shape != (4, 4) or cross.shape != est.level_kb_cov.shape \
             or level_cov.shape != est.level_cov.shape:
         raise ValueError("calibration arrays have the wrong shape")
-    joint = np.block([[level_cov, cross], [cross.T, cov]])
+    joint = calibration.joint_cov(level_cov, cross, cov)
     if not (np.all(np.isfinite(growth)) and np.all(np.isfinite(joint)) and np.allclose(joint, joint.T) and fits >= 0):
         raise ValueError("calibration arrays not finite or covariances not symmetric")
     np.linalg.cholesky(joint)  # LinAlgError (a ValueError) unless positive definite, as every survey leaves it

@@ -166,6 +166,31 @@ class SurveyFit:
     cross: np.ndarray
 
 
+def joint_cov(level_cov: np.ndarray, cross: np.ndarray, u_cov: np.ndarray) -> np.ndarray:
+    """The covariance of (the bands' levels, u), (B + 4, B + 4), from its blocks.
+
+    Parameters
+    ----------
+    level_cov : ndarray
+        Covariance of the bands' ln Z [-] (B, B).
+    cross : ndarray
+        Their covariance with u [-] (B, 4).
+    u_cov : ndarray
+        Covariance of u [-] (4, 4).
+
+    Returns
+    -------
+    ndarray
+        The joint covariance [-], levels first.
+
+    References
+    ----------
+    .. [1] A. Gelb (ed.), *Applied Optimal Estimation*, MIT Press, Cambridge MA, 1974, section 9.2
+       (parameters as augmented states).
+    """
+    return np.block([[level_cov, cross], [cross.T, u_cov]])
+
+
 def joint_update(post: KbPosterior, level_cov: np.ndarray, cross: np.ndarray, start: np.ndarray,
                  growth: np.ndarray, matched: np.ndarray, measured: np.ndarray, noise_var: np.ndarray | float
                  ) -> SurveyFit:
@@ -208,7 +233,7 @@ def joint_update(post: KbPosterior, level_cov: np.ndarray, cross: np.ndarray, st
     """
     bands, states = start.shape[0], len(post.mean)
     sel = np.flatnonzero(matched)
-    p_inv = np.linalg.inv(np.block([[level_cov, cross], [cross.T, post.cov]]))
+    p_inv = np.linalg.inv(joint_cov(level_cov, cross, post.cov))
     w = np.broadcast_to(1.0 / np.asarray(noise_var, float), sel.shape)
     h = np.zeros((len(sel), bands + states))
     h[np.arange(len(sel)), sel] = 1.0
