@@ -74,6 +74,10 @@ def graph_rows(source: str, site: str, keep: Path, repeat: int) -> list[Row]:
         ("real / ceiling", f"{np.median(ratios):.2f}",
          f"median of the {repeat} pairs ({', '.join(f'{x:.2f}' for x in ratios)}); against rclpy's default "
          f"dispatch: {bare1['replay_s'] / real['replay_s']:.2f}"),
+        *((f"no-op replay + the site engine alone {what}", f"{bound:.2f}",
+           f"of the ceiling: engine {t['engine_s']:.2f} s, its outputs' CDR {t['outputs_s']:.2f} s, no DDS "
+           "(the best a one-process graph could reach)")
+          for what, t, bound in bg.engine_bounds(source, site, bare["replay_s"])),
     ]
 
 

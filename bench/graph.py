@@ -3,7 +3,9 @@
 Each graph runs in its own process (``python -m bench.graph --one real|bare``): the real
 wayside_monitor graph, or the no-op graph of bench.bare_graph with the same topology, message
 types and sizes, QoS, executor and pass source, on the same input. Passes per second are over
-the replay (first pass published to the last output recorded); set-up is reported apart.
+the replay (first pass published to the last output recorded); set-up is reported apart. Then the
+site engine alone (bench.engine_pass.replay), as the graph feeds it and at its fastest: the no-op
+replay's time plus the engine's own is the best ratio a graph of one process could reach.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from bench.engine_pass import replay as engine_replay
 from bench.timing import peak_rss_mb
 from rail_monitor.site_file import load_parameter_file
 
@@ -73,6 +76,21 @@ def ceiling_ratios(pairs: list[tuple[dict[str, Any], dict[str, Any]]]) -> list[f
     return [bare["replay_s"] / real["replay_s"] for bare, real in pairs]
 
 
+def engine_bounds(source: str, site: str, floor_s: float, max_batch: int = 200
+                  ) -> list[tuple[str, dict[str, float], float]]:
+    """The site engine alone over the history (bench.engine_pass.replay), as the graph feeds it and
+    at its fastest: (what, its times, floor_s / (floor_s + its time)). The last is the ratio to the
+    ceiling (floor_s: the no-op replay's time) of a one-process graph that added nothing else: in
+    one process on one thread the engine's time adds to rclpy's."""
+    out = []
+    for what, chunk, kernels in ((f"as the graph feeds it (backlogs of {max_batch}, numpy kernels)", max_batch,
+                                  "numpy"),
+                                 ("at its fastest (the whole history one chunk, compiled kernels)", 10**9, "numba")):
+        t = engine_replay(site, source, chunk, kernels)
+        out.append((what, t, floor_s / (floor_s + t["engine_s"] + t["outputs_s"])))
+    return out
+
+
 def recorder_process(source: str) -> dict[str, Any]:
     """mcap_recorder in its own process recording pass_replayer (another process) over DDS as fast
     as it acknowledges: messages recorded, replay wall time [s], the recorder's peak RSS [MB]."""
@@ -120,7 +138,10 @@ def main() -> None:
     print(f"real / bare: {bare['replay_s'] / float(np.median([real['replay_s'] for _, real in pairs])):.2f}; "
           f"real / bare with the same batching: median {np.median(ratios):.2f} of "
           + ", ".join(f"{x:.2f}" for x in ratios))
-
+    for what, t, bound in engine_bounds(ns.source, ns.site, float(np.median([b["replay_s"] for b, _ in pairs])),
+                                        ns.max_batch):
+        print(f"the site engine alone {what}: {t['engine_s']:.2f} s, its outputs' CDR {t['outputs_s']:.2f} s; "
+              f"no-op replay + that = {bound:.2f} of the ceiling")
 
 if __name__ == "__main__":
     main()

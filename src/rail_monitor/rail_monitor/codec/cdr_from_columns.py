@@ -6,7 +6,8 @@ sequences (n, length) or one array per message, strings a list of str, sequences
 list of lists, sub-messages a namespace or dict of their own columns). Every message's field
 offsets follow from its strings' and sequences' lengths and CDR's alignment, computed for all
 messages at once; each field is then written into one zeroed buffer for every message in one
-numpy step (strings one by one, as bytes). A few messages are written one by one.
+numpy step (strings, and sequences whose lengths differ, joined and scattered in one step too).
+A few messages are written one by one.
 """
 
 from __future__ import annotations
@@ -36,8 +37,9 @@ class _Plan:
     def __init__(self, n: int) -> None:
         self.pos = np.full(n, len(ENCAPSULATION), np.int64)
         self.blocks: list[tuple[Any, np.ndarray, np.ndarray]] = []   # rows, offsets, (rows, width) bytes
-        # offsets, bytes per message: strings, and arrays whose lengths differ between messages
-        self.pieces: list[tuple[np.ndarray, list[bytes | None]]] = []
+        # strings, and arrays whose lengths differ between messages: per message the offset and the
+        # length of its piece, and the pieces joined
+        self.pieces: list[tuple[np.ndarray, np.ndarray, bytes]] = []
 
     def align(self, size: int, where: np.ndarray | None = None) -> None:
         step = -(self.pos - 4) % size
@@ -54,10 +56,12 @@ class _Plan:
         self.put(rows, np.ascontiguousarray(np.asarray(n, "<u4")[rows]).view(np.uint8).reshape(-1, 4))
 
     def string(self, texts: list[str | None], active: np.ndarray | None = None) -> None:
-        data = [None if t is None else t.encode() for t in texts]
-        size = np.array([0 if d is None else len(d) + 1 for d in data], np.int64)   # the NUL included
-        self.count(size, np.array([d is not None for d in data]) if active is None else active)
-        self.pieces.append((self.pos.copy(), data))
+        data = [b"" if t is None else t.encode() for t in texts]
+        present = np.fromiter((t is not None for t in texts), bool, len(texts))
+        lengths = np.fromiter(map(len, data), np.int64, len(data))
+        size = np.where(present, lengths + 1, 0)   # the NUL included (the buffer is zeroed)
+        self.count(size, present if active is None else active)
+        self.pieces.append((self.pos.copy(), lengths, b"".join(data)))
         self.pos += size
 
 
@@ -111,8 +115,9 @@ def _numbers(plan: _Plan, name: str, value: Any, dtype: np.dtype, length: int | 
         block = np.ascontiguousarray(np.asarray(value, dtype)).reshape(n, -1)
         plan.put(slice(None), block.view(np.uint8).reshape(n, -1))
     else:
-        plan.pieces.append((plan.pos.copy(), [r.tobytes() for r in rows]))
-        plan.pos += counts * dtype.itemsize
+        size = counts * dtype.itemsize
+        plan.pieces.append((plan.pos.copy(), size, np.concatenate(rows).tobytes() if rows else b""))
+        plan.pos += size
 
 
 def _strings(plan: _Plan, value: list[list[str]], length: int | None) -> None:
@@ -143,9 +148,9 @@ def serialize_columns(typename: str, values: Any, n: int) -> list[bytes]:
     for rows, offsets, data in plan.blocks:
         if data.size:
             buf[(start[:-1][rows] + offsets)[:, None] + np.arange(data.shape[1])] = data
-    for offsets, datas in plan.pieces:
-        at = (start[:-1] + offsets).tolist()
-        for a, d in zip(at, datas, strict=True):
-            if d:
-                raw[a:a + len(d)] = d
-    return [bytes(raw[a:b]) for a, b in zip(start[:-1].tolist(), start[1:].tolist(), strict=True)]
+    for offsets, lengths, joined in plan.pieces:
+        if joined:  # byte j of the joined pieces, in piece k, goes to k's offset + (j - k's start)
+            shift = start[:-1] + offsets - (np.cumsum(lengths) - lengths)
+            buf[np.repeat(shift, lengths) + np.arange(len(joined))] = np.frombuffer(joined, np.uint8)
+    whole = bytes(raw)
+    return [whole[a:b] for a, b in zip(start[:-1].tolist(), start[1:].tolist(), strict=True)]

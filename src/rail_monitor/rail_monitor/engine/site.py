@@ -298,13 +298,13 @@ class SiteEngine:
 
         # Block by block, so that the tracker holds no more than a block of predictions unpaired
         # (it keeps residual.held_predictions, however long the chunk).
-        predicted = predictions_of(accepted, noise, squeal_risk)
-        per, cut = len(self.tracker.models), np.iinfo(np.int64).min
+        cut = np.iinfo(np.int64).min
         block = max(1, min(PAIR_BLOCK, self.tracker.cfg.held_predictions // 2))
         for lo in range(0, len(accepted), block):
             cut = max(cut, int(accepted.stamp_ns[lo:lo + block].max()))
             take(cut)
-            out.extend(self.tracker.add_predictions(predicted[lo * per:(lo + block) * per]))
+            out.extend(self.tracker.add_predictions(predictions_of(accepted, noise, squeal_risk,
+                                                                   slice(lo, lo + block))))
         take(max(cut, int(table.stamp_ns.max()) if len(table) else cut))
         return taken, out
 

@@ -35,7 +35,8 @@ import math
 from collections import Counter, OrderedDict, deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from itertools import repeat
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -48,9 +49,9 @@ MID_BAND_HZ = (500.0, 2000.0)
 UNPAIRED = "no prediction for this pass (no such pass, or it was rejected)"
 
 
-@dataclass(frozen=True)
-class Predicted:
-    """One model's prediction of one pass (units as in rail_msgs/RollingNoise)."""
+class Predicted(NamedTuple):
+    """One model's prediction of one pass (units as in rail_msgs/RollingNoise). A named tuple: the
+    engine holds one per pass and model for the measurements to come, built in C."""
 
     stamp_ns: int
     train_id: str
@@ -231,12 +232,17 @@ class ResidualTracker:
         return out
 
 
-def predictions_of(passes: Any, noise: Mapping[str, Any], squeal_risk: np.ndarray) -> list[Predicted]:
-    """Each pass's prediction by each noise model and its squeal risk (rows of passes, a
-    PassTable, of each model's NoisePrediction and of squeal_risk), pass by pass."""
-    stamps, trains = passes.stamp_ns.tolist(), passes.train_id.tolist()
-    cols = {m: (p.lp_db, p.lpaeq_tp_dba.tolist(), p.lpafmax_dba.tolist(), p.tel_dba.tolist()) for m, p in noise.items()}
+def predictions_of(passes: Any, noise: Mapping[str, Any], squeal_risk: np.ndarray, rows: slice = slice(None)
+                   ) -> list[Predicted]:
+    """The predictions of the passes at rows (a slice of passes, a PassTable, of each model's
+    NoisePrediction and of squeal_risk): each noise model's in pass order, then the squeal
+    model's risk (ResidualTracker.add_predictions keeps each model's in stamp order)."""
+    stamps, trains = passes.stamp_ns[rows].tolist(), passes.train_id[rows].tolist()
+    out: list[Predicted] = []
+    for m, p in noise.items():
+        out += map(Predicted, stamps, trains, repeat(m), p.lp_db[rows], p.lpaeq_tp_dba[rows].tolist(),
+                   p.lpafmax_dba[rows].tolist(), p.tel_dba[rows].tolist())
     none = np.zeros(0)
-    return [p for i in range(len(stamps)) for p in (
-        *(Predicted(stamps[i], trains[i], m, lp[i], a[i], f[i], t[i]) for m, (lp, a, f, t) in cols.items()),
-        Predicted(stamps[i], trains[i], SQUEAL, none, math.nan, math.nan, math.nan, int(squeal_risk[i])))]
+    out += map(Predicted, stamps, trains, repeat(SQUEAL), repeat(none), repeat(math.nan), repeat(math.nan),
+               repeat(math.nan), np.asarray(squeal_risk[rows], int).tolist())
+    return out
