@@ -51,7 +51,8 @@ UNPAIRED = "no prediction for this pass (no such pass, or it was rejected)"
 
 class Predicted(NamedTuple):
     """One model's prediction of one pass (units as in rail_msgs/RollingNoise). A named tuple: the
-    engine holds one per pass and model for the measurements to come, built in C."""
+    engine holds one per pass and model for the measurements to come, and a tuple is the cheapest
+    record to build."""
 
     stamp_ns: int
     train_id: str
