@@ -143,5 +143,6 @@ def main() -> None:
         print(f"the site engine alone {what}: {t['engine_s']:.2f} s, its outputs' CDR {t['outputs_s']:.2f} s; "
               f"no-op replay + that = {bound:.2f} of the ceiling")
 
+
 if __name__ == "__main__":
     main()
