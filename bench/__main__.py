@@ -77,7 +77,7 @@ def graph_rows(source: str, site: str, keep: Path, repeat: int) -> list[Row]:
         *((f"no-op replay + the site engine alone {what}", f"{bound:.2f}",
            f"of the ceiling: engine {t['engine_s']:.2f} s, its outputs' CDR {t['outputs_s']:.2f} s, no DDS "
            "(the best a one-process graph could reach)")
-          for what, t, bound in bg.engine_bounds(source, site, bare["replay_s"])),
+          for what, t, bound in bg.engine_bounds(source, site, [b for b, _ in pairs])),
     ]
 
 

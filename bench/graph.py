@@ -76,12 +76,13 @@ def ceiling_ratios(pairs: list[tuple[dict[str, Any], dict[str, Any]]]) -> list[f
     return [bare["replay_s"] / real["replay_s"] for bare, real in pairs]
 
 
-def engine_bounds(source: str, site: str, floor_s: float, max_batch: int = 200
+def engine_bounds(source: str, site: str, bare_runs: list[dict[str, Any]], max_batch: int = 200
                   ) -> list[tuple[str, dict[str, float], float]]:
     """The site engine alone over the history (bench.engine_pass.replay), as the graph feeds it and
-    at its fastest: (what, its times, floor_s / (floor_s + its time)). The last is the ratio to the
-    ceiling (floor_s: the no-op replay's time) of a one-process graph that added nothing else: in
-    one process on one thread the engine's time adds to rclpy's."""
+    at its fastest: (what, its times, floor / (floor + its time)), floor the median replay time of
+    the no-op runs. The last is the ratio to the ceiling of a one-process graph that added nothing
+    else: in one process on one thread the engine's time adds to rclpy's."""
+    floor_s = float(np.median([r["replay_s"] for r in bare_runs]))
     out = []
     for what, chunk, kernels in ((f"as the graph feeds it (backlogs of {max_batch}, numpy kernels)", max_batch,
                                   "numpy"),
@@ -138,8 +139,7 @@ def main() -> None:
     print(f"real / bare: {bare['replay_s'] / float(np.median([real['replay_s'] for _, real in pairs])):.2f}; "
           f"real / bare with the same batching: median {np.median(ratios):.2f} of "
           + ", ".join(f"{x:.2f}" for x in ratios))
-    for what, t, bound in engine_bounds(ns.source, ns.site, float(np.median([b["replay_s"] for b, _ in pairs])),
-                                        ns.max_batch):
+    for what, t, bound in engine_bounds(ns.source, ns.site, [b for b, _ in pairs], ns.max_batch):
         print(f"the site engine alone {what}: {t['engine_s']:.2f} s, its outputs' CDR {t['outputs_s']:.2f} s; "
               f"no-op replay + that = {bound:.2f} of the ceiling")
 
